@@ -1,0 +1,87 @@
+//! One attached end of a port: its place in the core, and what it does on detach.
+
+use std::sync::Arc;
+use std::task::Context;
+use std::time::Duration;
+
+use crate::core::{Core, SlotId};
+use crate::meta::Name;
+
+pub(crate) struct Attachment<Req, Rep> {
+    pub(crate) core: Arc<Core<Req, Rep>>,
+    /// `Owner` for the owner end, `User(i)` for the user attached at slot `i`.
+    pub(crate) at: SlotId,
+    pub(crate) module: Name,
+    pub(crate) timeout: Option<Duration>,
+}
+
+impl<Req, Rep> Attachment<Req, Rep> {
+    pub(crate) fn is_owner(&self) -> bool {
+        self.at == SlotId::Owner
+    }
+
+    pub(crate) fn port(&self) -> &Name {
+        &self.core.meta.name
+    }
+
+    /// Takes the oldest request waiting for this end to serve it, and where it came from.
+    pub(crate) fn try_take(&self) -> Option<(Req, SlotId)> {
+        match self.at {
+            SlotId::Owner => loop {
+                let index = self.core.oldest_posted_user()?;
+                if let Some(request) = self.core.users[index].slot.take() {
+                    return Some((request, SlotId::User(index)));
+                }
+                // Its poster withdrew it between the scan and the take: look again.
+            },
+            SlotId::User(index) => {
+                // A broadcast lands in the user's own slot; a plain owner post in the
+                // owner's slot, which every user may take from.
+                let own = self.core.users[index].slot.take();
+                own.map(|request| (request, SlotId::User(index)))
+                    .or_else(|| {
+                        let shared = self.core.owner_slot.take()?;
+                        Some((shared, SlotId::Owner))
+                    })
+            }
+        }
+    }
+
+    /// Whether a request is waiting for this end to serve it.
+    pub(crate) fn has_waiting(&self) -> bool {
+        match self.at {
+            SlotId::Owner => self.core.oldest_posted_user().is_some(),
+            SlotId::User(index) => {
+                self.core.users[index].slot.posted_ticket().is_some()
+                    || self.core.owner_slot.posted_ticket().is_some()
+            }
+        }
+    }
+
+    /// Registers the task to be woken when a request arrives for this end to serve.
+    pub(crate) fn register_server(&self, cx: &mut Context<'_>) {
+        match self.at {
+            SlotId::Owner => self.core.owner_waker.register_by_ref(cx.waker()),
+            SlotId::User(index) => self.core.users[index].waker.register_by_ref(cx.waker()),
+        }
+    }
+
+    /// Whether no peer can ever come to this end again.
+    pub(crate) fn peer_gone(&self) -> bool {
+        self.core.peer_gone(self.is_owner())
+    }
+
+    /// How long a wait on this end may spin before it parks.
+    pub(crate) fn spins(&self) -> u32 {
+        self.core.meta.process_type.spins()
+    }
+}
+
+impl<Req, Rep> Drop for Attachment<Req, Rep> {
+    fn drop(&mut self) {
+        match self.at {
+            SlotId::Owner => self.core.detach_owner(),
+            SlotId::User(index) => self.core.detach_user(index),
+        }
+    }
+}

@@ -1,0 +1,198 @@
+//! The in-process transport: the shared state behind one port.
+//!
+//! One [`Slot`] per user, sized by the port's const-generic capacity when the port is
+//! declared, plus one slot for the owner's own posts. Users post into their own slot; the
+//! owner posts into its slot (any one user may take it) or, broadcasting, into every user's.
+
+use std::sync::{Mutex, PoisonError};
+use std::task::Waker;
+
+use crate::clock::SharedClock;
+use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
+use crate::meta::{Name, PortMeta};
+use crate::slot::Slot;
+
+/// Which slot of a port: the owner's, or a user's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SlotId {
+    Owner,
+    User(usize),
+}
+
+pub(crate) struct UserSlot<Req, Rep> {
+    pub(crate) slot: Slot<Req, Rep>,
+    /// Wakes the user while it waits to serve (receive or respond).
+    pub(crate) waker: AtomicWaker,
+    attached: AtomicBool,
+    /// Set by the owner while a broadcast of its awaits this user's answer.
+    pub(crate) in_broadcast: AtomicBool,
+    /// The attached module, for broadcasts to say who answered. Written only on attach.
+    module: Mutex<Option<Name>>,
+}
+
+impl<Req, Rep> UserSlot<Req, Rep> {
+    pub(crate) fn new() -> Self {
+        Self {
+            slot: Slot::new(),
+            waker: AtomicWaker::new(),
+            attached: AtomicBool::new(false),
+            in_broadcast: AtomicBool::new(false),
+            module: Mutex::new(None),
+        }
+    }
+}
+
+/// The shared state of one port. The user slots are allocated once, when the port is
+/// declared, from its const-generic capacity; nothing is allocated per message.
+pub(crate) struct Core<Req, Rep> {
+    pub(crate) meta: PortMeta,
+    pub(crate) clock: SharedClock,
+    next_ticket: AtomicU64,
+    pub(crate) owner_slot: Slot<Req, Rep>,
+    /// Wakes the owner while it waits to serve, or for a broadcast's answers.
+    pub(crate) owner_waker: AtomicWaker,
+    owner_attached: AtomicBool,
+    /// Live `Port` handles: while one exists, a missing end may still attach.
+    declarations: AtomicUsize,
+    users_attached: AtomicUsize,
+    pub(crate) users: Box<[UserSlot<Req, Rep>]>,
+}
+
+impl<Req, Rep> Core<Req, Rep> {
+    pub(crate) fn new(meta: PortMeta, clock: SharedClock, capacity: usize) -> Self {
+        Self {
+            meta,
+            clock,
+            next_ticket: AtomicU64::new(0),
+            owner_slot: Slot::new(),
+            owner_waker: AtomicWaker::new(),
+            owner_attached: AtomicBool::new(false),
+            declarations: AtomicUsize::new(1),
+            users_attached: AtomicUsize::new(0),
+            users: (0..capacity).map(|_| UserSlot::new()).collect(),
+        }
+    }
+
+    pub(crate) fn capacity(&self) -> usize {
+        self.users.len()
+    }
+
+    pub(crate) fn slot(&self, id: SlotId) -> &Slot<Req, Rep> {
+        match id {
+            SlotId::Owner => &self.owner_slot,
+            SlotId::User(index) => &self.users[index].slot,
+        }
+    }
+
+    pub(crate) fn ticket(&self) -> u64 {
+        self.next_ticket.fetch_add(1, Ordering::Relaxed)
+    }
+
+    /// The user slot holding the oldest waiting request, if any.
+    pub(crate) fn oldest_posted_user(&self) -> Option<usize> {
+        self.users
+            .iter()
+            .enumerate()
+            .filter_map(|(index, user)| Some((user.slot.posted_ticket()?, index)))
+            .min()
+            .map(|(_, index)| index)
+    }
+
+    /// Tells whoever serves the posts of `poster` that something arrived.
+    pub(crate) fn wake_servers_of(&self, poster: SlotId) {
+        match poster {
+            SlotId::User(_) => self.owner_waker.wake(),
+            SlotId::Owner => self.users.iter().for_each(|user| user.waker.wake()),
+        }
+    }
+
+    pub(crate) fn attach_owner(&self) -> bool {
+        self.owner_attached
+            .compare_exchange(false, true, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
+
+    pub(crate) fn detach_owner(&self) {
+        self.owner_attached.store(false, Ordering::Release);
+        self.wake_all();
+    }
+
+    pub(crate) fn attach_user(&self, module: &Name) -> Option<usize> {
+        let index = self.users.iter().position(|user| {
+            user.attached
+                .compare_exchange(false, true, Ordering::AcqRel, Ordering::Acquire)
+                .is_ok()
+        })?;
+        *self.users[index]
+            .module
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Some(module.clone());
+        self.users_attached.fetch_add(1, Ordering::AcqRel);
+        Some(index)
+    }
+
+    /// The module attached (or last attached) at user slot `index`.
+    pub(crate) fn user_module(&self, index: usize) -> Option<Name> {
+        self.users[index]
+            .module
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    pub(crate) fn detach_user(&self, index: usize) {
+        self.users[index].attached.store(false, Ordering::Release);
+        self.users_attached.fetch_sub(1, Ordering::AcqRel);
+        self.wake_all();
+    }
+
+    pub(crate) fn is_user_attached(&self, index: usize) -> bool {
+        self.users[index].attached.load(Ordering::Acquire)
+    }
+
+    pub(crate) fn users_attached(&self) -> usize {
+        self.users_attached.load(Ordering::Acquire)
+    }
+
+    pub(crate) fn add_declaration(&self) {
+        self.declarations.fetch_add(1, Ordering::AcqRel);
+    }
+
+    pub(crate) fn drop_declaration(&self) {
+        if self.declarations.fetch_sub(1, Ordering::AcqRel) == 1 {
+            self.wake_all();
+        }
+    }
+
+    /// Whether the other side of `side` is gone for good: nobody attached there, and no
+    /// declaration left from which anybody could attach.
+    pub(crate) fn peer_gone(&self, owner_side: bool) -> bool {
+        if self.declarations.load(Ordering::Acquire) > 0 {
+            return false;
+        }
+        if owner_side {
+            self.users_attached() == 0
+        } else {
+            !self.owner_attached.load(Ordering::Acquire)
+        }
+    }
+
+    /// Wakes every waiter, so that each re-checks whether its peer is gone.
+    fn wake_all(&self) {
+        self.owner_waker.wake();
+        self.owner_slot.wake_poster();
+        for user in self.users.iter() {
+            user.waker.wake();
+            user.slot.wake_poster();
+        }
+    }
+}
+
+/// Registers `waker` with every user slot's poster waker: a broadcast waits on all of them.
+pub(crate) fn register_broadcast<Req, Rep>(core: &Core<Req, Rep>, waker: &Waker) {
+    for user in core.users.iter() {
+        if user.in_broadcast.load(Ordering::Relaxed) {
+            user.slot.register_poster(waker);
+        }
+    }
+}

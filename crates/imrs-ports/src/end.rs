@@ -1,0 +1,128 @@
+//! Port ends: what a module holds to use a port. An end has only the methods of its usage.
+
+use std::fmt;
+use std::marker::PhantomData;
+use std::time::Duration;
+
+use crate::attachment::Attachment;
+use crate::broadcast::Broadcasting;
+use crate::meta::Name;
+use crate::post::{Posting, QueryOutcome, SendOutcome};
+use crate::priority::Priority;
+use crate::receive::{Receiving, ReplyHandle};
+use crate::usage::{CallsAll, Queries, Receives, Sends, SendsAll, Usage};
+
+/// One end of a port, owner's or user's, with usage `U`.
+///
+/// Built by [`Port::owner`](crate::Port::owner), [`Port::user`](crate::Port::user) or the
+/// [`Wiring`](crate::Wiring). Dropping it detaches it: the port stays, and a new copy of the
+/// module can attach in its place.
+pub struct End<Req, Rep, U: Usage> {
+    pub(crate) attachment: Attachment<Req, Rep>,
+    _usage: PhantomData<fn() -> U>,
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
+    pub(crate) fn new(attachment: Attachment<Req, Rep>) -> Self {
+        Self {
+            attachment,
+            _usage: PhantomData,
+        }
+    }
+
+    /// Sets this end's timeout (the seed's `TIMEOUT=` owner or user option).
+    pub fn with_timeout(mut self, timeout: Duration) -> Self {
+        self.attachment.timeout = Some(timeout);
+        self
+    }
+
+    /// The timeout of this end's primitives, if it has one.
+    pub fn timeout(&self) -> Option<Duration> {
+        self.attachment.timeout
+    }
+
+    /// The port's name.
+    pub fn port(&self) -> &Name {
+        self.attachment.port()
+    }
+
+    /// The module holding this end.
+    pub fn module(&self) -> &Name {
+        &self.attachment.module
+    }
+
+    /// The port's priority, used by [`select`](crate::select()).
+    pub fn priority(&self) -> Priority {
+        self.attachment.core.meta.priority
+    }
+
+    /// `SEND`: sends `message` and waits until the receiver replies; returns the reply.
+    ///
+    /// On a timeout or a closed port an undelivered message comes back in the error.
+    pub fn send(&mut self, message: Req) -> Posting<'_, Req, Rep, SendOutcome>
+    where
+        U: Sends,
+    {
+        Posting::new(&self.attachment, message)
+    }
+
+    /// `RECEIVE`: waits for a sender; returns its message and the handle to reply with.
+    ///
+    /// Several replies may be pending at once, and a handle may be moved to another task.
+    pub fn receive(&mut self) -> Receiving<'_, Req, Rep>
+    where
+        U: Receives,
+    {
+        Receiving::new(&self.attachment)
+    }
+
+    /// Takes a waiting message without blocking, if there is one.
+    pub fn try_receive(&mut self) -> Option<(Req, ReplyHandle<Rep>)>
+    where
+        U: Receives,
+    {
+        let (message, from) = self.attachment.try_take()?;
+        Some((message, ReplyHandle::new(&self.attachment, from)))
+    }
+
+    /// `QUERY`: runs the response handler at the other end and waits for its answer.
+    ///
+    /// When the handler runs is up to the responding module's order.
+    pub fn query(&mut self, query: Req) -> Posting<'_, Req, Rep, QueryOutcome>
+    where
+        U: Queries,
+    {
+        Posting::new(&self.attachment, query)
+    }
+
+    /// `SENDALL`: sends `message` to every user; returns at the first reply, and the later
+    /// replies stay readable through the returned [`Broadcast`](crate::Broadcast).
+    pub fn send_all(&mut self, message: Req) -> Broadcasting<'_, Req, Rep>
+    where
+        U: SendsAll,
+        Req: Clone,
+    {
+        Broadcasting::new(&self.attachment, message)
+    }
+
+    /// `CALLALL`: queries every user's response handler; returns at the first answer, and
+    /// the later answers stay readable through the returned [`Broadcast`](crate::Broadcast).
+    pub fn call_all(&mut self, query: Req) -> Broadcasting<'_, Req, Rep>
+    where
+        U: CallsAll,
+        Req: Clone,
+    {
+        Broadcasting::new(&self.attachment, query)
+    }
+}
+
+impl<Req, Rep, U: Usage> fmt::Debug for End<Req, Rep, U> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("End")
+            .field("port", self.attachment.port())
+            .field("module", &self.attachment.module)
+            .field("usage", &U::KIND)
+            .field("owner", &self.attachment.is_owner())
+            .finish()
+    }
+}

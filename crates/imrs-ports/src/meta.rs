@@ -1,0 +1,81 @@
+//! What a port declaration says about itself, kept at run time for checks and messages.
+
+use std::fmt;
+use std::sync::Arc;
+use std::time::Duration;
+
+use crate::priority::Priority;
+use crate::process_type::ProcessType;
+use crate::usage::UsageKind;
+
+/// A port's or a module's name, cheap to clone into errors.
+#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Name(Arc<str>);
+
+impl Name {
+    /// The name as text.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl From<&str> for Name {
+    fn from(name: &str) -> Self {
+        Self(name.into())
+    }
+}
+
+impl From<String> for Name {
+    fn from(name: String) -> Self {
+        Self(name.into())
+    }
+}
+
+impl fmt::Display for Name {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl fmt::Debug for Name {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(&*self.0, f)
+    }
+}
+
+impl PartialEq<str> for Name {
+    fn eq(&self, other: &str) -> bool {
+        &*self.0 == other
+    }
+}
+
+impl PartialEq<&str> for Name {
+    fn eq(&self, other: &&str) -> bool {
+        &*self.0 == *other
+    }
+}
+
+/// A module known by type, so that user lists can be checked at compile time.
+pub trait Named {
+    /// The module's name, as the seed writes it (`"LOAD_CARD"`).
+    const NAME: &'static str;
+}
+
+#[derive(Debug, Clone)]
+pub(crate) struct PortMeta {
+    pub(crate) name: Name,
+    pub(crate) owner: Name,
+    pub(crate) usage: UsageKind,
+    pub(crate) user_list: Option<Box<[Name]>>,
+    pub(crate) timeout: Option<Duration>,
+    pub(crate) priority: Priority,
+    pub(crate) process_type: ProcessType,
+}
+
+impl PortMeta {
+    pub(crate) fn admits(&self, module: &str) -> bool {
+        self.user_list
+            .as_ref()
+            .is_none_or(|list| list.iter().any(|name| name.as_str() == module))
+    }
+}

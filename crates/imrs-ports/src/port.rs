@@ -1,0 +1,319 @@
+//! Port declarations: the owner's `PORT` statement with its restrictions.
+
+use std::any::type_name;
+use std::fmt;
+use std::marker::PhantomData;
+use std::sync::Arc;
+use std::time::Duration;
+
+use crate::attachment::Attachment;
+use crate::clock::{RealClock, SharedClock};
+use crate::core::{Core, SlotId};
+use crate::end::End;
+use crate::error::WireError;
+use crate::meta::{Name, Named, PortMeta};
+use crate::priority::Priority;
+use crate::process_type::ProcessType;
+use crate::response::ResponseEnd;
+use crate::usage::{self, Plain, Usage};
+use crate::user_list::{Admits, AnyUser, UserList};
+
+/// The restrictions of a port that are values rather than types: its name and owner,
+/// timeout, priority, process type, clock, and a user list of names when the users are not
+/// known as types.
+#[derive(Debug, Clone)]
+pub struct PortSpec {
+    name: Name,
+    owner: Name,
+    timeout: Option<Duration>,
+    priority: Priority,
+    process_type: ProcessType,
+    user_list: Option<Vec<Name>>,
+    clock: Option<SharedClock>,
+}
+
+impl PortSpec {
+    /// Port `name`, owned by module `owner`.
+    pub fn new(name: impl Into<Name>, owner: impl Into<Name>) -> Self {
+        Self {
+            name: name.into(),
+            owner: owner.into(),
+            timeout: None,
+            priority: Priority::DEFAULT,
+            process_type: ProcessType::default(),
+            user_list: None,
+            clock: None,
+        }
+    }
+
+    /// `TIMEOUT=`: the owner end's primitives fail with a timeout after `timeout`.
+    pub fn timeout(mut self, timeout: Duration) -> Self {
+        self.timeout = Some(timeout);
+        self
+    }
+
+    /// `PRIORITY=n`: 1 is the most urgent.
+    pub fn priority(mut self, n: u32) -> Self {
+        self.priority = Priority::declared(n);
+        self
+    }
+
+    /// The process class of the subprocesses this port links.
+    pub fn process_type(mut self, process_type: ProcessType) -> Self {
+        self.process_type = process_type;
+        self
+    }
+
+    /// `USERLIST=(...)` by name, checked when a user attaches. Ports whose users are types
+    /// declare a [`user_list!`](crate::user_list) instead, checked at compile time.
+    pub fn user_list<I, S>(mut self, modules: I) -> Self
+    where
+        I: IntoIterator<Item = S>,
+        S: Into<Name>,
+    {
+        self.user_list = Some(modules.into_iter().map(Into::into).collect());
+        self
+    }
+
+    /// The clock the port's timeouts run on (the wall clock by default).
+    pub fn clock(mut self, clock: SharedClock) -> Self {
+        self.clock = Some(clock);
+        self
+    }
+
+    /// The port's name.
+    pub fn name(&self) -> &Name {
+        &self.name
+    }
+
+    pub(crate) fn owner_name(&self) -> &Name {
+        &self.owner
+    }
+
+    pub(crate) fn with_timeout_of(mut self, other: &PortSpec) -> Self {
+        self.timeout = other.timeout;
+        self
+    }
+
+    pub(crate) fn with_clock_of(mut self, other: &PortSpec) -> Self {
+        self.clock = other.clock.clone();
+        self
+    }
+
+    pub(crate) fn without_timeout(mut self) -> Self {
+        self.timeout = None;
+        self
+    }
+}
+
+/// A declared port carrying `Req` messages answered by `Rep`, whose owner's usage is `U`,
+/// whose users are restricted by the user list `L`, and which admits at most `N` active
+/// users (`#USERS=N`; the buffers are sized once from it).
+///
+/// The declaration is a handle: clones share the port, and while one lives, ends may attach
+/// and re-attach (a restarted module re-attaches to the same port).
+pub struct Port<Req, Rep, U: Usage, L: UserList = AnyUser, const N: usize = 1> {
+    core: Arc<Core<Req, Rep>>,
+    _restrictions: PhantomData<fn() -> (U, L)>,
+}
+
+impl<Req, Rep, U, L, const N: usize> Port<Req, Rep, U, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: Usage,
+    L: UserList,
+{
+    /// Declares the port.
+    pub fn declare(spec: PortSpec) -> Self {
+        const { assert!(N > 0, "a port needs room for at least one user (#USERS >= 1)") };
+        let user_list = match L::NAMES {
+            Some(names) => Some(names.iter().map(|&name| Name::from(name)).collect()),
+            None => spec.user_list.map(Vec::into_boxed_slice),
+        };
+        let meta = PortMeta {
+            name: spec.name,
+            owner: spec.owner,
+            usage: U::KIND,
+            user_list,
+            timeout: spec.timeout,
+            priority: spec.priority,
+            process_type: spec.process_type,
+        };
+        let clock = spec.clock.unwrap_or_else(|| Arc::new(RealClock::new()));
+        Self {
+            core: Arc::new(Core::new(meta, clock, N)),
+            _restrictions: PhantomData,
+        }
+    }
+
+    /// The port's name.
+    pub fn name(&self) -> &Name {
+        &self.core.meta.name
+    }
+
+    /// The owning module's name.
+    pub fn owner_module(&self) -> &Name {
+        &self.core.meta.owner
+    }
+
+    /// How many users are attached now.
+    pub fn users_attached(&self) -> usize {
+        self.core.users_attached()
+    }
+
+    /// Attaches the owner end. One owner end at a time; after it is dropped (its module
+    /// died), a new copy of the module may attach again.
+    pub fn owner(&self) -> Result<End<Req, Rep, U>, WireError>
+    where
+        U: Plain,
+    {
+        Ok(End::new(self.attach_owner()?))
+    }
+
+    /// Attaches a user end for module `M`, whose presence on the user list is checked at
+    /// compile time. The end's usage is the complement of the owner's.
+    pub fn user<M: Named>(&self) -> Result<End<Req, Rep, U::Complement>, WireError>
+    where
+        L: Admits<M>,
+        U::Complement: Plain,
+    {
+        self.user_named(M::NAME)
+    }
+
+    /// Attaches a user end for the module named `module`, checking the user list now.
+    pub fn user_named(
+        &self,
+        module: impl Into<Name>,
+    ) -> Result<End<Req, Rep, U::Complement>, WireError>
+    where
+        U::Complement: Plain,
+    {
+        Ok(End::new(attach_user(&self.core, module.into())?))
+    }
+
+    pub(crate) fn attach_owner(&self) -> Result<Attachment<Req, Rep>, WireError> {
+        let meta = &self.core.meta;
+        if !self.core.attach_owner() {
+            return Err(WireError::OwnerTaken {
+                port: meta.name.clone(),
+                module: meta.owner.clone(),
+            });
+        }
+        Ok(Attachment {
+            core: Arc::clone(&self.core),
+            at: SlotId::Owner,
+            module: meta.owner.clone(),
+            timeout: meta.timeout,
+        })
+    }
+
+    pub(crate) fn core(&self) -> &Arc<Core<Req, Rep>> {
+        &self.core
+    }
+}
+
+impl<Req, Rep, L, const N: usize> Port<Req, Rep, usage::Response, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    L: UserList,
+{
+    /// Attaches the owner end of a `RESPONSE` port with its response handler, which reads
+    /// the module's state `S` and answers each query.
+    pub fn owner_responder<S>(
+        &self,
+        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+    ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
+        Ok(ResponseEnd::new(self.attach_owner()?, Box::new(handler)))
+    }
+}
+
+impl<Req, Rep, U, L, const N: usize> Port<Req, Rep, U, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: Usage<Complement = usage::Response>,
+    L: UserList,
+{
+    /// Attaches the user end of a `QUERY` (or `CALLALL`) port for module `M`, with the
+    /// response handler that answers the owner's queries from the state `S`.
+    pub fn responder<M: Named, S>(
+        &self,
+        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+    ) -> Result<ResponseEnd<Req, Rep, S>, WireError>
+    where
+        L: Admits<M>,
+    {
+        self.responder_named(M::NAME, handler)
+    }
+
+    /// As [`Port::responder`], for a module known by name.
+    pub fn responder_named<S>(
+        &self,
+        module: impl Into<Name>,
+        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+    ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
+        let attachment = attach_user(&self.core, module.into())?;
+        Ok(ResponseEnd::new(attachment, Box::new(handler)))
+    }
+}
+
+/// Attaches a user of `core`: checks the user list and the number of active users.
+pub(crate) fn attach_user<Req, Rep>(
+    core: &Arc<Core<Req, Rep>>,
+    module: Name,
+) -> Result<Attachment<Req, Rep>, WireError> {
+    let meta = &core.meta;
+    if !meta.admits(module.as_str()) {
+        return Err(WireError::NotOnUserList {
+            port: meta.name.clone(),
+            module,
+        });
+    }
+    let Some(index) = core.attach_user(&module) else {
+        return Err(WireError::TooManyUsers {
+            port: meta.name.clone(),
+            module,
+            capacity: core.capacity(),
+        });
+    };
+    Ok(Attachment {
+        core: Arc::clone(core),
+        at: SlotId::User(index),
+        module,
+        timeout: None,
+    })
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> Clone for Port<Req, Rep, U, L, N> {
+    fn clone(&self) -> Self {
+        self.core.add_declaration();
+        Self {
+            core: Arc::clone(&self.core),
+            _restrictions: PhantomData,
+        }
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> Drop for Port<Req, Rep, U, L, N> {
+    fn drop(&mut self) {
+        self.core.drop_declaration();
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> fmt::Debug for Port<Req, Rep, U, L, N> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let meta = &self.core.meta;
+        f.debug_struct("Port")
+            .field("name", &meta.name)
+            .field("owner", &meta.owner)
+            .field("usage", &meta.usage)
+            .field("request", &type_name::<Req>())
+            .field("reply", &type_name::<Rep>())
+            .field("users", &N)
+            .field("timeout", &meta.timeout)
+            .field("priority", &meta.priority)
+            .finish()
+    }
+}

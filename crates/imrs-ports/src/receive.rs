@@ -1,0 +1,166 @@
+//! The server's side of send/receive/reply: `receive` and the reply handle.
+
+use std::fmt;
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::Arc;
+use std::task::{Context, Poll};
+
+use pin_project_lite::pin_project;
+
+use crate::attachment::Attachment;
+use crate::clock::{Sleep, deadline_passed};
+use crate::core::{Core, SlotId};
+use crate::error::ReceiveError;
+use crate::meta::Name;
+
+pin_project! {
+    /// The future of [`End::receive`](crate::End::receive).
+    ///
+    /// Dropping it before it completes takes nothing: a message can only be lost by a
+    /// receive that returned it.
+    #[must_use = "a receive does nothing unless awaited"]
+    pub struct Receiving<'a, Req, Rep> {
+        attachment: &'a Attachment<Req, Rep>,
+        #[pin]
+        deadline: Option<Sleep>,
+    }
+}
+
+impl<'a, Req, Rep> Receiving<'a, Req, Rep> {
+    pub(crate) fn new(attachment: &'a Attachment<Req, Rep>) -> Self {
+        Self {
+            attachment,
+            deadline: None,
+        }
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Future for Receiving<'_, Req, Rep> {
+    type Output = Result<(Req, ReplyHandle<Rep>), ReceiveError>;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
+        let mut this = self.project();
+        let attachment = *this.attachment;
+        if this.deadline.is_none()
+            && let Some(timeout) = attachment.timeout
+        {
+            this.deadline
+                .set(Some(attachment.core.clock.sleep(timeout)));
+        }
+        match poll_take(attachment, cx) {
+            Poll::Ready((message, from)) => {
+                return Poll::Ready(Ok((message, ReplyHandle::new(attachment, from))));
+            }
+            Poll::Pending => {}
+        }
+        let port = attachment.port().clone();
+        if attachment.peer_gone() {
+            return Poll::Ready(Err(ReceiveError::Closed { port }));
+        }
+        if deadline_passed(this.deadline, cx) {
+            Poll::Ready(Err(ReceiveError::Timeout { port }))
+        } else {
+            Poll::Pending
+        }
+    }
+}
+
+/// Takes the oldest waiting request for `attachment` to serve, registering the task to be
+/// woken if there is none yet. Spins first on a TIGHT port.
+pub(crate) fn poll_take<Req, Rep>(
+    attachment: &Attachment<Req, Rep>,
+    cx: &mut Context<'_>,
+) -> Poll<(Req, SlotId)> {
+    for _ in 0..=attachment.spins() {
+        if let Some(taken) = attachment.try_take() {
+            return Poll::Ready(taken);
+        }
+        std::hint::spin_loop();
+    }
+    attachment.register_server(cx);
+    // A post between the last look and the registration would have found no waker.
+    match attachment.try_take() {
+        Some(taken) => Poll::Ready(taken),
+        None => Poll::Pending,
+    }
+}
+
+/// Where a reply goes: the slot of the request it answers. Erases the request type, so that
+/// a reply handle is typed by its reply alone.
+trait ReplyTarget<Rep>: Send + Sync {
+    fn reply(&self, to: SlotId, reply: Rep);
+    fn unreplied(&self, to: SlotId);
+    fn port(&self) -> &Name;
+}
+
+impl<Req: Send, Rep: Send> ReplyTarget<Rep> for Core<Req, Rep> {
+    fn reply(&self, to: SlotId, reply: Rep) {
+        // SAFETY: a reply handle exists only for a request taken from slot `to`, and it is
+        // consumed by its first answer, so this is the one answer of the server that took it.
+        unsafe { self.slot(to).reply(reply) }
+    }
+
+    fn unreplied(&self, to: SlotId) {
+        // SAFETY: as in `reply`.
+        unsafe { self.slot(to).unreplied() }
+    }
+
+    fn port(&self) -> &Name {
+        &self.meta.name
+    }
+}
+
+/// The seed's runtime task id: the right to reply, once, to one received message.
+///
+/// It may be kept while other messages are received, and moved to another task. Replying
+/// never blocks. Dropping it without a reply fails the sender at once with
+/// [`SendError::NoReply`](crate::SendError::NoReply), so nothing hangs.
+#[must_use = "reply to the sender, or it receives SendError::NoReply"]
+pub struct ReplyHandle<Rep> {
+    target: Option<Arc<dyn ReplyTarget<Rep>>>,
+    to: SlotId,
+}
+
+impl<Rep: Send + 'static> ReplyHandle<Rep> {
+    pub(crate) fn new<Req: Send + 'static>(attachment: &Attachment<Req, Rep>, to: SlotId) -> Self {
+        let target: Arc<dyn ReplyTarget<Rep>> = attachment.core.clone();
+        Self {
+            target: Some(target),
+            to,
+        }
+    }
+
+    /// `REPLY`: answers the sender and unblocks it. Never blocks.
+    pub fn reply(mut self, reply: Rep) {
+        if let Some(target) = self.target.take() {
+            target.reply(self.to, reply);
+        }
+    }
+
+    /// The port the message came through.
+    pub fn port(&self) -> &Name {
+        self.target
+            .as_ref()
+            .expect("a reply handle holds its target until it is consumed")
+            .port()
+    }
+}
+
+impl<Rep> Drop for ReplyHandle<Rep> {
+    fn drop(&mut self) {
+        if let Some(target) = self.target.take() {
+            target.unreplied(self.to);
+        }
+    }
+}
+
+impl<Rep> fmt::Debug for ReplyHandle<Rep> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut debug = f.debug_struct("ReplyHandle");
+        if let Some(target) = &self.target {
+            debug.field("port", target.port());
+        }
+        debug.field("to", &self.to).finish()
+    }
+}
