@@ -82,8 +82,7 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
         }
 
         if *this.stage == Stage::Posting {
-            let attached =
-                |index: &usize| core.is_user_attached(*index);
+            let attached = |index: &usize| core.is_user_attached(*index);
             let users = 0..core.capacity();
             if users.clone().filter(attached).count() == 0 {
                 *this.stage = Stage::Done;
@@ -105,7 +104,10 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
                 }
                 return Poll::Pending;
             }
-            let message = this.message.as_ref().expect("the message waits to be posted");
+            let message = this
+                .message
+                .as_ref()
+                .expect("the message waits to be posted");
             for index in users.filter(attached) {
                 let user = &core.users[index];
                 // SAFETY: on a SENDALL/CALLALL port the owner end is the only poster of
@@ -141,7 +143,10 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
         }
         *this.stage = Stage::Done;
         withdraw_all(attachment);
-        let message = this.message.take().expect("the message is kept until the first reply");
+        let message = this
+            .message
+            .take()
+            .expect("the message is kept until the first reply");
         Poll::Ready(Err(BroadcastError::Timeout { port, message }))
     }
 }

@@ -257,13 +257,19 @@ impl<T> fmt::Display for SendError<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Timeout { port, .. } => {
-                write!(f, "send on port {port} timed out before a receiver took the message")
+                write!(
+                    f,
+                    "send on port {port} timed out before a receiver took the message"
+                )
             }
             Self::ReplyTimeout { port } => {
                 write!(f, "send on port {port} timed out waiting for the reply")
             }
             Self::NoReply { port } => {
-                write!(f, "the receiver on port {port} dropped the message without replying")
+                write!(
+                    f,
+                    "the receiver on port {port} dropped the message without replying"
+                )
             }
             Self::Closed { port, .. } => write!(f, "port {port} has no receiver any more"),
         }
@@ -274,10 +280,16 @@ impl<T> fmt::Display for QueryError<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Timeout { port, .. } => {
-                write!(f, "query on port {port} timed out before a response handler ran")
+                write!(
+                    f,
+                    "query on port {port} timed out before a response handler ran"
+                )
             }
             Self::ResponseTimeout { port } => {
-                write!(f, "query on port {port} timed out waiting for the response handler")
+                write!(
+                    f,
+                    "query on port {port} timed out waiting for the response handler"
+                )
             }
             Self::NoResponse { port } => {
                 write!(f, "the response handler of port {port} gave no answer")
@@ -310,26 +322,49 @@ impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::UnknownPort { port, module } => {
-                write!(f, "module {module} uses port {port}, which no module declares")
+                write!(
+                    f,
+                    "module {module} uses port {port}, which no module declares"
+                )
             }
             Self::DuplicatePort { port, module } => {
-                write!(f, "module {module} declares port {port}, which is already declared")
+                write!(
+                    f,
+                    "module {module} declares port {port}, which is already declared"
+                )
             }
             Self::OwnerTaken { port, module } => {
-                write!(f, "module {module} cannot own port {port}: its owner end is already attached")
+                write!(
+                    f,
+                    "module {module} cannot own port {port}: its owner end is already attached"
+                )
             }
             Self::NotOnUserList { port, module } => {
                 write!(f, "module {module} is not on the user list of port {port}")
             }
-            Self::TooManyUsers { port, module, capacity } => write!(
+            Self::TooManyUsers {
+                port,
+                module,
+                capacity,
+            } => write!(
                 f,
                 "module {module} cannot use port {port}: it allows {capacity} active user(s) and all are attached"
             ),
-            Self::UsageMismatch { port, module, owner, user } => write!(
+            Self::UsageMismatch {
+                port,
+                module,
+                owner,
+                user,
+            } => write!(
                 f,
                 "module {module} uses port {port} with USAGE={user}, which does not complement the owner's USAGE={owner}"
             ),
-            Self::TypeMismatch { port, module, declared, used } => write!(
+            Self::TypeMismatch {
+                port,
+                module,
+                declared,
+                used,
+            } => write!(
                 f,
                 "module {module} uses port {port} as {used}, but it is declared as {declared}"
             ),

@@ -126,7 +126,12 @@ where
 {
     /// Declares the port.
     pub fn declare(spec: PortSpec) -> Self {
-        const { assert!(N > 0, "a port needs room for at least one user (#USERS >= 1)") };
+        const {
+            assert!(
+                N > 0,
+                "a port needs room for at least one user (#USERS >= 1)"
+            )
+        };
         let user_list = match L::NAMES {
             Some(names) => Some(names.iter().map(|&name| Name::from(name)).collect()),
             None => spec.user_list.map(Vec::into_boxed_slice),

@@ -174,9 +174,8 @@ impl<Out, A: Arms<Out>> Select<Out, A> {
     /// The open arm that comes next after `after` in the serving order: higher priority
     /// first, then the earlier arm. A handful of arms, so a scan beats sorting into a buffer.
     fn next_in_order(&self, after: Option<(Priority, usize)>) -> Option<(Priority, usize)> {
-        let comes_before = |a: (Priority, usize), b: (Priority, usize)| {
-            a.0 > b.0 || (a.0 == b.0 && a.1 < b.1)
-        };
+        let comes_before =
+            |a: (Priority, usize), b: (Priority, usize)| a.0 > b.0 || (a.0 == b.0 && a.1 < b.1);
         (0..A::LEN)
             .filter_map(|index| Some((self.arms.priority(index)?, index)))
             .filter(|&arm| after.is_none_or(|after| comes_before(after, arm)))

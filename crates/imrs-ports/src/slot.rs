@@ -98,7 +98,8 @@ impl<Req, Rep> Slot<Req, Rep> {
         }
         // SAFETY: in EMPTY no server touches the request cell, and the caller is the only
         // poster, so this thread has the cell to itself.
-        self.request.with_mut(|cell| unsafe { (*cell).write(request) });
+        self.request
+            .with_mut(|cell| unsafe { (*cell).write(request) });
         self.ticket.store(ticket, Ordering::Relaxed);
         self.state.store(POSTED, Ordering::Release);
         Ok(())
@@ -106,8 +107,7 @@ impl<Req, Rep> Slot<Req, Rep> {
 
     /// The ticket of the waiting request, if one is waiting: lower tickets came first.
     pub(crate) fn posted_ticket(&self) -> Option<u64> {
-        (self.state.load(Ordering::Acquire) == POSTED)
-            .then(|| self.ticket.load(Ordering::Relaxed))
+        (self.state.load(Ordering::Acquire) == POSTED).then(|| self.ticket.load(Ordering::Relaxed))
     }
 
     /// Server: takes the waiting request, if there is one and no other server got it first.
@@ -120,7 +120,10 @@ impl<Req, Rep> Slot<Req, Rep> {
         // SAFETY: winning POSTED -> TAKEN hands the request cell to this server; the acquire
         // pairs with the poster's release store of POSTED, so the write is visible. The
         // poster only writes the cell again after the slot is EMPTY.
-        Some(self.request.with_mut(|cell| unsafe { (*cell).assume_init_read() }))
+        Some(
+            self.request
+                .with_mut(|cell| unsafe { (*cell).assume_init_read() }),
+        )
     }
 
     /// Server: answers the request it took.

@@ -42,7 +42,10 @@ impl UsageKind {
         use UsageKind::*;
         matches!(
             (self, user),
-            (Send | SendAll, Receive) | (Receive, Send) | (Query | CallAll, Response) | (Response, Query)
+            (Send | SendAll, Receive)
+                | (Receive, Send)
+                | (Query | CallAll, Response)
+                | (Response, Query)
         )
     }
 }

@@ -34,7 +34,12 @@ where
     }
 
     fn types(&self) -> (TypeId, TypeId, &'static str, &'static str) {
-        (TypeId::of::<Req>(), TypeId::of::<Rep>(), type_name::<Req>(), type_name::<Rep>())
+        (
+            TypeId::of::<Req>(),
+            TypeId::of::<Rep>(),
+            type_name::<Req>(),
+            type_name::<Rep>(),
+        )
     }
 
     fn core(&self) -> Arc<dyn Any + Send + Sync> {

@@ -48,7 +48,10 @@ impl<T: Send + 'static, const CAP: usize> BoundedBuffer<T, CAP> {
 
     /// Runs the filter: takes users' messages while there is room, and answers the owner's
     /// requests with the oldest message. Runs until the task running it is dropped.
-    pub async fn run(mut self, mut ends: FilterEnds<T, (), usage::Receive, (), Option<T>, usage::Send>) {
+    pub async fn run(
+        mut self,
+        mut ends: FilterEnds<T, (), usage::Receive, (), Option<T>, usage::Send>,
+    ) {
         enum Event<T> {
             FromUser(T, ReplyHandle<()>),
             FromOwner(ReplyHandle<Option<T>>),

@@ -59,10 +59,11 @@ where
     /// user list to the users' side.
     pub fn declare(spec: PortSpec, filter_task: impl Into<Name>) -> Self {
         let filter_task = filter_task.into();
-        let owner_side = PortSpec::new(format!("{}.FILTER", spec.name()), spec.owner_name().clone())
-            .with_timeout_of(&spec)
-            .with_clock_of(&spec)
-            .user_list([filter_task.clone()]);
+        let owner_side =
+            PortSpec::new(format!("{}.FILTER", spec.name()), spec.owner_name().clone())
+                .with_timeout_of(&spec)
+                .with_clock_of(&spec)
+                .user_list([filter_task.clone()]);
         Self {
             port: Port::declare(spec.without_timeout()),
             filter: Port::declare(owner_side),
