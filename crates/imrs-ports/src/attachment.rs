@@ -47,15 +47,26 @@ impl<Req, Rep> Attachment<Req, Rep> {
         }
     }
 
-    /// Whether a request is waiting for this end to serve it.
-    pub(crate) fn has_waiting(&self) -> bool {
+    /// How many requests are waiting for this end to serve them.
+    pub(crate) fn waiting(&self) -> usize {
+        let posted = |slot: &crate::slot::Slot<Req, Rep>| slot.posted_ticket().is_some();
         match self.at {
-            SlotId::Owner => self.core.oldest_posted_user().is_some(),
+            SlotId::Owner => self
+                .core
+                .users
+                .iter()
+                .filter(|user| posted(&user.slot))
+                .count(),
             SlotId::User(index) => {
-                self.core.users[index].slot.posted_ticket().is_some()
-                    || self.core.owner_slot.posted_ticket().is_some()
+                usize::from(posted(&self.core.users[index].slot))
+                    + usize::from(posted(&self.core.owner_slot))
             }
         }
+    }
+
+    /// Whether a request is waiting for this end to serve it.
+    pub(crate) fn has_waiting(&self) -> bool {
+        self.waiting() > 0
     }
 
     /// Registers the task to be woken when a request arrives for this end to serve.

@@ -85,6 +85,14 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         Some((message, ReplyHandle::new(&self.attachment, from)))
     }
 
+    /// How many senders wait for this end to receive them.
+    pub fn waiting(&self) -> usize
+    where
+        U: Receives,
+    {
+        self.attachment.waiting()
+    }
+
     /// `QUERY`: runs the response handler at the other end and waits for its answer.
     ///
     /// When the handler runs is up to the responding module's order.

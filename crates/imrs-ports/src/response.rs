@@ -7,10 +7,10 @@
 //! [`ResponseEnd::respond`] when the handler's rank allows. Without a scheduler,
 //! [`respond_while`] runs handlers as soon as the module's background code is suspended.
 
-use std::cell::RefCell;
 use std::fmt;
 use std::future::{Future, poll_fn};
 use std::pin::pin;
+use std::sync::{Mutex, MutexGuard, TryLockError};
 use std::task::{Context, Poll};
 use std::time::Duration;
 
@@ -153,14 +153,15 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req
 ///
 /// The background code changes it only inside [`ModuleState::update`], whose closure cannot
 /// await; so at every suspension point — where handlers run — the state is whole, and the
-/// handlers read it through `&S`.
+/// handlers read it through `&S`. It is `Sync`, so a module holding it runs on any thread;
+/// its lock is only ever taken by the module's own task, so it is never contended.
 #[derive(Debug, Default)]
-pub struct ModuleState<S>(RefCell<S>);
+pub struct ModuleState<S>(Mutex<S>);
 
 impl<S> ModuleState<S> {
     /// Wraps the initial state.
     pub fn new(state: S) -> Self {
-        Self(RefCell::new(state))
+        Self(Mutex::new(state))
     }
 
     /// Changes the state. The closure is synchronous, so no handler can run in the middle.
@@ -169,21 +170,38 @@ impl<S> ModuleState<S> {
     ///
     /// If called from inside another `update` or `read` of the same state.
     pub fn update<R>(&self, change: impl FnOnce(&mut S) -> R) -> R {
-        change(&mut self.0.borrow_mut())
+        change(&mut self.lock())
     }
 
     /// Reads the state.
     ///
     /// # Panics
     ///
-    /// If called from inside an `update` of the same state.
+    /// If called from inside an `update` or `read` of the same state.
     pub fn read<R>(&self, look: impl FnOnce(&S) -> R) -> R {
-        look(&self.0.borrow())
+        look(&self.lock())
     }
 
     /// The state, unwrapped.
     pub fn into_inner(self) -> S {
-        self.0.into_inner()
+        self.0
+            .into_inner()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    fn lock(&self) -> MutexGuard<'_, S> {
+        self.try_lock()
+            .expect("a module's state was used from inside its own update or read")
+    }
+
+    /// The state, unless it is in the middle of an update. A panic inside an update leaves
+    /// the state as the update left it, which is what the module would see next anyway.
+    fn try_lock(&self) -> Option<MutexGuard<'_, S>> {
+        match self.0.try_lock() {
+            Ok(guard) => Some(guard),
+            Err(TryLockError::Poisoned(poisoned)) => Some(poisoned.into_inner()),
+            Err(TryLockError::WouldBlock) => None,
+        }
     }
 }
 
@@ -192,7 +210,7 @@ impl<S> ModuleState<S> {
 /// for modules that have no order scheduler.
 pub async fn respond_while<S, F: Future>(
     state: &ModuleState<S>,
-    ends: &mut [&mut dyn Respond<S>],
+    ends: &mut [&mut (dyn Respond<S> + Send)],
     background: F,
 ) -> F::Output {
     let mut background = pin!(background);
@@ -201,7 +219,7 @@ pub async fn respond_while<S, F: Future>(
             return Poll::Ready(output);
         }
         // The background is suspended, outside any `update`: the state is whole.
-        if let Ok(state) = state.0.try_borrow() {
+        if let Some(state) = state.try_lock() {
             for end in ends.iter_mut() {
                 // Answer every waiting query; a closed port just has none.
                 while let Poll::Ready(Ok(())) = end.poll_pending(cx) {
