@@ -79,6 +79,7 @@ pub use process_type::ProcessType;
 pub use receive::{Receiving, ReplyHandle};
 pub use response::{ModuleState, Respond, ResponseEnd, respond_while};
 pub use select::{AllClosed, Select, select, when};
+pub use usage::UsageKind;
 pub use user_list::{Admits, AnyUser, UserList};
 pub use wiring::{WireErrors, Wiring};
 
