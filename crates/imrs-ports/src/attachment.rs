@@ -77,6 +77,18 @@ impl<Req, Rep> Attachment<Req, Rep> {
         }
     }
 
+    /// The modules at the other end of the port: the owner, for a user's end; the attached
+    /// users, for the owner's end.
+    pub(crate) fn peers(&self) -> Vec<Name> {
+        match self.at {
+            SlotId::User(_) => vec![self.core.meta.owner.clone()],
+            SlotId::Owner => (0..self.core.capacity())
+                .filter(|&index| self.core.is_user_attached(index))
+                .filter_map(|index| self.core.user_module(index))
+                .collect(),
+        }
+    }
+
     /// Whether no peer can ever come to this end again.
     pub(crate) fn peer_gone(&self) -> bool {
         self.core.peer_gone(self.is_owner())

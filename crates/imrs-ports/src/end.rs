@@ -51,6 +51,12 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         &self.attachment.module
     }
 
+    /// The modules at the other end of the port: the owner, seen from a user; the attached
+    /// users, seen from the owner.
+    pub fn peers(&self) -> Vec<Name> {
+        self.attachment.peers()
+    }
+
     /// The port's priority, used by [`select`](crate::select()).
     pub fn priority(&self) -> Priority {
         self.attachment.core.meta.priority

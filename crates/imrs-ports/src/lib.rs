@@ -81,7 +81,7 @@ pub use response::{ModuleState, Respond, ResponseEnd, respond_while};
 pub use select::{AllClosed, Select, select, when};
 pub use usage::UsageKind;
 pub use user_list::{Admits, AnyUser, UserList};
-pub use wiring::{WireErrors, Wiring};
+pub use wiring::{PortInfo, WireErrors, Wiring};
 
 /// Everything a module author needs, in one import.
 pub mod prelude {

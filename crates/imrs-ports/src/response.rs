@@ -56,6 +56,11 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> ResponseEnd<Req, Rep, S> {
         &self.attachment.module
     }
 
+    /// The modules that may query this end; see [`End::peers`](crate::End::peers).
+    pub fn peers(&self) -> Vec<Name> {
+        self.attachment.peers()
+    }
+
     /// The port's priority.
     pub fn priority(&self) -> Priority {
         self.attachment.core.meta.priority

@@ -20,6 +20,7 @@ trait Declared: Send + Sync {
     fn meta(&self) -> &PortMeta;
     fn types(&self) -> (TypeId, TypeId, &'static str, &'static str);
     fn core(&self) -> Arc<dyn Any + Send + Sync>;
+    fn capacity(&self) -> usize;
 }
 
 impl<Req, Rep, U, L, const N: usize> Declared for Port<Req, Rep, U, L, N>
@@ -44,6 +45,10 @@ where
 
     fn core(&self) -> Arc<dyn Any + Send + Sync> {
         Port::core(self).clone()
+    }
+
+    fn capacity(&self) -> usize {
+        N
     }
 }
 
@@ -121,6 +126,27 @@ impl Wiring {
         self.note(attached.map(|attachment| ResponseEnd::new(attachment, Box::new(handler))))
     }
 
+    /// What the wiring knows of port `port`, if it was declared.
+    pub fn port_info(&self, port: &str) -> Option<PortInfo> {
+        let declared = self.ports.get(&Name::from(port))?;
+        let meta = declared.meta();
+        let (_, _, request, reply) = declared.types();
+        Some(PortInfo {
+            name: meta.name.clone(),
+            owner: meta.owner.clone(),
+            usage: meta.usage,
+            user_list: meta.user_list.as_ref().map(|list| list.to_vec()),
+            capacity: declared.capacity(),
+            request,
+            reply,
+        })
+    }
+
+    /// The names of every declared port, in order.
+    pub fn port_names(&self) -> impl Iterator<Item = &Name> {
+        self.ports.keys()
+    }
+
     /// Every problem met so far, or `Ok` if there was none.
     pub fn check(&self) -> Result<(), WireErrors> {
         if self.problems.is_empty() {
@@ -183,6 +209,25 @@ impl fmt::Debug for Wiring {
             .field("problems", &self.problems)
             .finish()
     }
+}
+
+/// A declared port, as the wiring describes it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PortInfo {
+    /// The port's name.
+    pub name: Name,
+    /// The module declared as its owner.
+    pub owner: Name,
+    /// The owner's usage.
+    pub usage: crate::usage::UsageKind,
+    /// The user list, if the port has one.
+    pub user_list: Option<Vec<Name>>,
+    /// The number of active users it allows.
+    pub capacity: usize,
+    /// The request type's name.
+    pub request: &'static str,
+    /// The reply type's name.
+    pub reply: &'static str,
 }
 
 /// Every wiring problem of a cell, each naming its port and module.

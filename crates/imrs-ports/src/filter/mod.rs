@@ -76,6 +76,16 @@ where
         self.port.name()
     }
 
+    /// The port as its users see it, whose owner end the filter holds.
+    pub fn users_side(&self) -> &Port<Req, Rep, F, L, N> {
+        &self.port
+    }
+
+    /// The predefined port `FILTER`, between the owner and the filter.
+    pub fn filter_side(&self) -> &Port<FReq, FRep, O, AnyUser, 1> {
+        &self.filter
+    }
+
     /// The owner's end: it reaches the filter, never the users directly.
     pub fn owner(&self) -> Result<End<FReq, FRep, O>, WireError> {
         self.filter.owner()

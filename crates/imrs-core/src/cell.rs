@@ -1,0 +1,327 @@
+//! A cell: the clock, the event log, the wiring, and the modules running in it.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+
+use imrs_ports::usage::{Plain, Usage};
+use imrs_ports::{
+    End, FilteredPort, Instant, Name, Port, SharedClock, UserList, VirtualClock, WireError, Wiring,
+};
+use tokio::sync::watch;
+
+use crate::check::{CellErrors, check};
+use crate::deadlock::WaitGraph;
+use crate::event::{Event, EventKind, EventLog};
+use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
+use crate::module::spec::{ModuleDecl, ModuleSpec};
+use crate::supervision::RestartPolicy;
+
+pub(crate) struct CellShared {
+    pub(crate) clock: SharedClock,
+    pub(crate) events: EventLog,
+    waits: Mutex<WaitGraph>,
+    wiring: Mutex<Wiring>,
+    modules: Mutex<BTreeMap<Name, Arc<KillSwitch>>>,
+}
+
+impl CellShared {
+    pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
+        lock(&self.waits)
+    }
+
+    fn record(&self, module: &Name, kind: EventKind) {
+        self.events.record(Event {
+            at: self.clock.now(),
+            module: module.clone(),
+            task: None,
+            kind,
+        });
+    }
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Each critical section is one map operation: a panic cannot leave it half-done.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// A work cell: its clock, its event log, its ports by name, and its modules.
+///
+/// Modules run as tokio tasks, in parallel on a multi-thread runtime, or one at a time on a
+/// current-thread runtime — which, on a [`VirtualClock`](imrs_ports::VirtualClock), makes
+/// a run reproducible event for event.
+#[derive(Clone)]
+pub struct Cell {
+    shared: Arc<CellShared>,
+}
+
+impl Cell {
+    /// A cell on `clock`.
+    pub fn new(clock: SharedClock) -> Self {
+        Self {
+            shared: Arc::new(CellShared {
+                clock,
+                events: EventLog::new(),
+                waits: Mutex::default(),
+                wiring: Mutex::default(),
+                modules: Mutex::default(),
+            }),
+        }
+    }
+
+    /// A cell on a new virtual clock, and that clock, to drive it.
+    pub fn virtual_clock() -> (Self, VirtualClock) {
+        let clock = VirtualClock::new();
+        (Self::new(Arc::new(clock.clone())), clock)
+    }
+
+    /// The cell's clock.
+    pub fn clock(&self) -> &SharedClock {
+        &self.shared.clock
+    }
+
+    /// The time now, on the cell's clock.
+    pub fn now(&self) -> Instant {
+        self.shared.clock.now()
+    }
+
+    /// The cell's event log.
+    pub fn events(&self) -> &EventLog {
+        &self.shared.events
+    }
+
+    /// Makes `port` known to the cell by name, for [`Cell::check`] and [`Cell::use_port`].
+    pub fn declare<Req, Rep, U, L, const N: usize>(
+        &self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<(), WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        L: UserList,
+    {
+        lock(&self.shared.wiring).declare(port)
+    }
+
+    /// Makes a filtered port known to the cell: the users' side under the port's name, and
+    /// the owner's side as `PORT.FILTER`.
+    pub fn declare_filtered<Req, Rep, F, FReq, FRep, O, L, const N: usize>(
+        &self,
+        port: &FilteredPort<Req, Rep, F, FReq, FRep, O, L, N>,
+    ) -> Result<(), WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        FReq: Send + 'static,
+        FRep: Send + 'static,
+        F: Usage + Plain,
+        O: Usage + Plain,
+        O::Complement: Plain,
+        F::Complement: Plain,
+        L: UserList,
+    {
+        let mut wiring = lock(&self.shared.wiring);
+        wiring.declare(port.users_side())?;
+        wiring.declare(port.filter_side())
+    }
+
+    /// Attaches `module` to the port named `port`, checking what the types could not.
+    pub fn use_port<Req, Rep, U>(
+        &self,
+        module: &str,
+        port: &str,
+    ) -> Result<End<Req, Rep, U>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage + Plain,
+    {
+        lock(&self.shared.wiring).use_port(module, port)
+    }
+
+    /// The seed's load-time check: every problem with these modules and the declared ports,
+    /// all at once, each naming its module and port.
+    pub fn check(&self, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
+        check(&lock(&self.shared.wiring), modules)
+    }
+
+    /// Starts `spec` as a top-level module. If it fails, it stays failed.
+    pub fn start<S: Send + Sync + 'static>(&self, spec: ModuleSpec<S>) -> ModuleHandle {
+        spawn_module(
+            Arc::clone(&self.shared),
+            None,
+            RestartPolicy::NEVER,
+            spec,
+            None,
+        )
+    }
+
+    /// Starts a top-level module made by `factory`, and makes a new copy of it with
+    /// `factory` when it fails or is killed, as `policy` allows.
+    pub fn supervise<S, F>(&self, policy: RestartPolicy, mut factory: F) -> ModuleHandle
+    where
+        S: Send + Sync + 'static,
+        F: FnMut() -> ModuleSpec<S> + Send + 'static,
+    {
+        let first = factory();
+        spawn_module(
+            Arc::clone(&self.shared),
+            None,
+            policy,
+            first,
+            Some(Box::new(factory)),
+        )
+    }
+
+    /// Kills the running copy of `module`; a supervised module gets a new copy. Returns
+    /// whether a module of that name runs.
+    pub fn kill(&self, module: &str) -> bool {
+        let switch = lock(&self.shared.modules).get(&Name::from(module)).cloned();
+        switch.inspect(|switch| switch.kill()).is_some()
+    }
+
+    /// Stops `module` for good. Returns whether a module of that name runs.
+    pub fn stop(&self, module: &str) -> bool {
+        let switch = lock(&self.shared.modules).get(&Name::from(module)).cloned();
+        switch.inspect(|switch| switch.stop()).is_some()
+    }
+}
+
+impl fmt::Debug for Cell {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Cell")
+            .field("clock", &self.shared.clock)
+            .field(
+                "modules",
+                &lock(&self.shared.modules).keys().collect::<Vec<_>>(),
+            )
+            .finish_non_exhaustive()
+    }
+}
+
+/// How a module ended for good.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ModuleOutcome {
+    /// Every task finished.
+    Finished,
+    /// It failed, and its restart policy was spent.
+    Failed(String),
+    /// It was stopped, or killed with no restart left.
+    Killed,
+}
+
+/// A running module, seen from outside.
+#[derive(Debug, Clone)]
+pub struct ModuleHandle {
+    name: Name,
+    kill: Arc<KillSwitch>,
+    done: watch::Receiver<Option<ModuleOutcome>>,
+}
+
+impl ModuleHandle {
+    /// The module's name.
+    pub fn name(&self) -> &Name {
+        &self.name
+    }
+
+    /// Kills the running copy; a supervised module gets a new one.
+    pub fn kill(&self) {
+        self.kill.kill();
+    }
+
+    /// Stops the module for good.
+    pub fn stop(&self) {
+        self.kill.stop();
+    }
+
+    /// How the module ended, if it has.
+    pub fn outcome(&self) -> Option<ModuleOutcome> {
+        self.done.borrow().clone()
+    }
+
+    /// Waits until the module has ended for good.
+    pub async fn finished(&mut self) -> ModuleOutcome {
+        match self.done.wait_for(Option::is_some).await {
+            Ok(outcome) => outcome.clone().expect("waited for an outcome"),
+            // The supervisor is gone without a word: its runtime shut down.
+            Err(_) => ModuleOutcome::Killed,
+        }
+    }
+}
+
+type Factory<S> = Box<dyn FnMut() -> ModuleSpec<S> + Send>;
+
+/// Spawns the supervisor of one module: it runs copies of the module until one finishes,
+/// or the policy is spent, or the module is stopped.
+pub(crate) fn spawn_module<S: Send + Sync + 'static>(
+    cell: Arc<CellShared>,
+    parent: Option<Name>,
+    policy: RestartPolicy,
+    first: ModuleSpec<S>,
+    mut factory: Option<Factory<S>>,
+) -> ModuleHandle {
+    let name = first.name.clone();
+    let kill = Arc::new(KillSwitch::default());
+    lock(&cell.modules).insert(name.clone(), Arc::clone(&kill));
+    let (report, done) = watch::channel(None);
+    let handle = ModuleHandle {
+        name: name.clone(),
+        kill: Arc::clone(&kill),
+        done,
+    };
+    cell.record(
+        &name,
+        EventKind::ModuleStarted {
+            parent: parent.clone(),
+        },
+    );
+    tokio::spawn(async move {
+        let mut next = Some(first);
+        let mut attempt = 0;
+        let outcome = loop {
+            let Some(spec) = next.take() else {
+                unreachable!("a copy is made before every run");
+            };
+            kill.rearm();
+            let exit =
+                ModuleRun::new(spec, Arc::clone(&cell), parent.clone(), Arc::clone(&kill)).await;
+            let outcome = match exit {
+                ModuleExit::Finished => {
+                    cell.record(&name, EventKind::ModuleFinished);
+                    break ModuleOutcome::Finished;
+                }
+                ModuleExit::Killed => {
+                    cell.record(&name, EventKind::ModuleKilled);
+                    ModuleOutcome::Killed
+                }
+                ModuleExit::Failed(reason) => {
+                    cell.record(
+                        &name,
+                        EventKind::ModuleFailed {
+                            reason: reason.clone(),
+                        },
+                    );
+                    ModuleOutcome::Failed(reason)
+                }
+            };
+            attempt += 1;
+            let (Some(delay), Some(factory)) = (policy.delay_before(attempt), factory.as_mut())
+            else {
+                break outcome;
+            };
+            if kill.is_stopped() {
+                break outcome;
+            }
+            cell.clock.sleep(delay).await;
+            if kill.is_stopped() {
+                break outcome;
+            }
+            next = Some(factory());
+            cell.record(&name, EventKind::ModuleRestarted { attempt });
+        };
+        lock(&cell.modules).remove(&name);
+        report.send_replace(Some(outcome));
+    });
+    handle
+}

@@ -1,0 +1,342 @@
+//! The load-time check (seed 000, §3 and §5.1): everything the types could not show, for a
+//! whole cell at once, each problem naming its module and port.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+
+use imrs_ports::{Name, UsageKind, Wiring};
+
+use crate::exception::Exception;
+use crate::module::spec::ModuleDecl;
+
+/// One wiring problem of a cell.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CellError {
+    /// Two modules share a name.
+    DuplicateModule {
+        /// The name.
+        module: Name,
+    },
+    /// A declared port that no module owns.
+    NoOwner {
+        /// The port.
+        port: Name,
+        /// The owner the port was declared with.
+        declared_owner: Name,
+    },
+    /// A port that more than one module claims to own.
+    TwoOwners {
+        /// The port.
+        port: Name,
+        /// The modules that own it.
+        modules: Vec<Name>,
+    },
+    /// A module owns a port that was declared for another owner.
+    WrongOwner {
+        /// The port.
+        port: Name,
+        /// The module that claims it.
+        module: Name,
+        /// The owner in the port's declaration.
+        declared_owner: Name,
+    },
+    /// A module owns, uses or filters a port that was never declared.
+    UnknownPort {
+        /// The port.
+        port: Name,
+        /// The module.
+        module: Name,
+    },
+    /// A module uses a port whose user list does not name it.
+    NotOnUserList {
+        /// The port.
+        port: Name,
+        /// The module.
+        module: Name,
+    },
+    /// More modules use a port than its number of active users allows.
+    TooManyUsers {
+        /// The port.
+        port: Name,
+        /// The allowed number.
+        capacity: usize,
+        /// Every module that uses it.
+        modules: Vec<Name>,
+    },
+    /// A user's usage does not complement the owner's (or, on a filtered port, the filter's).
+    UsageMismatch {
+        /// The port.
+        port: Name,
+        /// The user module.
+        module: Name,
+        /// The usage it must complement.
+        owner: UsageKind,
+        /// The user's usage.
+        user: UsageKind,
+    },
+    /// A filter declares a usage toward the users that the port was not declared with.
+    FilterUsageMismatch {
+        /// The port.
+        port: Name,
+        /// The module whose task filters it.
+        module: Name,
+        /// The filter's declared usage.
+        filter: UsageKind,
+        /// The usage the port's users side was declared with.
+        declared: UsageKind,
+    },
+    /// An order names something the module does not have.
+    UnknownOrderName {
+        /// The module.
+        module: Name,
+        /// The name in its order.
+        name: Name,
+    },
+}
+
+impl fmt::Display for CellError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::DuplicateModule { module } => write!(f, "two modules are named {module}"),
+            Self::NoOwner {
+                port,
+                declared_owner,
+            } => write!(
+                f,
+                "port {port} has no owner: no module declares it (its declaration names {declared_owner})"
+            ),
+            Self::TwoOwners { port, modules } => {
+                write!(f, "port {port} has {} owners:", modules.len())?;
+                modules.iter().try_for_each(|module| write!(f, " {module}"))
+            }
+            Self::WrongOwner {
+                port,
+                module,
+                declared_owner,
+            } => write!(
+                f,
+                "module {module} owns port {port}, which is declared as owned by {declared_owner}"
+            ),
+            Self::UnknownPort { port, module } => {
+                write!(
+                    f,
+                    "module {module} names port {port}, which is not declared"
+                )
+            }
+            Self::NotOnUserList { port, module } => {
+                write!(f, "module {module} is not on the user list of port {port}")
+            }
+            Self::TooManyUsers {
+                port,
+                capacity,
+                modules,
+            } => {
+                write!(
+                    f,
+                    "port {port} allows {capacity} user(s), but {} use it:",
+                    modules.len()
+                )?;
+                modules.iter().try_for_each(|module| write!(f, " {module}"))
+            }
+            Self::UsageMismatch {
+                port,
+                module,
+                owner,
+                user,
+            } => write!(
+                f,
+                "module {module} uses port {port} with USAGE={user}, which does not complement USAGE={owner}"
+            ),
+            Self::FilterUsageMismatch {
+                port,
+                module,
+                filter,
+                declared,
+            } => write!(
+                f,
+                "module {module} filters port {port} with USAGE={filter}, but the port is declared USAGE={declared}"
+            ),
+            Self::UnknownOrderName { module, name } => write!(
+                f,
+                "the order of module {module} names {name}, which is not its background, a section, a handler or a port of it"
+            ),
+        }
+    }
+}
+
+/// Every wiring problem of a cell.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CellErrors(pub Vec<CellError>);
+
+impl fmt::Display for CellErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{} wiring problem(s):", self.0.len())?;
+        self.0
+            .iter()
+            .try_for_each(|problem| writeln!(f, "  - {problem}"))
+    }
+}
+
+impl std::error::Error for CellErrors {}
+
+pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
+    let mut problems = Vec::new();
+    let mut seen = BTreeSet::new();
+    for module in modules {
+        if !seen.insert(&module.name) {
+            problems.push(CellError::DuplicateModule {
+                module: module.name.clone(),
+            });
+        }
+    }
+    check_owners(wiring, modules, &mut problems);
+    check_users(wiring, modules, &mut problems);
+    check_filters(wiring, modules, &mut problems);
+    modules
+        .iter()
+        .for_each(|module| check_order(module, &mut problems));
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(CellErrors(problems))
+    }
+}
+
+fn check_owners(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<CellError>) {
+    let mut owners: BTreeMap<&Name, Vec<Name>> = BTreeMap::new();
+    for module in modules {
+        for port in module
+            .owns
+            .iter()
+            .chain(module.filters.iter().map(|(port, _)| port))
+        {
+            owners.entry(port).or_default().push(module.name.clone());
+        }
+    }
+    for port in wiring.port_names() {
+        let info = wiring
+            .port_info(port.as_str())
+            .expect("a listed port has info");
+        // A filtered port's two halves are owned through `filters` and the owner's `owns`.
+        let owner_side_of_filter = port.as_str().ends_with(".FILTER");
+        let claimed = owners.get(port).map(Vec::as_slice).unwrap_or_default();
+        match claimed {
+            [] if owner_side_of_filter => {}
+            [] => problems.push(CellError::NoOwner {
+                port: port.clone(),
+                declared_owner: info.owner,
+            }),
+            [owner] if *owner != info.owner => problems.push(CellError::WrongOwner {
+                port: port.clone(),
+                module: owner.clone(),
+                declared_owner: info.owner,
+            }),
+            [_] => {}
+            many => problems.push(CellError::TwoOwners {
+                port: port.clone(),
+                modules: many.to_vec(),
+            }),
+        }
+    }
+    for (port, modules) in owners {
+        if wiring.port_info(port.as_str()).is_none() {
+            for module in modules {
+                problems.push(CellError::UnknownPort {
+                    port: port.clone(),
+                    module,
+                });
+            }
+        }
+    }
+}
+
+fn check_users(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<CellError>) {
+    let mut users: BTreeMap<&Name, Vec<Name>> = BTreeMap::new();
+    for module in modules {
+        for (port, usage) in &module.uses {
+            let Some(info) = wiring.port_info(port.as_str()) else {
+                problems.push(CellError::UnknownPort {
+                    port: port.clone(),
+                    module: module.name.clone(),
+                });
+                continue;
+            };
+            users.entry(port).or_default().push(module.name.clone());
+            let listed = info
+                .user_list
+                .as_ref()
+                .is_none_or(|list| list.contains(&module.name));
+            if !listed {
+                problems.push(CellError::NotOnUserList {
+                    port: port.clone(),
+                    module: module.name.clone(),
+                });
+            }
+            if !info.usage.complements(*usage) {
+                problems.push(CellError::UsageMismatch {
+                    port: port.clone(),
+                    module: module.name.clone(),
+                    owner: info.usage,
+                    user: *usage,
+                });
+            }
+        }
+    }
+    for (port, modules) in users {
+        let info = wiring.port_info(port.as_str()).expect("checked above");
+        if modules.len() > info.capacity {
+            problems.push(CellError::TooManyUsers {
+                port: port.clone(),
+                capacity: info.capacity,
+                modules,
+            });
+        }
+    }
+}
+
+fn check_filters(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<CellError>) {
+    for module in modules {
+        for (port, usage) in &module.filters {
+            let Some(info) = wiring.port_info(port.as_str()) else {
+                continue; // reported by the owner check
+            };
+            if info.usage != *usage {
+                problems.push(CellError::FilterUsageMismatch {
+                    port: port.clone(),
+                    module: module.name.clone(),
+                    filter: *usage,
+                    declared: info.usage,
+                });
+            }
+        }
+    }
+}
+
+fn check_order(module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    let ports = module
+        .owns
+        .iter()
+        .chain(module.uses.iter().map(|(port, _)| port))
+        .chain(module.filters.iter().map(|(port, _)| port));
+    let mut known: BTreeSet<Name> = ports
+        .map(|port| Exception::timeout_of(port.as_str()))
+        .collect();
+    known.extend(
+        module
+            .tasks
+            .iter()
+            .map(|task| Exception::failure_of(task.as_str())),
+    );
+    known.insert(module.name.clone());
+    known.extend(module.sections.iter().cloned());
+    known.extend(module.responses.iter().cloned());
+    known.extend(module.exceptions.iter().cloned());
+    for name in &module.order {
+        if !known.contains(name) {
+            problems.push(CellError::UnknownOrderName {
+                module: module.name.clone(),
+                name: name.clone(),
+            });
+        }
+    }
+}

@@ -1,0 +1,280 @@
+//! The event log: what every module did, when, on the framework clock.
+//!
+//! A cell records module and task life, sections entered and left, port operations,
+//! exceptions, deadlocks and alarms, each with its virtual timestamp. On a virtual clock in
+//! single-thread mode, the same cell with the same seed yields the same log, event for
+//! event. Later layers (a recorder, a report) read it as a stream through
+//! [`EventLog::subscribe`].
+
+use std::fmt;
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+use imrs_ports::{Instant, Name};
+
+/// One thing that happened in a cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Event {
+    /// When, on the cell's clock.
+    pub at: Instant,
+    /// In which module.
+    pub module: Name,
+    /// In which task or handler of it, if any.
+    pub task: Option<Name>,
+    /// What.
+    pub kind: EventKind,
+}
+
+/// What happened.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum EventKind {
+    /// The module was created, by `parent` if it was costarted.
+    ModuleStarted {
+        /// The module that costarted it.
+        parent: Option<Name>,
+    },
+    /// Every task of the module finished.
+    ModuleFinished,
+    /// The module was killed.
+    ModuleKilled,
+    /// The module failed: a task failed beyond its restart policy.
+    ModuleFailed {
+        /// Why.
+        reason: String,
+    },
+    /// A new copy of the module was started after a failure.
+    ModuleRestarted {
+        /// Which restart this is, from 1.
+        attempt: u32,
+    },
+    /// A task started.
+    TaskStarted,
+    /// A task finished.
+    TaskFinished,
+    /// A task failed: it panicked or returned an error.
+    TaskFailed {
+        /// The panic message or the error.
+        reason: String,
+    },
+    /// A new copy of the task was started.
+    TaskRestarted {
+        /// Which restart this is, from 1.
+        attempt: u32,
+    },
+    /// The thread entered a named section.
+    SectionEntered {
+        /// The section.
+        section: Name,
+    },
+    /// The thread left a named section.
+    SectionLeft {
+        /// The section.
+        section: Name,
+    },
+    /// A send completed with a reply.
+    Sent {
+        /// The port.
+        port: Name,
+    },
+    /// A message was received.
+    Received {
+        /// The port.
+        port: Name,
+    },
+    /// A query was answered.
+    Queried {
+        /// The port.
+        port: Name,
+    },
+    /// A primitive failed.
+    PortError {
+        /// The port.
+        port: Name,
+        /// The error.
+        error: String,
+    },
+    /// A response handler answered a query.
+    Responded {
+        /// The handler (`PORT.resp`).
+        handler: Name,
+    },
+    /// An exception was raised in the module.
+    ExceptionRaised {
+        /// The exception (`PORT.TIMEOUT`).
+        exception: Name,
+    },
+    /// The module's handler for an exception started.
+    ExceptionHandled {
+        /// The exception.
+        exception: Name,
+    },
+    /// An exception was raised that the module has no handler for.
+    ExceptionUnhandled {
+        /// The exception.
+        exception: Name,
+    },
+    /// Every member of a `waitfor` arrived, and this task went on.
+    WaitForReleased {
+        /// The rendezvous.
+        barrier: Name,
+    },
+    /// A step of a work schedule was performed.
+    StepPerformed {
+        /// The step.
+        step: String,
+    },
+    /// A step of a work schedule failed and was skipped.
+    StepFailed {
+        /// The step.
+        step: String,
+        /// Why.
+        error: String,
+    },
+    /// Every member of a cycle of modules is blocked on the next: `(module, port)` pairs,
+    /// each module waiting on the port that leads to the next.
+    Deadlock {
+        /// The cycle.
+        cycle: Vec<(Name, Name)>,
+    },
+    /// Something an operator should look at.
+    Alarm {
+        /// What.
+        message: String,
+    },
+}
+
+impl fmt::Display for Event {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "[{}] {}", self.at, self.module)?;
+        if let Some(task) = &self.task {
+            write!(f, "/{task}")?;
+        }
+        write!(f, ": ")?;
+        match &self.kind {
+            EventKind::ModuleStarted {
+                parent: Some(parent),
+            } => {
+                write!(f, "started by {parent}")
+            }
+            EventKind::ModuleStarted { parent: None } => write!(f, "started"),
+            EventKind::ModuleFinished => write!(f, "finished"),
+            EventKind::ModuleKilled => write!(f, "killed"),
+            EventKind::ModuleFailed { reason } => write!(f, "failed: {reason}"),
+            EventKind::ModuleRestarted { attempt } => write!(f, "restarted (#{attempt})"),
+            EventKind::TaskStarted => write!(f, "task started"),
+            EventKind::TaskFinished => write!(f, "task finished"),
+            EventKind::TaskFailed { reason } => write!(f, "task failed: {reason}"),
+            EventKind::TaskRestarted { attempt } => write!(f, "task restarted (#{attempt})"),
+            EventKind::SectionEntered { section } => write!(f, "entered {section}"),
+            EventKind::SectionLeft { section } => write!(f, "left {section}"),
+            EventKind::Sent { port } => write!(f, "sent on {port}"),
+            EventKind::Received { port } => write!(f, "received on {port}"),
+            EventKind::Queried { port } => write!(f, "queried {port}"),
+            EventKind::PortError { port, error } => write!(f, "{port}: {error}"),
+            EventKind::Responded { handler } => write!(f, "responded {handler}"),
+            EventKind::ExceptionRaised { exception } => write!(f, "raised {exception}"),
+            EventKind::ExceptionHandled { exception } => write!(f, "handling {exception}"),
+            EventKind::ExceptionUnhandled { exception } => {
+                write!(f, "no handler for {exception}")
+            }
+            EventKind::WaitForReleased { barrier } => write!(f, "waitfor {barrier} released"),
+            EventKind::StepPerformed { step } => write!(f, "performed {step}"),
+            EventKind::StepFailed { step, error } => write!(f, "skipped {step}: {error}"),
+            EventKind::Deadlock { cycle } => {
+                write!(f, "deadlock:")?;
+                for (module, port) in cycle {
+                    write!(f, " {module} -[{port}]->")?;
+                }
+                match cycle.first() {
+                    Some((first, _)) => write!(f, " {first}"),
+                    None => Ok(()),
+                }
+            }
+            EventKind::Alarm { message } => write!(f, "ALARM {message}"),
+        }
+    }
+}
+
+type Sink = Box<dyn FnMut(&Event) + Send>;
+
+/// The event log of a cell: kept in memory, and streamed to subscribers as it grows.
+#[derive(Default)]
+pub struct EventLog {
+    inner: Mutex<Inner>,
+}
+
+#[derive(Default)]
+struct Inner {
+    events: Vec<Event>,
+    forget: bool,
+    sinks: Vec<Sink>,
+}
+
+impl EventLog {
+    /// An empty log that keeps every event.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Stops keeping events in memory (subscribers still see them): for long runs.
+    pub fn forget_events(&self) {
+        let mut inner = self.lock();
+        inner.forget = true;
+        inner.events = Vec::new();
+    }
+
+    /// Calls `sink` with every event recorded from now on, in order.
+    pub fn subscribe(&self, sink: impl FnMut(&Event) + Send + 'static) {
+        self.lock().sinks.push(Box::new(sink));
+    }
+
+    /// Records `event`.
+    pub fn record(&self, event: Event) {
+        match &event.kind {
+            EventKind::Deadlock { .. }
+            | EventKind::Alarm { .. }
+            | EventKind::ModuleFailed { .. } => {
+                tracing::warn!(target: "imrs", "{event}");
+            }
+            EventKind::TaskFailed { .. } | EventKind::ExceptionUnhandled { .. } => {
+                tracing::warn!(target: "imrs", "{event}");
+            }
+            _ => tracing::debug!(target: "imrs", "{event}"),
+        }
+        let mut inner = self.lock();
+        for sink in &mut inner.sinks {
+            sink(&event);
+        }
+        if !inner.forget {
+            inner.events.push(event);
+        }
+    }
+
+    /// Every event kept so far.
+    pub fn snapshot(&self) -> Vec<Event> {
+        self.lock().events.clone()
+    }
+
+    /// How many events are kept.
+    pub fn len(&self) -> usize {
+        self.lock().events.len()
+    }
+
+    /// Whether no event is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Inner> {
+        // A panicking sink leaves the log as it was before that event: still consistent.
+        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+impl fmt::Debug for EventLog {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("EventLog")
+            .field("events", &self.len())
+            .finish()
+    }
+}

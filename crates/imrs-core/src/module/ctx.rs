@@ -1,0 +1,445 @@
+//! What a task of a module sees: its module's state, the clock, named sections, and the
+//! port primitives, wrapped so that timeouts raise the module's exceptions and every
+//! operation lands in the event log.
+
+use std::collections::VecDeque;
+use std::fmt;
+use std::future::Future;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
+
+use imrs_ports::usage::{Queries, Receives, Sends};
+use imrs_ports::{
+    End, Instant, ModuleState, Name, QueryError, ReceiveError, ReplyHandle, SendError, SharedClock,
+};
+use tracing::Instrument;
+
+use super::spec::ModuleSpec;
+use crate::cell::{CellShared, ModuleHandle, spawn_module};
+use crate::event::{Event, EventKind};
+use crate::exception::Exception;
+use crate::order::{Order, Rank};
+use crate::supervision::RestartPolicy;
+use crate::waitfor::{Pool, WaitFor, WaitForError};
+use crate::work::{Performed, WorkSchedule};
+
+/// The section a thread of a module is in, as a rank: read by the module's scheduler at
+/// every suspension point.
+#[derive(Debug)]
+pub(crate) struct SectionCell(AtomicU32);
+
+impl SectionCell {
+    pub(crate) fn new(rank: Rank) -> Self {
+        Self(AtomicU32::new(rank.position()))
+    }
+
+    pub(crate) fn get(&self) -> Rank {
+        Rank::from_raw(self.0.load(Ordering::Relaxed))
+    }
+
+    fn replace(&self, rank: Rank) -> Rank {
+        Rank::from_raw(self.0.swap(rank.position(), Ordering::Relaxed))
+    }
+
+    pub(crate) fn set(&self, rank: Rank) {
+        self.0.store(rank.position(), Ordering::Relaxed);
+    }
+}
+
+/// What a module's tasks and handlers share.
+pub(crate) struct ModuleShared<S> {
+    pub(crate) name: Name,
+    pub(crate) parent: Option<Name>,
+    pub(crate) state: ModuleState<S>,
+    pub(crate) order: Order,
+    pub(crate) cell: Arc<CellShared>,
+    raised: Mutex<VecDeque<Exception>>,
+    restarts: Mutex<Vec<Name>>,
+}
+
+impl<S> ModuleShared<S> {
+    pub(crate) fn new(
+        spec_name: Name,
+        parent: Option<Name>,
+        state: S,
+        order: Order,
+        cell: Arc<CellShared>,
+    ) -> Self {
+        Self {
+            name: spec_name,
+            parent,
+            state: ModuleState::new(state),
+            order,
+            cell,
+            raised: Mutex::new(VecDeque::new()),
+            restarts: Mutex::new(Vec::new()),
+        }
+    }
+
+    pub(crate) fn event(&self, task: Option<&Name>, kind: EventKind) {
+        self.cell.events.record(Event {
+            at: self.cell.clock.now(),
+            module: self.name.clone(),
+            task: task.cloned(),
+            kind,
+        });
+    }
+
+    pub(crate) fn raise(&self, exception: Exception) {
+        self.event(
+            exception.task.as_ref(),
+            EventKind::ExceptionRaised {
+                exception: exception.name.clone(),
+            },
+        );
+        lock(&self.raised).push_back(exception);
+    }
+
+    pub(crate) fn raised(&self) -> MutexGuard<'_, VecDeque<Exception>> {
+        lock(&self.raised)
+    }
+
+    pub(crate) fn take_restart_requests(&self) -> Vec<Name> {
+        std::mem::take(&mut *lock(&self.restarts))
+    }
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Only ever held for one push or pop: never left half-done by a panic.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// A task's (or handler's) view of its module. Cheap to clone.
+pub struct Ctx<S> {
+    module: Arc<ModuleShared<S>>,
+    task: Name,
+    section: Arc<SectionCell>,
+}
+
+impl<S> Clone for Ctx<S> {
+    fn clone(&self) -> Self {
+        Self {
+            module: Arc::clone(&self.module),
+            task: self.task.clone(),
+            section: Arc::clone(&self.section),
+        }
+    }
+}
+
+impl<S: Send + Sync + 'static> Ctx<S> {
+    pub(crate) fn new(module: Arc<ModuleShared<S>>, task: Name, section: Arc<SectionCell>) -> Self {
+        Self {
+            module,
+            task,
+            section,
+        }
+    }
+
+    /// The module's name.
+    pub fn module(&self) -> &Name {
+        &self.module.name
+    }
+
+    /// The module that costarted this one, if any.
+    pub fn parent(&self) -> Option<&Name> {
+        self.module.parent.as_ref()
+    }
+
+    /// The task's (or handler's) name.
+    pub fn task(&self) -> &Name {
+        &self.task
+    }
+
+    /// The module's state: change it with `update`, read it with `read`.
+    pub fn state(&self) -> &ModuleState<S> {
+        &self.module.state
+    }
+
+    /// The cell's clock.
+    pub fn clock(&self) -> &SharedClock {
+        &self.module.cell.clock
+    }
+
+    /// The time now, on the cell's clock.
+    pub fn now(&self) -> Instant {
+        self.module.cell.clock.now()
+    }
+
+    /// `DELAY d`, on the cell's clock.
+    pub async fn delay(&self, duration: Duration) {
+        self.module.cell.clock.sleep(duration).await;
+    }
+
+    /// Runs `body` inside the named section: while it runs, the module's scheduler sees this
+    /// thread at the section's rank. A section the order does not name keeps the rank of the
+    /// code around it.
+    pub async fn section<F: Future>(&self, name: &str, body: F) -> F::Output {
+        let rank = self
+            .module
+            .order
+            .rank_of(name)
+            .unwrap_or_else(|| self.section.get());
+        let name: Name = name.into();
+        let _inside = SectionGuard::enter(self, name.clone(), rank);
+        let span = tracing::debug_span!("section", module = %self.module.name, section = %name);
+        body.instrument(span).await
+    }
+
+    /// `SEND`: as [`End::send`], and a timeout raises `PORT.TIMEOUT` in this module.
+    pub async fn send<Req, Rep, U>(
+        &self,
+        end: &mut End<Req, Rep, U>,
+        message: Req,
+    ) -> Result<Rep, SendError<Req>>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Sends,
+    {
+        let port = end.port().clone();
+        let waiting = self.wait_on(&port, end.peers());
+        let result = end.send(message).await;
+        drop(waiting);
+        match &result {
+            Ok(_) => self.event(EventKind::Sent { port }),
+            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
+        }
+        result
+    }
+
+    /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
+    pub async fn receive<Req, Rep, U>(
+        &self,
+        end: &mut End<Req, Rep, U>,
+    ) -> Result<(Req, ReplyHandle<Rep>), ReceiveError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Receives,
+    {
+        let port = end.port().clone();
+        let result = end.receive().await;
+        match &result {
+            Ok(_) => self.event(EventKind::Received { port }),
+            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
+        }
+        result
+    }
+
+    /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
+    pub async fn query<Req, Rep, U>(
+        &self,
+        end: &mut End<Req, Rep, U>,
+        query: Req,
+    ) -> Result<Rep, QueryError<Req>>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Queries,
+    {
+        let port = end.port().clone();
+        let waiting = self.wait_on(&port, end.peers());
+        let result = end.query(query).await;
+        drop(waiting);
+        match &result {
+            Ok(_) => self.event(EventKind::Queried { port }),
+            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
+        }
+        result
+    }
+
+    /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
+    /// `BARRIER.TIMEOUT` in this module.
+    pub async fn waitfor<M, R>(
+        &self,
+        barrier: &WaitFor<M>,
+        message: M,
+        combine: impl FnOnce(&Pool<M>) -> R,
+        timeout: Option<Duration>,
+    ) -> Result<R, WaitForError<M>>
+    where
+        M: Send + Sync + 'static,
+    {
+        let result = barrier
+            .waitfor(self.task.as_str(), message, combine, timeout)
+            .await;
+        match &result {
+            Ok(_) => self.event(EventKind::WaitForReleased {
+                barrier: barrier.name().clone(),
+            }),
+            Err(error) => {
+                let timed_out = matches!(error, WaitForError::Timeout { .. });
+                self.port_failed(barrier.name().clone(), error.to_string(), timed_out);
+            }
+        }
+        result
+    }
+
+    /// `PERFORM`: runs the next step of `schedule`, recording it; a failed step is skipped,
+    /// recorded, and raised as an alarm for the operator.
+    pub async fn perform<St, F, Fut, E>(
+        &self,
+        schedule: &mut WorkSchedule<St>,
+        run: F,
+    ) -> Option<Performed<E>>
+    where
+        St: fmt::Debug,
+        F: FnOnce(&St) -> Fut,
+        Fut: Future<Output = Result<(), E>>,
+        E: fmt::Display,
+    {
+        let performed = schedule.perform(run).await?;
+        match &performed {
+            Performed::Done { index } => {
+                let step = format!(
+                    "{:?}",
+                    schedule.get(*index).expect("a performed step exists")
+                );
+                self.event(EventKind::StepPerformed { step });
+            }
+            Performed::Failed { index, error } => {
+                let step = format!(
+                    "{:?}",
+                    schedule.get(*index).expect("a performed step exists")
+                );
+                self.event(EventKind::StepFailed {
+                    step,
+                    error: error.to_string(),
+                });
+            }
+        }
+        Some(performed)
+    }
+
+    /// Raises exception `name` in this module; its handler runs at its rank.
+    pub fn raise(&self, name: impl Into<Name>, detail: impl Into<String>) {
+        self.module.raise(Exception {
+            name: name.into(),
+            task: Some(self.task.clone()),
+            detail: detail.into(),
+        });
+    }
+
+    /// `{signal for help}`: records an alarm for the operator.
+    pub fn alarm(&self, message: impl Into<String>) {
+        self.event(EventKind::Alarm {
+            message: message.into(),
+        });
+    }
+
+    /// Asks the module to kill task `task` (if it runs) and start a new copy of it.
+    pub fn restart_task(&self, task: impl Into<Name>) {
+        lock(&self.module.restarts).push(task.into());
+    }
+
+    /// `COSTART`: starts `child` as a child module of this one.
+    pub fn costart<C: Send + Sync + 'static>(&self, child: ModuleSpec<C>) -> ModuleHandle {
+        let cell = Arc::clone(&self.module.cell);
+        spawn_module(
+            cell,
+            Some(self.module.name.clone()),
+            RestartPolicy::NEVER,
+            child,
+            None,
+        )
+    }
+
+    /// As [`Ctx::costart`], with a factory that makes a new copy of the child after a
+    /// failure, as `policy` allows.
+    pub fn costart_supervised<C, F>(&self, policy: RestartPolicy, mut factory: F) -> ModuleHandle
+    where
+        C: Send + Sync + 'static,
+        F: FnMut() -> ModuleSpec<C> + Send + 'static,
+    {
+        let cell = Arc::clone(&self.module.cell);
+        let first = factory();
+        spawn_module(
+            cell,
+            Some(self.module.name.clone()),
+            policy,
+            first,
+            Some(Box::new(factory)),
+        )
+    }
+
+    pub(crate) fn event(&self, kind: EventKind) {
+        self.module.event(Some(&self.task), kind);
+    }
+
+    fn port_failed(&self, port: Name, error: String, timed_out: bool) {
+        self.event(EventKind::PortError {
+            port: port.clone(),
+            error: error.clone(),
+        });
+        if timed_out {
+            self.module.raise(Exception {
+                name: Exception::timeout_of(port.as_str()),
+                task: Some(self.task.clone()),
+                detail: error,
+            });
+        }
+    }
+
+    fn wait_on(&self, port: &Name, on: Vec<Name>) -> WaitGuard {
+        let cell = &self.module.cell;
+        let (id, cycle) = cell.waits().begin(&self.module.name, port, on);
+        if let Some(cycle) = cycle {
+            self.event(EventKind::Deadlock { cycle });
+        }
+        WaitGuard {
+            cell: Arc::clone(cell),
+            module: self.module.name.clone(),
+            id,
+        }
+    }
+}
+
+impl<S> fmt::Debug for Ctx<S> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Ctx")
+            .field("module", &self.module.name)
+            .field("task", &self.task)
+            .field("rank", &self.section.get())
+            .finish()
+    }
+}
+
+/// Marks a thread as inside a section until dropped, also when the section is cancelled.
+struct SectionGuard<'a, S: Send + Sync + 'static> {
+    ctx: &'a Ctx<S>,
+    name: Name,
+    outer: Rank,
+}
+
+impl<'a, S: Send + Sync + 'static> SectionGuard<'a, S> {
+    fn enter(ctx: &'a Ctx<S>, name: Name, rank: Rank) -> Self {
+        let outer = ctx.section.replace(rank);
+        ctx.event(EventKind::SectionEntered {
+            section: name.clone(),
+        });
+        Self { ctx, name, outer }
+    }
+}
+
+impl<S: Send + Sync + 'static> Drop for SectionGuard<'_, S> {
+    fn drop(&mut self) {
+        self.ctx.section.set(self.outer);
+        self.ctx.event(EventKind::SectionLeft {
+            section: self.name.clone(),
+        });
+    }
+}
+
+/// A module's wait in the deadlock graph, removed when the wait ends.
+struct WaitGuard {
+    cell: Arc<CellShared>,
+    module: Name,
+    id: u64,
+}
+
+impl Drop for WaitGuard {
+    fn drop(&mut self) {
+        self.cell.waits().end(&self.module, self.id);
+    }
+}

@@ -1,0 +1,474 @@
+//! The order scheduler: one module's executor.
+//!
+//! A module is one future, polled by one tokio task. Inside it, this scheduler polls the
+//! module's threads — its tasks, and the exception handlers that are running — and decides
+//! when pending handlers may start. The rule (seed 000, §4.2 and §5.1):
+//!
+//! - A pending handler (a query for a response handler, a raised exception) starts when its
+//!   rank outranks the section that some live thread of the module is in, at that thread's
+//!   suspension point: that is, at the end of a poll. Ranks are re-checked after every poll
+//!   of every thread. Wakers only wake the module's task; nothing is polled inside a waker.
+//! - A response handler is synchronous: it runs to completion right there, reading `&S`.
+//!   An exception handler is asynchronous and becomes a thread of its own, at its rank.
+//! - The order decides only when handlers *start*; it never stops a running thread from
+//!   making progress. So a high-rank thread waiting on a port served by a lower-ranked thread
+//!   of the same module cannot deadlock: the lower-ranked thread keeps running (this is the
+//!   rule for priority inversion). Across modules there is no rank inheritance: the serving
+//!   module's order decides when its handler runs, and the waiter's port timeout bounds the
+//!   wait — which is how the seed breaks the CHIP_IT/CHIP_IT2 deadlock.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::pin::Pin;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::task::{Context, Poll, Waker};
+
+use imrs_ports::clock::Sleep;
+use imrs_ports::{Name, Respond};
+
+use super::ctx::{Ctx, ModuleShared, SectionCell};
+use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
+use crate::event::EventKind;
+use crate::exception::Exception;
+use crate::order::{Order, Rank};
+use crate::supervision::RestartPolicy;
+
+/// One waker slot, for the kill switch (rarely used, so a mutex is plenty).
+#[derive(Debug, Default)]
+struct WakerSlot(Mutex<Option<Waker>>);
+
+impl WakerSlot {
+    fn register(&self, waker: &Waker) {
+        let mut slot = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        if !slot.as_ref().is_some_and(|held| held.will_wake(waker)) {
+            *slot = Some(waker.clone());
+        }
+    }
+
+    fn wake(&self) {
+        let waker = self.0.lock().unwrap_or_else(PoisonError::into_inner).take();
+        if let Some(waker) = waker {
+            waker.wake();
+        }
+    }
+}
+
+/// Kills a running module from outside: its future ends at its next poll.
+#[derive(Debug, Default)]
+pub(crate) struct KillSwitch {
+    killed: AtomicBool,
+    stopped: AtomicBool,
+    waker: WakerSlot,
+}
+
+impl KillSwitch {
+    /// Kills the current copy; a supervised module may get a new one.
+    pub(crate) fn kill(&self) {
+        self.killed.store(true, Ordering::Release);
+        self.waker.wake();
+    }
+
+    /// Kills the current copy and asks for no new one.
+    pub(crate) fn stop(&self) {
+        self.stopped.store(true, Ordering::Release);
+        self.kill();
+    }
+
+    pub(crate) fn is_stopped(&self) -> bool {
+        self.stopped.load(Ordering::Acquire)
+    }
+
+    pub(crate) fn rearm(&self) {
+        self.killed.store(false, Ordering::Release);
+    }
+
+    fn poll_killed(&self, cx: &mut Context<'_>) -> bool {
+        if self.killed.load(Ordering::Acquire) {
+            return true;
+        }
+        self.waker.register(cx.waker());
+        self.killed.load(Ordering::Acquire)
+    }
+}
+
+/// How a module's copy ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum ModuleExit {
+    /// Every task finished.
+    Finished,
+    /// A task failed beyond its restart policy.
+    Failed(String),
+    /// Killed from outside.
+    Killed,
+}
+
+enum Stage {
+    Running(BoxFuture<TaskResult>),
+    Restarting(Pin<Box<Sleep>>),
+    Finished,
+    GaveUp(String),
+}
+
+struct TaskRun<S> {
+    name: Name,
+    factory: TaskFactory<S>,
+    policy: RestartPolicy,
+    section: Arc<SectionCell>,
+    stage: Stage,
+    restarts: u32,
+}
+
+struct HandlerRun {
+    name: Name,
+    rank: Rank,
+    future: BoxFuture<()>,
+}
+
+struct ResponseRun<S> {
+    name: Name,
+    rank: Rank,
+    end: Box<dyn Respond<S> + Send>,
+}
+
+pub(crate) struct ModuleRun<S> {
+    shared: Arc<ModuleShared<S>>,
+    tasks: Vec<TaskRun<S>>,
+    handlers: Vec<HandlerRun>,
+    responses: Vec<ResponseRun<S>>,
+    exception_handlers: Vec<(Name, Rank, ExceptionHandler<S>)>,
+    kill: Arc<KillSwitch>,
+    span: tracing::Span,
+}
+
+impl<S: Send + Sync + 'static> ModuleRun<S> {
+    pub(crate) fn new(
+        spec: ModuleSpec<S>,
+        cell: Arc<crate::cell::CellShared>,
+        parent: Option<Name>,
+        kill: Arc<KillSwitch>,
+    ) -> Self {
+        let order = Order::new(spec.name.clone(), spec.order);
+        let background = order.background();
+        let mut responses: Vec<_> = spec
+            .responses
+            .into_iter()
+            .map(|(name, end)| ResponseRun {
+                rank: order.handler_rank(name.as_str()),
+                name,
+                end,
+            })
+            .collect();
+        responses.sort_by_key(|response| response.rank);
+        let exception_handlers = spec
+            .exceptions
+            .into_iter()
+            .map(|(name, handler)| {
+                let rank = order.handler_rank(name.as_str());
+                (name, rank, handler)
+            })
+            .collect();
+        let span = tracing::info_span!("module", name = %spec.name);
+        let shared = Arc::new(ModuleShared::new(
+            spec.name, parent, spec.state, order, cell,
+        ));
+        let tasks = spec
+            .tasks
+            .into_iter()
+            .map(|task| {
+                let section = Arc::new(SectionCell::new(background));
+                let mut run = TaskRun {
+                    name: task.name,
+                    factory: task.factory,
+                    policy: task.policy,
+                    section,
+                    stage: Stage::Finished,
+                    restarts: 0,
+                };
+                let ctx = Ctx::new(
+                    Arc::clone(&shared),
+                    run.name.clone(),
+                    Arc::clone(&run.section),
+                );
+                run.stage = Stage::Running((run.factory)(ctx));
+                shared.event(Some(&run.name), EventKind::TaskStarted);
+                run
+            })
+            .collect();
+        Self {
+            shared,
+            tasks,
+            handlers: Vec::new(),
+            responses,
+            exception_handlers,
+            kill,
+            span,
+        }
+    }
+
+    /// The least urgent section any live thread is in: a handler must outrank it to start.
+    /// `None` when no thread lives, and any handler may start.
+    fn host_rank(&self) -> Option<Rank> {
+        let tasks = self.tasks.iter().filter_map(|task| match task.stage {
+            Stage::Running(_) => Some(task.section.get()),
+            _ => None,
+        });
+        let handlers = self.handlers.iter().map(|handler| handler.rank);
+        tasks.chain(handlers).max()
+    }
+
+    /// Starts every pending handler whose rank allows it now. Returns whether any started.
+    fn admit(&mut self, cx: &mut Context<'_>) -> bool {
+        let mut started = false;
+        self.restart_requested();
+        loop {
+            let host = self.host_rank();
+            let admissible = |rank: Rank| host.is_none_or(|host| rank.outranks(host));
+            let mut raised = self.shared.raised();
+            let Some(position) = raised.iter().position(|exception| {
+                let rank = self.handler_for(&exception.name).map(|(rank, _)| rank);
+                rank.is_none_or(admissible)
+            }) else {
+                drop(raised);
+                break;
+            };
+            let exception = raised.remove(position).expect("found just above");
+            drop(raised);
+            self.start_handler(exception);
+            started = true;
+        }
+        let host = self.host_rank();
+        for response in &mut self.responses {
+            if !host.is_none_or(|host| response.rank.outranks(host)) {
+                // Sorted by rank: no later handler outranks the host either.
+                break;
+            }
+            while let Poll::Ready(Ok(())) = response.end.poll_pending(cx) {
+                let end = &mut response.end;
+                let answered = self.shared.state.read(|state| end.respond(state));
+                if answered {
+                    self.shared.event(
+                        Some(&response.name),
+                        EventKind::Responded {
+                            handler: response.name.clone(),
+                        },
+                    );
+                    started = true;
+                }
+            }
+        }
+        started
+    }
+
+    fn handler_for(&self, exception: &Name) -> Option<(Rank, &ExceptionHandler<S>)> {
+        self.exception_handlers
+            .iter()
+            .find(|(name, _, _)| name == exception)
+            .map(|(_, rank, handler)| (*rank, handler))
+    }
+
+    fn start_handler(&mut self, exception: Exception) {
+        let Some((rank, handler)) = self.handler_for(&exception.name) else {
+            self.shared.event(
+                exception.task.as_ref(),
+                EventKind::ExceptionUnhandled {
+                    exception: exception.name,
+                },
+            );
+            return;
+        };
+        let handler = Arc::clone(handler);
+        let name = exception.name.clone();
+        let ctx = Ctx::new(
+            Arc::clone(&self.shared),
+            name.clone(),
+            Arc::new(SectionCell::new(rank)),
+        );
+        self.shared.event(
+            Some(&name),
+            EventKind::ExceptionHandled {
+                exception: name.clone(),
+            },
+        );
+        let future = handler(ctx, exception);
+        let position = self
+            .handlers
+            .partition_point(|running| running.rank <= rank);
+        self.handlers
+            .insert(position, HandlerRun { name, rank, future });
+    }
+
+    fn restart_requested(&mut self) {
+        for name in self.shared.take_restart_requests() {
+            let Some(index) = self.tasks.iter().position(|task| task.name == name) else {
+                self.shared.event(
+                    None,
+                    EventKind::Alarm {
+                        message: format!(
+                            "restart asked for task {name}, which module {} does not have",
+                            self.shared.name
+                        ),
+                    },
+                );
+                continue;
+            };
+            self.start_copy(index);
+        }
+    }
+
+    /// Drops whatever copy of task `index` there is and starts a new one.
+    fn start_copy(&mut self, index: usize) {
+        let background = self.shared.order.background();
+        let task = &mut self.tasks[index];
+        task.stage = Stage::Finished;
+        task.restarts += 1;
+        task.section.set(background);
+        let ctx = Ctx::new(
+            Arc::clone(&self.shared),
+            task.name.clone(),
+            Arc::clone(&task.section),
+        );
+        task.stage = Stage::Running((task.factory)(ctx));
+        self.shared.event(
+            Some(&task.name),
+            EventKind::TaskRestarted {
+                attempt: task.restarts,
+            },
+        );
+    }
+
+    /// Polls task `index` once. Returns whether its stage changed.
+    fn poll_task(&mut self, index: usize, cx: &mut Context<'_>) -> bool {
+        let task = &mut self.tasks[index];
+        match &mut task.stage {
+            Stage::Running(future) => {
+                let outcome = catch_unwind(AssertUnwindSafe(|| future.as_mut().poll(cx)));
+                let failure = match outcome {
+                    Ok(Poll::Pending) => return false,
+                    Ok(Poll::Ready(Ok(()))) => {
+                        task.stage = Stage::Finished;
+                        self.shared.event(Some(&task.name), EventKind::TaskFinished);
+                        return true;
+                    }
+                    Ok(Poll::Ready(Err(error))) => error.to_string(),
+                    Err(panic) => panic_message(panic.as_ref()),
+                };
+                self.fail_task(index, failure);
+                true
+            }
+            Stage::Restarting(sleep) => {
+                if sleep.as_mut().poll(cx).is_pending() {
+                    return false;
+                }
+                self.start_copy(index);
+                true
+            }
+            Stage::Finished | Stage::GaveUp(_) => false,
+        }
+    }
+
+    fn fail_task(&mut self, index: usize, reason: String) {
+        let task = &mut self.tasks[index];
+        self.shared.event(
+            Some(&task.name),
+            EventKind::TaskFailed {
+                reason: reason.clone(),
+            },
+        );
+        task.stage = match task.policy.delay_before(task.restarts + 1) {
+            Some(delay) => Stage::Restarting(Box::pin(self.shared.cell.clock.sleep(delay))),
+            None => Stage::GaveUp(reason.clone()),
+        };
+        let exception = Exception {
+            name: Exception::failure_of(task.name.as_str()),
+            task: Some(task.name.clone()),
+            detail: reason,
+        };
+        self.shared.raise(exception);
+    }
+
+    /// Polls running handler `index` once. Returns whether it finished.
+    fn poll_handler(&mut self, index: usize, cx: &mut Context<'_>) -> bool {
+        let handler = &mut self.handlers[index];
+        match catch_unwind(AssertUnwindSafe(|| handler.future.as_mut().poll(cx))) {
+            Ok(Poll::Pending) => false,
+            Ok(Poll::Ready(())) => {
+                self.handlers.remove(index);
+                true
+            }
+            Err(panic) => {
+                let handler = self.handlers.remove(index);
+                self.shared.event(
+                    Some(&handler.name),
+                    EventKind::TaskFailed {
+                        reason: format!(
+                            "exception handler panicked: {}",
+                            panic_message(panic.as_ref())
+                        ),
+                    },
+                );
+                true
+            }
+        }
+    }
+
+    fn exit(&self) -> Option<ModuleExit> {
+        if !self.handlers.is_empty() || !self.shared.raised().is_empty() {
+            return None;
+        }
+        if let Some(reason) = self.tasks.iter().find_map(|task| match &task.stage {
+            Stage::GaveUp(reason) => Some(format!("task {} failed: {reason}", task.name)),
+            _ => None,
+        }) {
+            return Some(ModuleExit::Failed(reason));
+        }
+        let all_finished = self
+            .tasks
+            .iter()
+            .all(|task| matches!(task.stage, Stage::Finished));
+        (!self.tasks.is_empty() && all_finished).then_some(ModuleExit::Finished)
+    }
+}
+
+impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
+    type Output = ModuleExit;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<ModuleExit> {
+        let this = self.get_mut();
+        let span = this.span.clone();
+        let _entered = span.enter();
+        if this.kill.poll_killed(cx) {
+            return Poll::Ready(ModuleExit::Killed);
+        }
+        loop {
+            let mut progress = this.admit(cx);
+            // Running handlers are kept in rank order, most urgent first.
+            let mut index = 0;
+            while index < this.handlers.len() {
+                if this.poll_handler(index, cx) {
+                    progress = true;
+                } else {
+                    index += 1;
+                }
+                progress |= this.admit(cx);
+            }
+            for index in 0..this.tasks.len() {
+                progress |= this.poll_task(index, cx);
+                progress |= this.admit(cx);
+            }
+            if let Some(exit) = this.exit() {
+                return Poll::Ready(exit);
+            }
+            if !progress {
+                return Poll::Pending;
+            }
+        }
+    }
+}
+
+fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|text| (*text).to_owned())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "panicked".to_owned())
+}

@@ -1,0 +1,234 @@
+//! What a module is made of, declared in one place, the way the seed's module specification
+//! and body declare it: state, order, tasks, response and exception handlers, named
+//! sections, the ports it owns and uses, and its hardware division.
+
+use std::fmt;
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::Arc;
+
+use imrs_ports::{Name, Respond, UsageKind};
+
+use super::ctx::Ctx;
+use crate::exception::Exception;
+use crate::supervision::RestartPolicy;
+
+/// What a task may fail with: any error, so that `?` works on port errors.
+pub type TaskError = Box<dyn std::error::Error + Send + Sync>;
+
+/// What a task returns.
+pub type TaskResult = Result<(), TaskError>;
+
+pub(crate) type BoxFuture<T> = Pin<Box<dyn Future<Output = T> + Send>>;
+pub(crate) type TaskFactory<S> = Box<dyn FnMut(Ctx<S>) -> BoxFuture<TaskResult> + Send>;
+pub(crate) type ExceptionHandler<S> = Arc<dyn Fn(Ctx<S>, Exception) -> BoxFuture<()> + Send + Sync>;
+
+pub(crate) struct TaskSpec<S> {
+    pub(crate) name: Name,
+    pub(crate) factory: TaskFactory<S>,
+    pub(crate) policy: RestartPolicy,
+}
+
+/// A module, declared: build it with [`ModuleSpec::new`] and start it with
+/// [`Cell::start`](crate::Cell::start) or [`Ctx::costart`](crate::Ctx::costart).
+///
+/// `S` is the module's state. Tasks change it with
+/// [`ModuleState::update`](imrs_ports::ModuleState::update); response handlers read it.
+pub struct ModuleSpec<S> {
+    pub(crate) name: Name,
+    pub(crate) state: S,
+    pub(crate) order: Vec<Name>,
+    pub(crate) sections: Vec<Name>,
+    pub(crate) hardware: Vec<Name>,
+    pub(crate) owns: Vec<Name>,
+    pub(crate) uses: Vec<(Name, UsageKind)>,
+    pub(crate) filters: Vec<(Name, UsageKind)>,
+    pub(crate) tasks: Vec<TaskSpec<S>>,
+    pub(crate) responses: Vec<(Name, Box<dyn Respond<S> + Send>)>,
+    pub(crate) exceptions: Vec<(Name, ExceptionHandler<S>)>,
+}
+
+impl<S: Send + Sync + 'static> ModuleSpec<S> {
+    /// Module `name` with initial state `state`.
+    pub fn new(name: impl Into<Name>, state: S) -> Self {
+        Self {
+            name: name.into(),
+            state,
+            order: Vec::new(),
+            sections: Vec::new(),
+            hardware: Vec::new(),
+            owns: Vec::new(),
+            uses: Vec::new(),
+            filters: Vec::new(),
+            tasks: Vec::new(),
+            responses: Vec::new(),
+            exceptions: Vec::new(),
+        }
+    }
+
+    /// The module's name.
+    pub fn name(&self) -> &Name {
+        &self.name
+    }
+
+    /// `ORDER(...)`: the module's sections, most urgent first. See [`Order`](crate::Order).
+    pub fn order<I, N>(mut self, names: I) -> Self
+    where
+        I: IntoIterator<Item = N>,
+        N: Into<Name>,
+    {
+        self.order = names.into_iter().map(Into::into).collect();
+        self
+    }
+
+    /// Declares named sections (subprograms such as `GRASP` and `INSERT`).
+    pub fn sections<I, N>(mut self, names: I) -> Self
+    where
+        I: IntoIterator<Item = N>,
+        N: Into<Name>,
+    {
+        self.sections.extend(names.into_iter().map(Into::into));
+        self
+    }
+
+    /// The hardware division: the devices the module drives, by name.
+    pub fn hardware<I, N>(mut self, devices: I) -> Self
+    where
+        I: IntoIterator<Item = N>,
+        N: Into<Name>,
+    {
+        self.hardware.extend(devices.into_iter().map(Into::into));
+        self
+    }
+
+    /// `PORT ...`: declares that this module owns `port`.
+    pub fn owns(mut self, port: impl Into<Name>) -> Self {
+        self.owns.push(port.into());
+        self
+    }
+
+    /// `USE PORT ... USAGE=usage`: declares that this module uses `port` with `usage`.
+    pub fn uses(mut self, port: impl Into<Name>, usage: UsageKind) -> Self {
+        self.uses.push((port.into(), usage));
+        self
+    }
+
+    /// Declares that a task of this module is the filter of `port`, serving the port's users
+    /// with `usage`.
+    pub fn filters(mut self, port: impl Into<Name>, usage: UsageKind) -> Self {
+        self.filters.push((port.into(), usage));
+        self
+    }
+
+    /// `TASK name`: a task of the module's background code; all tasks start together when
+    /// the module starts. `body` makes a fresh copy of the task each time it (re)starts.
+    pub fn task<F, Fut>(self, name: impl Into<Name>, body: F) -> Self
+    where
+        F: FnMut(Ctx<S>) -> Fut + Send + 'static,
+        Fut: Future<Output = TaskResult> + Send + 'static,
+    {
+        self.task_with_policy(name, RestartPolicy::NEVER, body)
+    }
+
+    /// As [`ModuleSpec::task`], restarted by `policy` when it fails.
+    pub fn task_with_policy<F, Fut>(
+        mut self,
+        name: impl Into<Name>,
+        policy: RestartPolicy,
+        mut body: F,
+    ) -> Self
+    where
+        F: FnMut(Ctx<S>) -> Fut + Send + 'static,
+        Fut: Future<Output = TaskResult> + Send + 'static,
+    {
+        self.tasks.push(TaskSpec {
+            name: name.into(),
+            factory: Box::new(move |ctx| Box::pin(body(ctx))),
+            policy,
+        });
+        self
+    }
+
+    /// `WHEN PORT.resp ==>`: a response handler, named as the order names it
+    /// (`"ASK_CHILD1.STATUS"`), on a response end built with its handler.
+    pub fn response(
+        mut self,
+        name: impl Into<Name>,
+        end: impl Respond<S> + Send + 'static,
+    ) -> Self {
+        self.responses.push((name.into(), Box::new(end)));
+        self
+    }
+
+    /// `WHEN exception ==>`: an exception handler, named as the order names it
+    /// (`"LET_1_GO.TIMEOUT"`, `"RELEASE.FAILED"`).
+    pub fn exception<F, Fut>(mut self, name: impl Into<Name>, handler: F) -> Self
+    where
+        F: Fn(Ctx<S>, Exception) -> Fut + Send + Sync + 'static,
+        Fut: Future<Output = ()> + Send + 'static,
+    {
+        let handler: ExceptionHandler<S> =
+            Arc::new(move |ctx, exception| Box::pin(handler(ctx, exception)));
+        self.exceptions.push((name.into(), handler));
+        self
+    }
+
+    /// What the wiring check needs to know of this module.
+    pub fn declaration(&self) -> ModuleDecl {
+        ModuleDecl {
+            name: self.name.clone(),
+            order: self.order.clone(),
+            sections: self.sections.clone(),
+            owns: self.owns.clone(),
+            uses: self.uses.clone(),
+            filters: self.filters.clone(),
+            responses: self
+                .responses
+                .iter()
+                .map(|(name, _)| name.clone())
+                .collect(),
+            exceptions: self
+                .exceptions
+                .iter()
+                .map(|(name, _)| name.clone())
+                .collect(),
+            tasks: self.tasks.iter().map(|task| task.name.clone()).collect(),
+        }
+    }
+}
+
+impl<S> fmt::Debug for ModuleSpec<S> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("ModuleSpec")
+            .field("name", &self.name)
+            .field("order", &self.order)
+            .field(
+                "tasks",
+                &self.tasks.iter().map(|t| &t.name).collect::<Vec<_>>(),
+            )
+            .finish_non_exhaustive()
+    }
+}
+
+/// A module's declarations, for the wiring check: the seed's module specification.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModuleDecl {
+    /// The module.
+    pub name: Name,
+    /// Its order.
+    pub order: Vec<Name>,
+    /// Its named sections.
+    pub sections: Vec<Name>,
+    /// The ports it owns.
+    pub owns: Vec<Name>,
+    /// The ports it uses, with its usage.
+    pub uses: Vec<(Name, UsageKind)>,
+    /// The ports it filters, with the filter's usage toward the users.
+    pub filters: Vec<(Name, UsageKind)>,
+    /// Its response handlers (`PORT.resp`).
+    pub responses: Vec<Name>,
+    /// Its exception handlers.
+    pub exceptions: Vec<Name>,
+    /// Its tasks.
+    pub tasks: Vec<Name>,
+}

@@ -1,0 +1,280 @@
+//! `waitfor` and `getmess` (seed 000, §4.2 and §5.2): an n-way rendezvous of named tasks.
+//!
+//! Each named task calls [`WaitFor::waitfor`] with a message. It blocks until every named
+//! task has called it; then each runs its own combining function over all pooled messages,
+//! read-only, and goes on with the result. Inside the function, [`Pool::getmess`] reads one
+//! task's message. The same rendezvous can be used again for the next round.
+
+use std::fmt;
+use std::future::poll_fn;
+use std::pin::pin;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::task::{Poll, Waker};
+use std::time::Duration;
+
+use imrs_ports::{Name, SharedClock};
+
+/// The pooled messages of one round of a `waitfor`, one per named task.
+#[derive(Debug)]
+pub struct Pool<M> {
+    members: Arc<[Name]>,
+    messages: Vec<M>,
+}
+
+impl<M> Pool<M> {
+    /// `GETMESS(task)`: the message `task` pooled, if it is a member.
+    pub fn getmess(&self, task: &str) -> Option<&M> {
+        let index = self.members.iter().position(|m| m.as_str() == task)?;
+        self.messages.get(index)
+    }
+
+    /// Every member with its message, in the order the rendezvous names them.
+    pub fn iter(&self) -> impl Iterator<Item = (&Name, &M)> {
+        self.members.iter().zip(&self.messages)
+    }
+
+    /// How many messages were pooled.
+    pub fn len(&self) -> usize {
+        self.messages.len()
+    }
+
+    /// Whether the pool is empty (a rendezvous of nobody).
+    pub fn is_empty(&self) -> bool {
+        self.messages.is_empty()
+    }
+}
+
+/// Why a `waitfor` failed; the message comes back where it was not pooled.
+#[derive(Debug, PartialEq, Eq)]
+pub enum WaitForError<M> {
+    /// Not every member arrived before the timeout; `missing` are those that did not.
+    Timeout {
+        /// The rendezvous.
+        barrier: Name,
+        /// The members that had not arrived.
+        missing: Vec<Name>,
+        /// The message, withdrawn from the pool.
+        message: M,
+    },
+    /// The caller is not one of the named tasks.
+    NotAMember {
+        /// The rendezvous.
+        barrier: Name,
+        /// The caller.
+        task: Name,
+        /// The message.
+        message: M,
+    },
+    /// The caller is already waiting in this round (two tasks under one name).
+    AlreadyWaiting {
+        /// The rendezvous.
+        barrier: Name,
+        /// The caller.
+        task: Name,
+        /// The message.
+        message: M,
+    },
+}
+
+impl<M> fmt::Display for WaitForError<M> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Timeout {
+                barrier, missing, ..
+            } => {
+                write!(f, "waitfor {barrier} timed out waiting for")?;
+                for name in missing {
+                    write!(f, " {name}")?;
+                }
+                Ok(())
+            }
+            Self::NotAMember { barrier, task, .. } => {
+                write!(f, "task {task} is not named in waitfor {barrier}")
+            }
+            Self::AlreadyWaiting { barrier, task, .. } => {
+                write!(f, "task {task} is already waiting in waitfor {barrier}")
+            }
+        }
+    }
+}
+
+impl<M: fmt::Debug> std::error::Error for WaitForError<M> {}
+
+/// An n-way rendezvous of named tasks, pooling messages of type `M`.
+pub struct WaitFor<M> {
+    shared: Arc<Shared<M>>,
+}
+
+struct Shared<M> {
+    name: Name,
+    members: Arc<[Name]>,
+    clock: SharedClock,
+    round: Mutex<Round<M>>,
+}
+
+struct Round<M> {
+    generation: u64,
+    arrived: Vec<Option<M>>,
+    wakers: Vec<Option<Waker>>,
+    /// The pool of the last completed round, for members that have not picked it up yet.
+    released: Option<Arc<Pool<M>>>,
+}
+
+impl<M> Clone for WaitFor<M> {
+    fn clone(&self) -> Self {
+        Self {
+            shared: Arc::clone(&self.shared),
+        }
+    }
+}
+
+impl<M: Send + Sync + 'static> WaitFor<M> {
+    /// The rendezvous `name` of the tasks `members`, timed on `clock`.
+    pub fn new<I, N>(name: impl Into<Name>, members: I, clock: SharedClock) -> Self
+    where
+        I: IntoIterator<Item = N>,
+        N: Into<Name>,
+    {
+        let members: Arc<[Name]> = members.into_iter().map(Into::into).collect();
+        let count = members.len();
+        Self {
+            shared: Arc::new(Shared {
+                name: name.into(),
+                members,
+                clock,
+                round: Mutex::new(Round {
+                    generation: 0,
+                    arrived: (0..count).map(|_| None).collect(),
+                    wakers: vec![None; count],
+                    released: None,
+                }),
+            }),
+        }
+    }
+
+    /// The rendezvous' name.
+    pub fn name(&self) -> &Name {
+        &self.shared.name
+    }
+
+    /// The named tasks.
+    pub fn members(&self) -> &[Name] {
+        &self.shared.members
+    }
+
+    /// `waitfor`: `task` pools `message`, waits (at most `timeout`) until every member has,
+    /// then runs `combine` over the pool and returns its result.
+    pub async fn waitfor<R>(
+        &self,
+        task: &str,
+        message: M,
+        combine: impl FnOnce(&Pool<M>) -> R,
+        timeout: Option<Duration>,
+    ) -> Result<R, WaitForError<M>> {
+        let shared = &self.shared;
+        let Some(index) = shared.members.iter().position(|m| m.as_str() == task) else {
+            return Err(WaitForError::NotAMember {
+                barrier: shared.name.clone(),
+                task: task.into(),
+                message,
+            });
+        };
+        let generation = {
+            let mut round = self.lock();
+            if round.arrived[index].is_some() {
+                return Err(WaitForError::AlreadyWaiting {
+                    barrier: shared.name.clone(),
+                    task: task.into(),
+                    message,
+                });
+            }
+            round.arrived[index] = Some(message);
+            let generation = round.generation;
+            if round.arrived.iter().all(Option::is_some) {
+                self.release(&mut round);
+            }
+            generation
+        };
+        let mut deadline = pin!(timeout.map(|timeout| shared.clock.sleep(timeout)));
+        let pool = poll_fn(|cx| {
+            let mut round = self.lock();
+            if round.generation > generation {
+                let pool = round
+                    .released
+                    .clone()
+                    .expect("a released round keeps its pool");
+                return Poll::Ready(Ok(pool));
+            }
+            round.wakers[index] = Some(cx.waker().clone());
+            drop(round);
+            let timed_out = deadline
+                .as_mut()
+                .as_pin_mut()
+                .is_some_and(|sleep| sleep.poll(cx).is_ready());
+            if !timed_out {
+                return Poll::Pending;
+            }
+            let mut round = self.lock();
+            if round.generation > generation {
+                // The last member came in just as the time ran out: the rendezvous wins.
+                let pool = round
+                    .released
+                    .clone()
+                    .expect("a released round keeps its pool");
+                return Poll::Ready(Ok(pool));
+            }
+            round.wakers[index] = None;
+            let message = round.arrived[index]
+                .take()
+                .expect("the caller's message waits");
+            let missing = shared
+                .members
+                .iter()
+                .zip(&round.arrived)
+                .filter(|(_, arrived)| arrived.is_none())
+                .map(|(name, _)| name.clone())
+                .filter(|name| name.as_str() != task)
+                .collect();
+            Poll::Ready(Err(WaitForError::Timeout {
+                barrier: shared.name.clone(),
+                missing,
+                message,
+            }))
+        })
+        .await?;
+        Ok(combine(&pool))
+    }
+
+    fn release(&self, round: &mut Round<M>) {
+        let messages = round
+            .arrived
+            .iter_mut()
+            .map(|slot| slot.take().expect("every member arrived"))
+            .collect();
+        round.released = Some(Arc::new(Pool {
+            members: Arc::clone(&self.shared.members),
+            messages,
+        }));
+        round.generation += 1;
+        for waker in round.wakers.iter_mut().filter_map(Option::take) {
+            waker.wake();
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Round<M>> {
+        // Every critical section leaves the round consistent before anything can panic.
+        self.shared
+            .round
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+impl<M> fmt::Debug for WaitFor<M> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("WaitFor")
+            .field("name", &self.shared.name)
+            .field("members", &self.shared.members)
+            .finish_non_exhaustive()
+    }
+}
