@@ -84,7 +84,7 @@ pub use work::{Performed, WorkSchedule};
 pub mod prelude {
     pub use crate::{
         Cell, Ctx, Event, EventKind, Exception, ModuleHandle, ModuleOutcome, ModuleSpec, Performed,
-        RestartPolicy, TaskResult, WaitFor, WorkSchedule,
+        RestartPolicy, TaskError, TaskResult, WaitFor, WorkSchedule,
     };
     pub use imrs_ports::prelude::*;
     pub use imrs_ports::{Instant, Name, SharedClock, UsageKind};
