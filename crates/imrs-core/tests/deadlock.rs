@@ -1,0 +1,139 @@
+//! The deadlock of the Appendix's note 6: CHIP_IT and CHIP_IT2 query each other from their
+//! background code. It is reported by module and port names, and broken by asymmetric
+//! timeouts.
+
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use imrs_core::prelude::*;
+use imrs_core::time::drive;
+
+fn secs(n: u64) -> Duration {
+    Duration::from_secs(n)
+}
+
+fn at(n: u64) -> Instant {
+    Instant::from_start(secs(n))
+}
+
+type Log = Arc<Mutex<Vec<(String, u64)>>>;
+
+/// A chip robot: asks its twin for the feeders on `asks` (timeout `patience`), answers the
+/// twin's CRIT_SECTION on `answers`. After a timeout it runs a section ranked below
+/// CRIT_SECTION for a moment, so that the twin's pending query gets through (the seed's
+/// remedy), then asks again.
+fn chip_robot(
+    name: &str,
+    asks: Port<(), i32, usage::Query>,
+    answers: &Port<(), i32, usage::Query>,
+    log: Log,
+) -> ModuleSpec<()> {
+    let asks_name = asks.name().to_string();
+    let answers_name = answers.name().to_string();
+    let crit_section = format!("{answers_name}.CRIT_SECTION");
+    let robot = name.to_string();
+    ModuleSpec::new(name, ())
+        .order([
+            format!("{asks_name}.TIMEOUT"),
+            name.to_string(),
+            "GRASP".into(),
+            crit_section.clone(),
+            "INSERT".into(),
+            "BACK_OFF".into(),
+        ])
+        .sections(["GRASP", "INSERT", "BACK_OFF"])
+        .owns(asks_name)
+        .uses(answers_name, UsageKind::Response)
+        .response(
+            crit_section,
+            answers.responder_named(name, |_: &(), ()| 1).unwrap(),
+        )
+        .task(name, move |ctx| {
+            let (asks, log, robot) = (asks.clone(), Arc::clone(&log), robot.clone());
+            async move {
+                let mut share_feeder = asks.owner()?;
+                loop {
+                    match ctx.query(&mut share_feeder, ()).await {
+                        Ok(_) => break,
+                        Err(error) if error.is_timeout() => {
+                            ctx.section("BACK_OFF", ctx.delay(secs(1))).await;
+                        }
+                        Err(error) => return Err(error.into()),
+                    }
+                }
+                log.lock()
+                    .unwrap()
+                    .push((robot.clone(), ctx.now().since_start().as_secs()));
+                ctx.section("GRASP", ctx.delay(secs(2))).await;
+                ctx.section("INSERT", ctx.delay(secs(5))).await;
+                Ok(())
+            }
+        })
+}
+
+#[test]
+fn the_chip_robots_deadlock_is_reported_and_broken_by_asymmetric_timeouts() {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .start_paused(true)
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        // SHARE_FEEDER (CHIP_IT's, TIMEOUT=3 SEC) and SHARE_FEEDER1 (CHIP_IT2's, 5 s): the
+        // asymmetry decides who gives way.
+        let share_feeder = Port::<(), i32, usage::Query>::declare(
+            PortSpec::new("SHARE_FEEDER", "CHIP_IT")
+                .user_list(["CHIP_IT2"])
+                .timeout(secs(3))
+                .clock(cell.clock().clone()),
+        );
+        let share_feeder1 = Port::<(), i32, usage::Query>::declare(
+            PortSpec::new("SHARE_FEEDER1", "CHIP_IT2")
+                .user_list(["CHIP_IT"])
+                .timeout(secs(5))
+                .clock(cell.clock().clone()),
+        );
+        let log: Log = Arc::default();
+        let chip_it = chip_robot("CHIP_IT", share_feeder.clone(), &share_feeder1, Arc::clone(&log));
+        let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+        let mut handles = [cell.start(chip_it), cell.start(chip_it2)];
+        drive(&clock, at(40)).await;
+        for handle in &mut handles {
+            assert_eq!(handle.finished().await, ModuleOutcome::Finished);
+        }
+
+        let events = cell.events().snapshot();
+        let deadlocks: Vec<_> = events
+            .iter()
+            .filter_map(|event| match &event.kind {
+                EventKind::Deadlock { cycle } => Some((event.at, cycle.clone())),
+                _ => None,
+            })
+            .collect();
+        // Both query at once, from their background code: the cycle closes at 0 s.
+        assert_eq!(
+            deadlocks.first(),
+            Some(&(
+                at(0),
+                vec![
+                    (Name::from("CHIP_IT2"), Name::from("SHARE_FEEDER1")),
+                    (Name::from("CHIP_IT"), Name::from("SHARE_FEEDER")),
+                ]
+            ))
+        );
+        let line = events
+            .iter()
+            .find(|event| matches!(event.kind, EventKind::Deadlock { .. }))
+            .unwrap()
+            .to_string();
+        assert_eq!(
+            line,
+            "[0.000s] CHIP_IT2/CHIP_IT2: deadlock: CHIP_IT2 -[SHARE_FEEDER1]-> CHIP_IT -[SHARE_FEEDER]-> CHIP_IT2"
+        );
+        // CHIP_IT times out first (3 s) and backs off below CRIT_SECTION, so CHIP_IT2's
+        // query is answered at 3 s; CHIP_IT gets its turn once CHIP_IT2 is in INSERT (5 s).
+        let turns = log.lock().unwrap().clone();
+        assert_eq!(turns, [("CHIP_IT2".to_string(), 3), ("CHIP_IT".to_string(), 5)]);
+    });
+}

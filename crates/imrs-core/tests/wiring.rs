@@ -1,0 +1,195 @@
+//! The load-time check: every problem at once, each naming its module and port.
+
+use imrs_core::prelude::*;
+use imrs_core::{CellError, ModuleDecl};
+use imrs_ports::AnyUser;
+
+fn cell() -> Cell {
+    Cell::virtual_clock().0
+}
+
+fn declare_appendix_ports(cell: &Cell) {
+    // LET_1_GO: owned by GATE, #USERS=1.
+    cell.declare(&Port::<(), i32, usage::Send>::declare(PortSpec::new(
+        "LET_1_GO", "GATE",
+    )))
+    .unwrap();
+    // ASK_CHILD1: owned by LOAD_IT, USERLIST=(LOAD_CARD).
+    cell.declare(&Port::<(), (i32, u32), usage::Query>::declare(
+        PortSpec::new("ASK_CHILD1", "LOAD_IT").user_list(["LOAD_CARD"]),
+    ))
+    .unwrap();
+    // CARD_IN_PLACE: owned by LOAD_CARD, USAGE=SEND.
+    cell.declare(&Port::<(), i32, usage::Send, AnyUser, 2>::declare(
+        PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"),
+    ))
+    .unwrap();
+    // FREQUENCY: owned by GATE, filtered by its task BOUNDED_BUFFER.
+    let frequency = BoundedBufferPort::<(i32, f64), AnyUser, 2>::declare(
+        PortSpec::new("FREQUENCY", "GATE"),
+        "BOUNDED_BUFFER",
+    );
+    cell.declare_filtered(&frequency).unwrap();
+}
+
+fn decl(spec: ModuleSpec<()>) -> ModuleDecl {
+    spec.declaration()
+}
+
+#[test]
+fn a_correct_cell_passes() {
+    let cell = cell();
+    declare_appendix_ports(&cell);
+    let modules = [
+        decl(
+            ModuleSpec::new("GATE", ())
+                .order(["LET_1_GO.TIMEOUT", "GATE"])
+                .owns("LET_1_GO")
+                .owns("FREQUENCY.FILTER")
+                .filters("FREQUENCY", UsageKind::Receive),
+        ),
+        decl(
+            ModuleSpec::new("LOAD_IT", ())
+                .order(["ASK_CHILD1.TIMEOUT", "LOAD_IT"])
+                .owns("ASK_CHILD1")
+                .uses("FREQUENCY", UsageKind::Send),
+        ),
+        decl(
+            ModuleSpec::new("LOAD_CARD", ())
+                .owns("CARD_IN_PLACE")
+                .uses("ASK_CHILD1", UsageKind::Response),
+        ),
+        decl(ModuleSpec::new("SCREW_IN_CARD", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
+        decl(ModuleSpec::new("RELEASER", ()).uses("LET_1_GO", UsageKind::Receive)),
+    ];
+    assert_eq!(cell.check(&modules), Ok(()));
+}
+
+#[test]
+fn every_problem_is_reported_at_once_naming_module_and_port() {
+    let cell = cell();
+    declare_appendix_ports(&cell);
+    let modules = [
+        // GATE forgets LET_1_GO; LOAD_CARD claims ASK_CHILD1 as well as LOAD_IT.
+        decl(
+            ModuleSpec::new("GATE", ())
+                .order(["LET_1_GO.TIMEOUT", "GATE", "PANIC_BUTTON"])
+                .owns("FREQUENCY.FILTER")
+                .filters("FREQUENCY", UsageKind::Send),
+        ),
+        decl(ModuleSpec::new("LOAD_IT", ()).owns("ASK_CHILD1")),
+        decl(
+            ModuleSpec::new("LOAD_CARD", ())
+                .owns("ASK_CHILD1")
+                .owns("CARD_IN_PLACE")
+                .owns("PALLET_IN_PLACE"),
+        ),
+        // Not on ASK_CHILD1's user list; and both ends of CARD_IN_PLACE say SEND.
+        decl(
+            ModuleSpec::new("SCREW_IN_CARD", ())
+                .uses("ASK_CHILD1", UsageKind::Response)
+                .uses("CARD_IN_PLACE", UsageKind::Send),
+        ),
+        // Three users for a port of two.
+        decl(ModuleSpec::new("A", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
+        decl(ModuleSpec::new("B", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
+    ];
+    let problems = cell.check(&modules).unwrap_err();
+    let expected = [
+        CellError::NoOwner {
+            port: "LET_1_GO".into(),
+            declared_owner: "GATE".into(),
+        },
+        CellError::TwoOwners {
+            port: "ASK_CHILD1".into(),
+            modules: vec!["LOAD_IT".into(), "LOAD_CARD".into()],
+        },
+        CellError::UnknownPort {
+            port: "PALLET_IN_PLACE".into(),
+            module: "LOAD_CARD".into(),
+        },
+        CellError::NotOnUserList {
+            port: "ASK_CHILD1".into(),
+            module: "SCREW_IN_CARD".into(),
+        },
+        CellError::UsageMismatch {
+            port: "CARD_IN_PLACE".into(),
+            module: "SCREW_IN_CARD".into(),
+            owner: UsageKind::Send,
+            user: UsageKind::Send,
+        },
+        CellError::TooManyUsers {
+            port: "CARD_IN_PLACE".into(),
+            capacity: 2,
+            modules: vec!["SCREW_IN_CARD".into(), "A".into(), "B".into()],
+        },
+        CellError::FilterUsageMismatch {
+            port: "FREQUENCY".into(),
+            module: "GATE".into(),
+            filter: UsageKind::Send,
+            declared: UsageKind::Receive,
+        },
+        // GATE no longer declares LET_1_GO, so its order's LET_1_GO.TIMEOUT names nothing.
+        CellError::UnknownOrderName {
+            module: "GATE".into(),
+            name: "LET_1_GO.TIMEOUT".into(),
+        },
+        CellError::UnknownOrderName {
+            module: "GATE".into(),
+            name: "PANIC_BUTTON".into(),
+        },
+    ];
+    for problem in &expected {
+        assert!(
+            problems.0.contains(problem),
+            "missing {problem:?} in {problems:#?}"
+        );
+    }
+    assert_eq!(problems.0.len(), expected.len(), "{problems:#?}");
+
+    let report = problems.to_string();
+    for line in [
+        "9 wiring problem(s):",
+        "port LET_1_GO has no owner: no module declares it (its declaration names GATE)",
+        "port ASK_CHILD1 has 2 owners: LOAD_IT LOAD_CARD",
+        "module LOAD_CARD names port PALLET_IN_PLACE, which is not declared",
+        "module SCREW_IN_CARD is not on the user list of port ASK_CHILD1",
+        "module SCREW_IN_CARD uses port CARD_IN_PLACE with USAGE=SEND, which does not complement USAGE=SEND",
+        "port CARD_IN_PLACE allows 2 user(s), but 3 use it: SCREW_IN_CARD A B",
+        "module GATE filters port FREQUENCY with USAGE=SEND, but the port is declared USAGE=RECEIVE",
+        "the order of module GATE names PANIC_BUTTON, which is not its background, a section, a handler or a port of it",
+    ] {
+        assert!(report.contains(line), "missing line {line:?} in:\n{report}");
+    }
+}
+
+#[test]
+fn a_module_owning_a_port_declared_for_another_is_refused() {
+    let cell = cell();
+    declare_appendix_ports(&cell);
+    let problems = cell
+        .check(&[decl(ModuleSpec::new("LOAD_IT", ()).owns("LET_1_GO"))])
+        .unwrap_err();
+    assert!(problems.0.contains(&CellError::WrongOwner {
+        port: "LET_1_GO".into(),
+        module: "LOAD_IT".into(),
+        declared_owner: "GATE".into()
+    }));
+}
+
+#[test]
+fn two_modules_of_one_name_are_refused() {
+    let cell = cell();
+    let problems = cell
+        .check(&[
+            decl(ModuleSpec::new("GATE", ())),
+            decl(ModuleSpec::new("GATE", ())),
+        ])
+        .unwrap_err();
+    assert_eq!(
+        problems.0,
+        [CellError::DuplicateModule {
+            module: "GATE".into()
+        }]
+    );
+}
