@@ -1,0 +1,217 @@
+//! A robot: moves, grasps, inserts, places and screws, each taking its time on the clock.
+
+use std::time::Duration;
+
+use crate::error::DeviceError;
+use crate::event::{SimEvent, SimEventKind};
+use crate::ids::{FeederId, RobotId, Station};
+use crate::layout::{GRASP_TIME, INSERT_TIME, PICK_CARD_TIME, PLACE_CARD_TIME, SCREW_TIME};
+use crate::sim::Sim;
+use crate::world::arm::Held;
+use crate::world::{Target, World};
+
+/// One robot of the cell.
+#[derive(Debug, Clone)]
+pub struct Robot {
+    sim: Sim,
+    id: RobotId,
+}
+
+impl Robot {
+    pub(crate) fn new(sim: Sim, id: RobotId) -> Self {
+        Self { sim, id }
+    }
+
+    /// Which robot this is.
+    pub fn id(&self) -> RobotId {
+        self.id
+    }
+
+    /// The time now, on the simulation's clock.
+    pub fn now(&self) -> imrs_core::imrs_ports::Instant {
+        self.sim.now()
+    }
+
+    /// Moves the tool in a straight line to `target`, taking the time its trapezoidal
+    /// profile takes.
+    pub async fn move_to(&self, target: Target) -> Result<(), DeviceError> {
+        let robot = self.id;
+        let duration = self.sim.with(|world, now| {
+            if !world.reaches(robot, target) {
+                let point = world.point_of(robot, target);
+                let millimetres = point.map(|metres| (metres * 1000.0).round() as i32);
+                return Err(DeviceError::OutOfReach {
+                    robot,
+                    target: millimetres,
+                });
+            }
+            let to = world.point_of(robot, target);
+            Ok(world.arm(robot).start_move(now, to))
+        })?;
+        self.sim.wake_stepper();
+        let outcome = self.busy(duration).await;
+        self.sim.with(|world, now| {
+            let (arm, physics) = world.arm_and_physics(robot);
+            arm.stop(now, physics);
+        });
+        outcome
+    }
+
+    /// Grasps a chip from `feeder`, where the tool must be. Fails on an empty feeder.
+    pub async fn grasp(&self, feeder: FeederId) -> Result<u32, DeviceError> {
+        self.require_at(Target::Feeder(feeder), "feeder")?;
+        self.busy(GRASP_TIME).await?;
+        let robot = self.id;
+        self.sim.with(|world, _| {
+            let feeder = world
+                .feeders
+                .iter_mut()
+                .find(|f| f.id == feeder)
+                .expect("a robot at a feeder names an existing feeder");
+            if feeder.stock == 0 {
+                return Err(DeviceError::EmptyFeeder {
+                    feeder: feeder.id,
+                    chip: feeder.chip,
+                });
+            }
+            feeder.stock -= 1;
+            let chip = feeder.chip;
+            world.arm(robot).holding = Some(Held::Chip(chip));
+            Ok(chip)
+        })
+    }
+
+    /// Inserts the chip it holds into the card on the pallet its station holds.
+    pub async fn insert(&self) -> Result<u32, DeviceError> {
+        let robot = self.id;
+        self.require_at(Target::Card, "card")?;
+        let Some(Held::Chip(chip)) = self.sim.with(|world, _| world.arm(robot).holding) else {
+            return Err(DeviceError::NothingHeld { robot });
+        };
+        self.busy(INSERT_TIME).await?;
+        self.on_pallet(Station::Chip, |world, pallet_line, now| {
+            let pallet = world.held_pallet(pallet_line, Station::Chip)?;
+            if !pallet.screwed {
+                return Err(DeviceError::NotReady {
+                    line: pallet_line,
+                    missing: "screwed card",
+                });
+            }
+            pallet.chips += 1;
+            let pallet = pallet.id;
+            world.arm(robot).holding = None;
+            Ok(SimEvent {
+                at: now,
+                kind: SimEventKind::ChipInserted {
+                    line: pallet_line,
+                    pallet,
+                    chip,
+                },
+            })
+        })?;
+        Ok(chip)
+    }
+
+    /// Picks a blank card from the magazine, where the tool must be.
+    pub async fn pick_card(&self) -> Result<(), DeviceError> {
+        self.require_at(Target::Magazine, "magazine")?;
+        self.busy(PICK_CARD_TIME).await?;
+        let robot = self.id;
+        self.sim
+            .with(|world, _| world.arm(robot).holding = Some(Held::Card));
+        Ok(())
+    }
+
+    /// Lays the card it holds on the pallet its station holds.
+    pub async fn place_card(&self) -> Result<(), DeviceError> {
+        let robot = self.id;
+        self.require_at(Target::Card, "card")?;
+        if self.sim.with(|world, _| world.arm(robot).holding) != Some(Held::Card) {
+            return Err(DeviceError::NothingHeld { robot });
+        }
+        self.busy(PLACE_CARD_TIME).await?;
+        self.on_pallet(Station::Load, |world, line, now| {
+            let pallet = world.held_pallet(line, Station::Load)?;
+            if pallet.card {
+                return Err(DeviceError::NotReady {
+                    line,
+                    missing: "free place for a card",
+                });
+            }
+            pallet.card = true;
+            let pallet = pallet.id;
+            world.arm(robot).holding = None;
+            Ok(SimEvent {
+                at: now,
+                kind: SimEventKind::CardPlaced { line, pallet },
+            })
+        })
+    }
+
+    /// Screws the card on the pallet its station holds to the pallet.
+    pub async fn screw(&self) -> Result<(), DeviceError> {
+        self.require_at(Target::Card, "card")?;
+        self.busy(SCREW_TIME).await?;
+        self.on_pallet(Station::Load, |world, line, now| {
+            let pallet = world.held_pallet(line, Station::Load)?;
+            if !pallet.card {
+                return Err(DeviceError::NotReady {
+                    line,
+                    missing: "card",
+                });
+            }
+            pallet.screwed = true;
+            let pallet = pallet.id;
+            Ok(SimEvent {
+                at: now,
+                kind: SimEventKind::CardScrewed { line, pallet },
+            })
+        })
+    }
+
+    fn require_at(&self, target: Target, what: &'static str) -> Result<(), DeviceError> {
+        let robot = self.id;
+        let there = self.sim.with(|world, now| world.is_at(robot, target, now));
+        if there {
+            Ok(())
+        } else {
+            Err(DeviceError::NotThere { robot, at: what })
+        }
+    }
+
+    /// Applies a step's effect to the pallet at the robot's station, recording the fact.
+    fn on_pallet(
+        &self,
+        station: Station,
+        effect: impl FnOnce(
+            &mut World,
+            crate::ids::Line,
+            imrs_core::imrs_ports::Instant,
+        ) -> Result<SimEvent, DeviceError>,
+    ) -> Result<(), DeviceError> {
+        debug_assert_eq!(World::station_of(self.id), station);
+        let line = self.id.line;
+        let fact = self.sim.with(|world, now| effect(world, line, now))?;
+        self.sim.record(fact);
+        Ok(())
+    }
+
+    /// Spends `duration` working, unless an injected fault strikes first.
+    async fn busy(&self, duration: Duration) -> Result<(), DeviceError> {
+        let robot = self.id;
+        let (start, fault) = self
+            .sim
+            .with(|world, now| (now, world.take_robot_fault(robot, now + duration)));
+        let clock = self.sim.clock();
+        match fault {
+            None => {
+                clock.sleep(duration).await;
+                Ok(())
+            }
+            Some(at) => {
+                clock.sleep_until(at.max(start)).await;
+                Err(DeviceError::RobotFault { robot })
+            }
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! The simulation: the world, the stepper that moves it on the framework clock, and the
+//! handles through which modules drive its devices.
+
+use std::fmt;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+
+use imrs_core::imrs_ports::{Instant, SharedClock};
+use tokio::sync::{Notify, watch};
+
+use crate::device::{Gate, Relay, Robot};
+use crate::event::{SimEvent, SimLog};
+use crate::fault::Fault;
+use crate::ids::{FeederId, Line, PalletId, RobotId, Station};
+use crate::layout::STEP;
+use crate::world::{World, next_step_after};
+
+/// How the cell is set up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SimConfig {
+    /// Seeds every random choice (feeder stocks).
+    pub seed: u64,
+    /// The feeders' stocks, or `None` to draw them from the seed (150 to 250 chips each).
+    pub stocks: Option<[u32; 4]>,
+}
+
+impl SimConfig {
+    /// The cell for `seed`.
+    pub fn seeded(seed: u64) -> Self {
+        Self { seed, stocks: None }
+    }
+}
+
+/// The simulated cell. Cheap to clone: every clone drives the same world.
+#[derive(Clone)]
+pub struct Sim {
+    shared: Arc<Shared>,
+}
+
+struct Shared {
+    world: Mutex<World>,
+    clock: SharedClock,
+    activity: Notify,
+    steps: watch::Sender<u64>,
+    log: SimLog,
+}
+
+impl Sim {
+    /// A cell set up by `config`, on `clock`. Nothing moves until [`Sim::run`] runs.
+    pub fn new(config: SimConfig, clock: SharedClock) -> Self {
+        Self {
+            shared: Arc::new(Shared {
+                world: Mutex::new(World::new(config.seed, config.stocks)),
+                clock,
+                activity: Notify::new(),
+                steps: watch::channel(0).0,
+                log: SimLog::default(),
+            }),
+        }
+    }
+
+    /// The stepper: steps the world every [`STEP`](crate::layout::STEP) of the clock while
+    /// anything moves, and sleeps while nothing does. Spawn it once.
+    pub async fn run(self) {
+        let clock = Arc::clone(&self.shared.clock);
+        let mut last = None;
+        loop {
+            if !self.world().is_active() {
+                self.shared.activity.notified().await;
+            }
+            let now = clock.now().max(last.unwrap_or(Instant::ZERO));
+            let next = next_step_after(now, STEP);
+            clock.sleep_until(next).await;
+            let events = self.world().step(next);
+            last = Some(next);
+            events
+                .into_iter()
+                .for_each(|event| self.shared.log.record(event));
+            self.shared.steps.send_modify(|steps| *steps += 1);
+        }
+    }
+
+    /// Spawns [`Sim::run`] on the current tokio runtime.
+    pub fn spawn(&self) -> tokio::task::JoinHandle<()> {
+        tokio::spawn(self.clone().run())
+    }
+
+    /// The robot `id`.
+    pub fn robot(&self, id: RobotId) -> Robot {
+        Robot::new(self.clone(), id)
+    }
+
+    /// The gate of `line`.
+    pub fn gate(&self, line: Line) -> Gate {
+        Gate::new(self.clone(), line)
+    }
+
+    /// The freeze relay of `station` on `line`.
+    pub fn relay(&self, line: Line, station: Station) -> Relay {
+        Relay::new(self.clone(), line, station)
+    }
+
+    /// Injects `fault`, to strike at its time.
+    pub fn inject(&self, fault: Fault) {
+        self.world().inject(fault);
+        self.shared.activity.notify_one();
+    }
+
+    /// The measured facts of the run.
+    pub fn log(&self) -> &SimLog {
+        &self.shared.log
+    }
+
+    /// The time now, on the simulation's clock.
+    pub fn now(&self) -> Instant {
+        self.shared.clock.now()
+    }
+
+    /// The simulation's clock.
+    pub fn clock(&self) -> &SharedClock {
+        &self.shared.clock
+    }
+
+    /// Every pallet on the conveyors, with its position as rapier has it.
+    pub fn pallets(&self) -> Vec<(Line, PalletId, [f32; 3])> {
+        self.world().pallet_positions()
+    }
+
+    /// Each feeder's chip number and the chips it has left.
+    pub fn feeders(&self) -> Vec<(FeederId, u32, u32)> {
+        self.world()
+            .feeders
+            .iter()
+            .map(|feeder| (feeder.id, feeder.chip, feeder.stock))
+            .collect()
+    }
+
+    /// Runs `change` on the world at the current time, then records the events it made.
+    pub(crate) fn with<R>(&self, change: impl FnOnce(&mut World, Instant) -> R) -> R {
+        let now = self.now();
+        let (result, events) = {
+            let mut world = self.world();
+            let result = change(&mut world, now);
+            (result, world.take_pending())
+        };
+        events
+            .into_iter()
+            .for_each(|event| self.shared.log.record(event));
+        result
+    }
+
+    pub(crate) fn record(&self, event: SimEvent) {
+        self.shared.log.record(event);
+    }
+
+    /// Tells the stepper that something started moving.
+    pub(crate) fn wake_stepper(&self) {
+        self.shared.activity.notify_one();
+    }
+
+    /// A receiver that changes after every step.
+    pub(crate) fn steps(&self) -> watch::Receiver<u64> {
+        self.shared.steps.subscribe()
+    }
+
+    fn world(&self) -> MutexGuard<'_, World> {
+        // Every change to the world is a short synchronous block that leaves it consistent.
+        self.shared
+            .world
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+impl fmt::Debug for Sim {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Sim")
+            .field("now", &self.now())
+            .finish_non_exhaustive()
+    }
+}

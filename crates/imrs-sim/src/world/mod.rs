@@ -1,0 +1,397 @@
+//! The simulated cell's state: arms, conveyors, pallets, feeders and the rapier world that
+//! measures them.
+
+pub(crate) mod arm;
+mod conveyor;
+mod physics;
+
+use std::collections::BTreeSet;
+use std::time::Duration;
+
+use imrs_core::imrs_ports::Instant;
+
+use self::arm::{Arm, distance};
+use self::conveyor::{Conveyor, PalletState};
+use self::physics::Physics;
+use crate::error::DeviceError;
+use crate::event::{SimEvent, SimEventKind};
+use crate::fault::{Fault, FaultKind};
+use crate::ids::{FeederId, Line, PalletId, RobotId, Role, Station};
+use crate::layout::{CHIP_X, FEEDER_X, LOAD_X, REACH_TOLERANCE, ZONE_CENTRE, line_y};
+use crate::rng::Rng;
+use crate::scara::Elbow;
+
+pub(crate) use self::conveyor::Pallet;
+
+/// Where a robot's tool should go.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Target {
+    /// Its resting position, clear of the conveyor and the zone.
+    Home,
+    /// Above a feeder of the shared zone.
+    Feeder(FeederId),
+    /// Above the card on the pallet its station holds.
+    Card,
+    /// Above the magazine of blank cards (for the card-loading robot).
+    Magazine,
+    /// Any point of the working plane, in metres.
+    Point([f32; 2]),
+}
+
+pub(crate) struct Feeder {
+    pub(crate) id: FeederId,
+    pub(crate) chip: u32,
+    pub(crate) stock: u32,
+    at: [f32; 2],
+}
+
+/// The chip numbers of the feeders, as in the Appendix's work schedule (GRASP(1), GRASP(4),
+/// ..., GRASP(12)).
+pub const FEEDER_CHIPS: [u32; 4] = [1, 4, 7, 12];
+
+pub(crate) struct World {
+    physics: Physics,
+    arms: Vec<Arm>,
+    lines: [Conveyor; 2],
+    pub(crate) feeders: Vec<Feeder>,
+    /// Pending faults, soonest first.
+    faults: Vec<Fault>,
+    in_zone: Vec<bool>,
+    touching: BTreeSet<(usize, usize)>,
+    last_step: Option<Instant>,
+    next_pallet: u32,
+    pending: Vec<SimEvent>,
+}
+
+/// Where each robot stands: its base, its resting tool position, its elbow side, and (for the
+/// card-loading robot) the magazine of blank cards.
+fn layout(robot: RobotId) -> ([f32; 2], [f32; 2], Elbow) {
+    let y = line_y(robot.line.index());
+    // Load and screw robots stand outside their line; chip robots between the lines.
+    let outside = match robot.line {
+        Line::A => -1.0,
+        Line::B => 1.0,
+    };
+    match robot.role {
+        // The two robots of a load station bend their elbows away from each other.
+        Role::LoadCard => (
+            [LOAD_X - 0.35, y + outside * 0.45],
+            [LOAD_X - 0.35, y + outside * 0.1],
+            if outside < 0.0 {
+                Elbow::Left
+            } else {
+                Elbow::Right
+            },
+        ),
+        Role::ScrewInCard => (
+            [LOAD_X + 0.35, y + outside * 0.45],
+            [LOAD_X + 0.35, y + outside * 0.1],
+            if outside < 0.0 {
+                Elbow::Right
+            } else {
+                Elbow::Left
+            },
+        ),
+        // Each chip robot bends its elbow away from the other line.
+        Role::ChipIt => (
+            [CHIP_X - 0.35, y - outside * 0.25],
+            [CHIP_X - 0.1, y - outside * 0.1],
+            if outside < 0.0 {
+                Elbow::Right
+            } else {
+                Elbow::Left
+            },
+        ),
+    }
+}
+
+fn magazine(line: Line) -> [f32; 2] {
+    let outside = if line == Line::A { -1.0 } else { 1.0 };
+    [LOAD_X - 0.65, line_y(line.index()) + outside * 0.15]
+}
+
+impl World {
+    pub(crate) fn new(seed: u64, stocks: Option<[u32; 4]>) -> Self {
+        let mut physics = Physics::new();
+        let arms = RobotId::ALL
+            .iter()
+            .map(|&id| {
+                let (base, home, side) = layout(id);
+                Arm::new(id, base, home, side, &mut physics)
+            })
+            .collect();
+        let mut rng = Rng::new(seed);
+        let feeders = FEEDER_CHIPS
+            .iter()
+            .enumerate()
+            .map(|(index, &chip)| Feeder {
+                id: FeederId(index as u8),
+                chip,
+                stock: stocks.map_or_else(|| rng.range(150, 250), |stocks| stocks[index]),
+                at: [FEEDER_X[index], ZONE_CENTRE[1]],
+            })
+            .collect();
+        let mut world = Self {
+            physics,
+            arms,
+            lines: [Conveyor::new(Line::A), Conveyor::new(Line::B)],
+            feeders,
+            faults: Vec::new(),
+            in_zone: vec![false; RobotId::ALL.len()],
+            touching: BTreeSet::new(),
+            last_step: None,
+            next_pallet: 0,
+            pending: Vec::new(),
+        };
+        world.physics.detect();
+        world
+    }
+
+    /// Whether anything moves, so that the world needs stepping.
+    pub(crate) fn is_active(&self) -> bool {
+        self.arms.iter().any(Arm::is_moving) || self.lines.iter().any(Conveyor::is_moving)
+    }
+
+    /// Advances the world to `now`: pallets, arms, collision detection, and what it measured.
+    pub(crate) fn step(&mut self, now: Instant) -> Vec<SimEvent> {
+        self.apply_due_faults(now);
+        let seconds = self.last_step.map_or(0.0, |last| {
+            now.saturating_duration_since(last).as_secs_f32()
+        });
+        self.last_step = Some(now);
+        let mut events = std::mem::take(&mut self.pending);
+        for line in &mut self.lines {
+            line.advance(seconds, now, &mut self.physics, &mut events);
+        }
+        for arm in &mut self.arms {
+            arm.update(now, &mut self.physics);
+        }
+        self.physics.detect();
+        self.measure(now, &mut events);
+        events
+    }
+
+    /// Zone occupancy and contacts between robots, from rapier.
+    fn measure(&mut self, now: Instant, events: &mut Vec<SimEvent>) {
+        for (index, arm) in self.arms.iter().enumerate() {
+            let inside = arm.colliders.iter().any(|&c| self.physics.in_zone(c));
+            if inside != self.in_zone[index] {
+                self.in_zone[index] = inside;
+                let robot = arm.id;
+                let kind = if inside {
+                    SimEventKind::ZoneEntered { robot }
+                } else {
+                    SimEventKind::ZoneLeft { robot }
+                };
+                events.push(SimEvent { at: now, kind });
+            }
+        }
+        for a in 0..self.arms.len() {
+            for b in a + 1..self.arms.len() {
+                let contact = self.arms[a].colliders.iter().find_map(|&ca| {
+                    self.arms[b]
+                        .colliders
+                        .iter()
+                        .find_map(|&cb| self.physics.touching(ca, cb))
+                });
+                let was = self.touching.contains(&(a, b));
+                match contact {
+                    Some(point) if !was => {
+                        self.touching.insert((a, b));
+                        events.push(SimEvent {
+                            at: now,
+                            kind: SimEventKind::Collision {
+                                a: self.arms[a].id,
+                                b: self.arms[b].id,
+                                point,
+                            },
+                        });
+                    }
+                    None if was => {
+                        self.touching.remove(&(a, b));
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+
+    pub(crate) fn inject(&mut self, fault: Fault) {
+        let position = self
+            .faults
+            .partition_point(|pending| pending.at <= fault.at);
+        self.faults.insert(position, fault);
+    }
+
+    /// Applies the faults that act on their own when their time comes: empty feeders, jams.
+    fn apply_due_faults(&mut self, now: Instant) {
+        let mut index = 0;
+        while index < self.faults.len() && self.faults[index].at <= now {
+            let fault = self.faults[index];
+            let applied = match fault.kind {
+                FaultKind::FeederEmpty(feeder) => {
+                    if let Some(feeder) = self.feeders.iter_mut().find(|f| f.id == feeder) {
+                        feeder.stock = 0;
+                    }
+                    true
+                }
+                FaultKind::Jam(line, station) => {
+                    self.jam(line, station, now);
+                    true
+                }
+                // A robot fault waits for the operation it breaks.
+                FaultKind::Robot(_) => false,
+            };
+            if applied {
+                self.faults.remove(index);
+                self.pending.push(SimEvent {
+                    at: now,
+                    kind: SimEventKind::FaultStruck { fault: fault.kind },
+                });
+            } else {
+                index += 1;
+            }
+        }
+    }
+
+    fn jam(&mut self, line: Line, station: Station, now: Instant) {
+        let conveyor = &mut self.lines[line.index()];
+        match conveyor.at_station(station) {
+            Some(pallet) if pallet.state == PalletState::Held(station) => {
+                pallet.state = PalletState::Jammed(station);
+                let pallet = pallet.id;
+                self.pending.push(SimEvent {
+                    at: now,
+                    kind: SimEventKind::PalletJammed {
+                        line,
+                        station,
+                        pallet,
+                    },
+                });
+            }
+            _ => conveyor.jam_next[station.index()] = true,
+        }
+    }
+
+    /// Takes the robot fault that strikes `robot` by `until`, if any: when it strikes.
+    pub(crate) fn take_robot_fault(&mut self, robot: RobotId, until: Instant) -> Option<Instant> {
+        let index = self
+            .faults
+            .iter()
+            .position(|fault| fault.at <= until && fault.kind == FaultKind::Robot(robot))?;
+        let fault = self.faults.remove(index);
+        self.pending.push(SimEvent {
+            at: fault.at,
+            kind: SimEventKind::FaultStruck { fault: fault.kind },
+        });
+        Some(fault.at)
+    }
+
+    pub(crate) fn take_pending(&mut self) -> Vec<SimEvent> {
+        std::mem::take(&mut self.pending)
+    }
+
+    pub(crate) fn arm(&mut self, robot: RobotId) -> &mut Arm {
+        &mut self.arms[robot.index()]
+    }
+
+    pub(crate) fn arm_and_physics(&mut self, robot: RobotId) -> (&mut Arm, &mut Physics) {
+        (&mut self.arms[robot.index()], &mut self.physics)
+    }
+
+    /// The point a robot's target names.
+    pub(crate) fn point_of(&self, robot: RobotId, target: Target) -> [f32; 2] {
+        let y = line_y(robot.line.index());
+        match target {
+            Target::Home => self.arms[robot.index()].home,
+            Target::Feeder(feeder) => self
+                .feeders
+                .iter()
+                .find(|f| f.id == feeder)
+                .map_or(self.arms[robot.index()].home, |f| f.at),
+            Target::Card => match robot.role {
+                Role::LoadCard | Role::ScrewInCard => [LOAD_X, y],
+                Role::ChipIt => [CHIP_X, y],
+            },
+            Target::Magazine => magazine(robot.line),
+            Target::Point(point) => point,
+        }
+    }
+
+    /// Whether `robot`'s tool is (now) at `target`.
+    pub(crate) fn is_at(&self, robot: RobotId, target: Target, now: Instant) -> bool {
+        let arm = &self.arms[robot.index()];
+        distance(arm.tool_at(now), self.point_of(robot, target)) <= REACH_TOLERANCE
+    }
+
+    pub(crate) fn station_of(robot: RobotId) -> Station {
+        match robot.role {
+            Role::LoadCard | Role::ScrewInCard => Station::Load,
+            Role::ChipIt => Station::Chip,
+        }
+    }
+
+    /// The pallet held at `station` of `line`, ready to work on.
+    pub(crate) fn held_pallet(
+        &mut self,
+        line: Line,
+        station: Station,
+    ) -> Result<&mut Pallet, DeviceError> {
+        match self.lines[line.index()].at_station(station) {
+            Some(pallet) if pallet.state == PalletState::Held(station) => Ok(pallet),
+            Some(_) => Err(DeviceError::Jam { line, station }),
+            None => Err(DeviceError::NoPallet { line, station }),
+        }
+    }
+
+    /// What the pallet at a station is: held, jammed, or none.
+    pub(crate) fn station_state(
+        &mut self,
+        line: Line,
+        station: Station,
+    ) -> Option<(PalletId, bool)> {
+        let pallet = self.lines[line.index()].at_station(station)?;
+        Some((pallet.id, matches!(pallet.state, PalletState::Jammed(_))))
+    }
+
+    pub(crate) fn conveyor(&mut self, line: Line) -> &mut Conveyor {
+        &mut self.lines[line.index()]
+    }
+
+    pub(crate) fn release_pallet(&mut self, line: Line) -> PalletId {
+        let id = PalletId(self.next_pallet);
+        self.next_pallet += 1;
+        self.lines[line.index()].release(id, &mut self.physics);
+        id
+    }
+
+    pub(crate) fn scrap(&mut self, line: Line, station: Station) -> Option<PalletId> {
+        self.lines[line.index()].scrap(station, &mut self.physics)
+    }
+
+    pub(crate) fn pallet_positions(&self) -> Vec<(Line, PalletId, [f32; 3])> {
+        Line::ALL
+            .iter()
+            .flat_map(|&line| {
+                self.lines[line.index()]
+                    .positions(&self.physics)
+                    .into_iter()
+                    .map(move |(id, at)| (line, id, at))
+            })
+            .collect()
+    }
+
+    /// How long a move of `robot` to `target` would take from where it is now.
+    pub(crate) fn reaches(&self, robot: RobotId, target: Target) -> bool {
+        let point = self.point_of(robot, target);
+        self.arms[robot.index()].reaches(point)
+    }
+}
+
+/// The step grid: the first multiple of `step` after `now`.
+pub(crate) fn next_step_after(now: Instant, step: Duration) -> Instant {
+    let step = step.as_nanos();
+    let now = now.since_start().as_nanos();
+    let next = (now / step + 1) * step;
+    Instant::from_start(Duration::from_nanos(next as u64))
+}

@@ -1,0 +1,138 @@
+//! The rapier world: kinematic arm links and pallets, and the fixed feeder-zone sensor.
+//!
+//! Nothing here is dynamic: every body is placed by the simulation, and rapier's collision
+//! pipeline (broad and narrow phase, no integration) says what overlaps what.
+
+use rapier3d::prelude::*;
+
+use crate::layout::{ARM_Z, LINK_RADIUS, PALLET_HALF, ZONE_CENTRE, ZONE_HALF};
+
+/// Arm links collide with each other and are seen by the zone sensor; pallets with nothing.
+const ARMS: Group = Group::GROUP_1;
+const ZONE: Group = Group::GROUP_2;
+
+pub(crate) struct Physics {
+    world: PhysicsWorld,
+    zone: ColliderHandle,
+}
+
+impl Physics {
+    pub(crate) fn new() -> Self {
+        let mut world = PhysicsWorld::new();
+        let zone = world.colliders.insert(
+            ColliderBuilder::cuboid(ZONE_HALF[0], ZONE_HALF[1], ZONE_HALF[2])
+                .translation(Vector::new(ZONE_CENTRE[0], ZONE_CENTRE[1], ZONE_HALF[2]))
+                .sensor(true)
+                .collision_groups(InteractionGroups::new(ZONE, ARMS, InteractionTestMode::And))
+                .active_events(ActiveEvents::COLLISION_EVENTS)
+                .active_collision_types(
+                    ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
+                ),
+        );
+        Self { world, zone }
+    }
+
+    /// A kinematic capsule of length `length` lying along its body's x axis.
+    pub(crate) fn add_link(&mut self, length: f32) -> (RigidBodyHandle, ColliderHandle) {
+        let body = self
+            .world
+            .bodies
+            .insert(RigidBodyBuilder::kinematic_position_based().can_sleep(true));
+        let collider = ColliderBuilder::capsule_x(length / 2.0, LINK_RADIUS)
+            .collision_groups(InteractionGroups::new(
+                ARMS,
+                ARMS | ZONE,
+                InteractionTestMode::And,
+            ))
+            .active_collision_types(
+                ActiveCollisionTypes::default()
+                    | ActiveCollisionTypes::KINEMATIC_KINEMATIC
+                    | ActiveCollisionTypes::KINEMATIC_FIXED,
+            );
+        let collider =
+            self.world
+                .colliders
+                .insert_with_parent(collider, body, &mut self.world.bodies);
+        (body, collider)
+    }
+
+    /// A kinematic pallet, which takes part in no collision.
+    pub(crate) fn add_pallet(&mut self, at: [f32; 3]) -> RigidBodyHandle {
+        let body = self.world.bodies.insert(
+            RigidBodyBuilder::kinematic_position_based()
+                .translation(Vector::new(at[0], at[1], at[2])),
+        );
+        let collider = ColliderBuilder::cuboid(PALLET_HALF[0], PALLET_HALF[1], PALLET_HALF[2])
+            .collision_groups(InteractionGroups::none());
+        self.world
+            .colliders
+            .insert_with_parent(collider, body, &mut self.world.bodies);
+        body
+    }
+
+    pub(crate) fn remove_body(&mut self, body: RigidBodyHandle) {
+        let world = &mut self.world;
+        world.bodies.remove(
+            body,
+            &mut world.islands,
+            &mut world.colliders,
+            &mut world.impulse_joints,
+            &mut world.multibody_joints,
+            &mut world.soft_bodies,
+            true,
+        );
+    }
+
+    /// Places a link between two points of the arms' plane.
+    pub(crate) fn place_link(&mut self, body: RigidBodyHandle, from: [f32; 2], to: [f32; 2]) {
+        let middle = Vector::new((from[0] + to[0]) / 2.0, (from[1] + to[1]) / 2.0, ARM_Z);
+        let angle = (to[1] - from[1]).atan2(to[0] - from[0]);
+        let pose = Pose::from_parts(middle, Rotation::from_rotation_z(angle));
+        self.world.bodies[body].set_position(pose, true);
+    }
+
+    pub(crate) fn place_pallet(&mut self, body: RigidBodyHandle, at: [f32; 3]) {
+        self.world.bodies[body].set_translation(Vector::new(at[0], at[1], at[2]), true);
+    }
+
+    pub(crate) fn position_of(&self, body: RigidBodyHandle) -> [f32; 3] {
+        let at = self.world.bodies[body].translation();
+        [at.x, at.y, at.z]
+    }
+
+    /// Runs collision detection for the bodies as they are placed now.
+    pub(crate) fn detect(&mut self) {
+        let world = &mut self.world;
+        world.collision_pipeline.step(
+            0.0,
+            &mut world.islands,
+            &mut world.broad_phase,
+            &mut world.narrow_phase,
+            &mut world.bodies,
+            &mut world.colliders,
+            &(),
+            &(),
+        );
+    }
+
+    /// Whether `collider` overlaps the feeder zone.
+    pub(crate) fn in_zone(&self, collider: ColliderHandle) -> bool {
+        self.world
+            .narrow_phase
+            .intersection_pair(self.zone, collider)
+            == Some(true)
+    }
+
+    /// Where two colliders touch or overlap, if they do.
+    pub(crate) fn touching(&self, a: ColliderHandle, b: ColliderHandle) -> Option<[f32; 3]> {
+        let pair = self.world.narrow_phase.contact_pair(a, b)?;
+        let (_, contact) = pair.find_deepest_contact()?;
+        if contact.dist > 0.0 {
+            return None;
+        }
+        let point = self.world.colliders[pair.collider1]
+            .position()
+            .transform_point(contact.local_p1);
+        Some([point.x, point.y, point.z])
+    }
+}
