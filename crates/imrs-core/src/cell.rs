@@ -26,6 +26,11 @@ pub(crate) struct CellShared {
 }
 
 impl CellShared {
+    pub(crate) fn kill(&self, module: &str) -> bool {
+        let switch = lock(&self.modules).get(&Name::from(module)).cloned();
+        switch.inspect(|switch| switch.kill()).is_some()
+    }
+
     pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
         lock(&self.waits)
     }
@@ -177,8 +182,7 @@ impl Cell {
     /// Kills the running copy of `module`; a supervised module gets a new copy. Returns
     /// whether a module of that name runs.
     pub fn kill(&self, module: &str) -> bool {
-        let switch = lock(&self.shared.modules).get(&Name::from(module)).cloned();
-        switch.inspect(|switch| switch.kill()).is_some()
+        self.shared.kill(module)
     }
 
     /// Stops `module` for good. Returns whether a module of that name runs.

@@ -333,6 +333,12 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         lock(&self.module.restarts).push(task.into());
     }
 
+    /// Kills the running copy of module `module` (a supervised one gets a new copy). Returns
+    /// whether such a module runs.
+    pub fn kill(&self, module: &str) -> bool {
+        self.module.cell.kill(module)
+    }
+
     /// `COSTART`: starts `child` as a child module of this one.
     pub fn costart<C: Send + Sync + 'static>(&self, child: ModuleSpec<C>) -> ModuleHandle {
         let cell = Arc::clone(&self.module.cell);

@@ -411,21 +411,24 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         }
     }
 
+    /// How the module ends, once no thread can go on: every task finished, or some gave up
+    /// (while another task lives, a handler may still start a new copy of a failed one).
     fn exit(&self) -> Option<ModuleExit> {
         if !self.handlers.is_empty() || !self.shared.raised().is_empty() {
             return None;
         }
-        if let Some(reason) = self.tasks.iter().find_map(|task| match &task.stage {
-            Stage::GaveUp(reason) => Some(format!("task {} failed: {reason}", task.name)),
-            _ => None,
-        }) {
-            return Some(ModuleExit::Failed(reason));
-        }
-        let all_finished = self
+        let live = self
             .tasks
             .iter()
-            .all(|task| matches!(task.stage, Stage::Finished));
-        (!self.tasks.is_empty() && all_finished).then_some(ModuleExit::Finished)
+            .any(|task| matches!(task.stage, Stage::Running(_) | Stage::Restarting(_)));
+        if live || self.tasks.is_empty() {
+            return None;
+        }
+        let failure = self.tasks.iter().find_map(|task| match &task.stage {
+            Stage::GaveUp(reason) => Some(format!("task {} failed: {reason}", task.name)),
+            _ => None,
+        });
+        Some(failure.map_or(ModuleExit::Finished, ModuleExit::Failed))
     }
 }
 
