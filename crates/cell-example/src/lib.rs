@@ -1,6 +1,29 @@
-//! The chip-insertion line of Shin (1985), Appendix, as IMRS modules.
+//! The three-workcell chip-insertion line of Shin (1985), Appendix, running on IMRS modules
+//! and the simulated cell: `cargo run --release --example chip_cell`.
 //!
-//! The modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD, CHIP_IT, CHIP_IT2) arrive with the
-//! order scheduler and the simulated cell they run on.
+//! Put the Appendix beside this crate: GATE with its tasks BOUNDED_BUFFER and RELEASE and its
+//! ports FREQUENCY and LET_1_GO is [`gate`]; LOAD_IT, LOAD_CARD and SCREW_IN_CARD are in
+//! [`load`]; CHIP_IT (and its twin CHIP_IT2 on the second line) with its order, its work
+//! schedule and the SHARE_FEEDER ports are in [`chip`]; the port declarations, with the
+//! Appendix's restrictions, in [`ports`]. Where the Appendix writes `{signal for help}`, the
+//! modules raise an alarm and retry or restart, as the paper suggests.
+//!
+//! Two policies share the feeders: the Appendix's query/order scheme, which deadlocks as the
+//! paper's note 6 predicts and breaks the deadlock with asymmetric timeout handlers, and an
+//! arbiter (the monitor task the paper's conclusion points to). The [`report`] sets them side
+//! by side, with what rapier measured.
 
-pub use imrs_sim;
+pub mod chip;
+pub mod faults;
+pub mod gate;
+pub mod help;
+pub mod load;
+pub mod names;
+pub mod ports;
+pub mod report;
+pub mod run;
+
+pub use chip::FeederPolicy;
+pub use faults::{CellFault, CellFaultKind};
+pub use report::{Report, speed_line};
+pub use run::{CellConfig, RunRecord, run};

@@ -4,7 +4,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
-use imrs_ports::{Name, UsageKind, Wiring};
+use imrs_ports::{Name, UsageKind, WireError, Wiring};
 
 use crate::exception::Exception;
 use crate::module::spec::ModuleDecl;
@@ -12,6 +12,8 @@ use crate::module::spec::ModuleDecl;
 /// One wiring problem of a cell.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CellError {
+    /// A port could not be declared or attached.
+    Wire(WireError),
     /// Two modules share a name.
     DuplicateModule {
         /// The name.
@@ -97,6 +99,7 @@ pub enum CellError {
 impl fmt::Display for CellError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            Self::Wire(error) => write!(f, "{error}"),
             Self::DuplicateModule { module } => write!(f, "two modules are named {module}"),
             Self::NoOwner {
                 port,
@@ -178,6 +181,12 @@ impl fmt::Display for CellErrors {
 }
 
 impl std::error::Error for CellErrors {}
+
+impl From<WireError> for CellErrors {
+    fn from(error: WireError) -> Self {
+        Self(vec![CellError::Wire(error)])
+    }
+}
 
 pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
     let mut problems = Vec::new();

@@ -8,7 +8,7 @@ use imrs_ports::{Clock, Instant, VirtualClock};
 /// to the next timer. Returns the time reached.
 ///
 /// Idleness is read from tokio's own paused clock, so run this on a current-thread runtime
-/// built with `start_paused(true)`: then tokio lets this driver go on only once nothing else
+/// built with `start_paused(true)` (tokio's `test-util` feature): then tokio lets this driver go on only once nothing else
 /// can run, and a cell runs as fast as it computes and the same way every time. (On other
 /// runtimes it still advances the clock, but without that guarantee.)
 pub async fn drive(clock: &VirtualClock, until: Instant) -> Instant {

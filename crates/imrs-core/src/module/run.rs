@@ -121,6 +121,8 @@ struct TaskRun<S> {
 struct HandlerRun {
     name: Name,
     rank: Rank,
+    /// The section the handler is in: its rank, or a section it entered.
+    section: Arc<SectionCell>,
     future: BoxFuture<()>,
 }
 
@@ -212,7 +214,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             Stage::Running(_) => Some(task.section.get()),
             _ => None,
         });
-        let handlers = self.handlers.iter().map(|handler| handler.rank);
+        let handlers = self.handlers.iter().map(|handler| handler.section.get());
         tasks.chain(handlers).max()
     }
 
@@ -278,11 +280,8 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         };
         let handler = Arc::clone(handler);
         let name = exception.name.clone();
-        let ctx = Ctx::new(
-            Arc::clone(&self.shared),
-            name.clone(),
-            Arc::new(SectionCell::new(rank)),
-        );
+        let section = Arc::new(SectionCell::new(rank));
+        let ctx = Ctx::new(Arc::clone(&self.shared), name.clone(), Arc::clone(&section));
         self.shared.event(
             Some(&name),
             EventKind::ExceptionHandled {
@@ -293,8 +292,15 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         let position = self
             .handlers
             .partition_point(|running| running.rank <= rank);
-        self.handlers
-            .insert(position, HandlerRun { name, rank, future });
+        self.handlers.insert(
+            position,
+            HandlerRun {
+                name,
+                rank,
+                section,
+                future,
+            },
+        );
     }
 
     fn restart_requested(&mut self) {

@@ -1,0 +1,384 @@
+//! The chip workcell: CHIP_IT on line A and its twin CHIP_IT2 on line B, sharing the feeders
+//! (Appendix, MODULE CHIP_IT), and FEEDER_MONITOR, the arbiter the paper's conclusion points to.
+
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Duration;
+
+use imrs_sim::imrs_core::imrs_ports::{End, usage};
+use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::{DeviceError, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target};
+
+use crate::help::{insisted, retried};
+use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+use crate::ports::{CellPorts, ZonePort};
+
+/// How the two chip robots share the feeder zone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeederPolicy {
+    /// The Appendix's scheme: query the twin's CRIT_SECTION, as CHIP_IT's order allows, with
+    /// asymmetric timeout handlers to break the deadlock it admits (note 6).
+    Appendix,
+    /// A monitor task that hands the zone to one robot at a time.
+    Arbiter,
+}
+
+/// One step of CHIP_IT's work schedule: `GRASP(n), INSERT(X, Y, Z)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChipStep {
+    /// The feeder to grasp from.
+    pub feeder: FeederId,
+    /// Where on the card, in millimetres from its corner.
+    pub at: (u32, u32),
+}
+
+/// CHIP_IT's work schedule: four chips, all of priority 1, so any order will do.
+pub fn work_schedule() -> WorkSchedule<ChipStep> {
+    WorkSchedule::new()
+        .step(
+            1,
+            ChipStep {
+                feeder: FeederId(0),
+                at: (20, 30),
+            },
+        )
+        .step(
+            1,
+            ChipStep {
+                feeder: FeederId(1),
+                at: (60, 30),
+            },
+        )
+        .step(
+            1,
+            ChipStep {
+                feeder: FeederId(2),
+                at: (20, 70),
+            },
+        )
+        .step(
+            1,
+            ChipStep {
+                feeder: FeederId(3),
+                at: (60, 70),
+            },
+        )
+}
+
+/// What the chip robots measured of their own waiting for the zone.
+#[derive(Debug, Default, Clone, Copy, PartialEq)]
+pub struct ZoneWaits {
+    /// How often a robot asked for the zone.
+    pub asks: u32,
+    /// How often it was refused (a timeout, or CLEAR = 0).
+    pub refused: u32,
+    /// The time spent asking, in seconds.
+    pub waited: f64,
+}
+
+/// Per line, the chip robot's waits.
+pub type SharedWaits = Arc<Mutex<[ZoneWaits; 2]>>;
+
+/// CHIP_IT's variables.
+#[derive(Debug, Default)]
+pub struct ChipItState {
+    /// Cards done.
+    pub cards: u32,
+    /// Cycle times since the last FREQUENCY message.
+    cycle_times: Vec<f64>,
+}
+
+/// The way into the zone under a policy: the twin's permission, or the arbiter's.
+enum Access {
+    Appendix(End<(), i32, usage::Query>),
+    Arbiter {
+        request: End<String, (), usage::Send>,
+        release: End<String, (), usage::Send>,
+    },
+}
+
+impl Access {
+    /// Asks to enter the zone; whether it may.
+    async fn enter(&mut self, ctx: &Ctx<ChipItState>) -> bool {
+        match self {
+            // QUERY SHARE_FEEDER.CRIT_SECTION(OK)
+            Access::Appendix(share_feeder) => {
+                matches!(ctx.query(share_feeder, ()).await, Ok(clear) if clear != 0)
+            }
+            Access::Arbiter { request, .. } => {
+                ctx.send(request, ctx.module().to_string()).await.is_ok()
+            }
+        }
+    }
+
+    /// Says it has left the zone.
+    async fn left(&mut self, ctx: &Ctx<ChipItState>) {
+        if let Access::Arbiter { release, .. } = self {
+            while ctx.send(release, ctx.module().to_string()).await.is_err() {
+                ctx.delay(Duration::from_secs(1)).await;
+            }
+        }
+    }
+}
+
+/// The CHIP_IT module of `line` (CHIP_IT2 on line B).
+pub fn chip_it(
+    line: Line,
+    policy: FeederPolicy,
+    ports: &CellPorts,
+    sim: &Sim,
+    waits: SharedWaits,
+) -> ModuleSpec<ChipItState> {
+    let n = LineNames::of(line);
+    let twin_line = match line {
+        Line::A => Line::B,
+        Line::B => Line::A,
+    };
+    let twin = LineNames::of(twin_line);
+    let crit_section = format!("{}.CRIT_SECTION", twin.share_feeder);
+    let own_timeout = format!("{}.TIMEOUT", n.share_feeder);
+    let mut spec = ModuleSpec::new(n.chip_it.clone(), ChipItState::default())
+        // 1) timeouts first; 2) never preempt the background, else a QUERY could be
+        // interrupted by a QUERY from the twin; 3) nor the critical region; 4) then the twin's
+        // query; 5) the insertion last: a query is answered only while inserting.
+        .order([
+            format!("{}.TIMEOUT", n.ready_to_chip),
+            own_timeout.clone(),
+            n.chip_it.clone(),
+            "GRASP".into(),
+            crit_section.clone(),
+            "INSERT".into(),
+            "BACK_OFF".into(),
+        ])
+        .sections(["GRASP", "INSERT", "BACK_OFF"])
+        .hardware([
+            format!("chip robot of line {line:?}"),
+            "chip station freeze relay".into(),
+        ])
+        .owns(n.ready_to_chip.clone())
+        .uses(n.frequency.clone(), UsageKind::Send);
+    let line_ports = &ports.lines[line.index_in_cell()];
+    let twin_ports = &ports.lines[twin_line.index_in_cell()];
+    // The Appendix's feeder ports are declared under both policies, so that the module keeps
+    // the Appendix's shape; under the arbiter nobody queries them.
+    // WHEN SHARE_FEEDER1.CRIT_SECTION(CLEAR) ==> CLEAR := 1: the order decides when.
+    let handler = twin_ports
+        .share_feeder
+        .responder_named(n.chip_it.clone(), |_: &ChipItState, ()| 1);
+    spec = spec
+        .owns(n.share_feeder.clone())
+        .uses(twin.share_feeder.clone(), UsageKind::Response);
+    spec = match handler {
+        Ok(end) => spec.response(crit_section, end),
+        Err(error) => {
+            let reason = error.to_string();
+            spec.task("WIRING", move |_ctx| {
+                let reason = reason.clone();
+                async move { Err(reason.into()) }
+            })
+        }
+    };
+    if policy == FeederPolicy::Arbiter {
+        spec = spec
+            .uses(ZONE_REQUEST, UsageKind::Send)
+            .uses(ZONE_RELEASE, UsageKind::Send);
+    }
+    // The asymmetric timeout handlers (note 6): CHIP_IT steps into a procedure ranked below
+    // CRIT_SECTION for a moment, so its twin's pending query is answered; CHIP_IT2 just
+    // retries.
+    let backs_off = line == Line::A;
+    spec = spec.exception(own_timeout, move |ctx: Ctx<ChipItState>, _| async move {
+        if backs_off {
+            ctx.section("BACK_OFF", ctx.delay(Duration::from_millis(500)))
+                .await;
+        }
+    });
+
+    let (ready_port, share_feeder, frequency) = (
+        line_ports.ready_to_chip.clone(),
+        line_ports.share_feeder.clone(),
+        line_ports.frequency.clone(),
+    );
+    let (zone_request, zone_release) = (ports.zone_request.clone(), ports.zone_release.clone());
+    let robot = sim.robot(RobotId::new(line, Role::ChipIt));
+    let name = n.chip_it.clone();
+    let background = move |ctx: Ctx<ChipItState>| {
+        let (ready_port, share_feeder, frequency) =
+            (ready_port.clone(), share_feeder.clone(), frequency.clone());
+        let (zone_request, zone_release, robot, name) = (
+            zone_request.clone(),
+            zone_release.clone(),
+            robot.clone(),
+            name.clone(),
+        );
+        let waits = Arc::clone(&waits);
+        async move {
+            let mut ready_to_chip = ready_port.owner()?;
+            let mut frequency = frequency.user_named(name.clone())?;
+            let mut access = match policy {
+                FeederPolicy::Appendix => Access::Appendix(share_feeder.owner()?),
+                FeederPolicy::Arbiter => Access::Arbiter {
+                    request: zone_request.user_named(name.clone())?,
+                    release: zone_release.user_named(name.clone())?,
+                },
+            };
+            let mut work = work_schedule();
+            loop {
+                // {Start timer}
+                let start = ctx.now();
+                // RECEIVE READY_TO_CHIP(TASK_ID): get signal to begin.
+                let (pallet, task_id) = match ctx.receive(&mut ready_to_chip).await {
+                    Ok(received) => received,
+                    Err(error) if error.is_timeout() => continue,
+                    Err(error) => return Err(error.into()),
+                };
+                work.reinstate();
+                while work.more() > 0 {
+                    let asked = ctx.now();
+                    let ok = access.enter(&ctx).await;
+                    let waited = (ctx.now() - asked).as_secs_f64();
+                    record_wait(&waits, line, ok, waited);
+                    if !ok {
+                        // {Signal operator}: counted; a timeout already raised SHARE_FEEDER.TIMEOUT.
+                        continue;
+                    }
+                    ctx.perform(&mut work, |step| {
+                        chip_step(&ctx, &robot, *step, &mut access)
+                    })
+                    .await;
+                }
+                task_id.reply(());
+                let _ = pallet;
+                // {stop timer, update and average cycle time, and once in a while do
+                //  SEND FREQUENCY(1, CYCLE_TIME)}
+                let cycle = (ctx.now() - start).as_secs_f64();
+                let average = ctx.state().update(|chip| {
+                    chip.cards += 1;
+                    chip.cycle_times.push(cycle);
+                    (chip.cycle_times.len() >= 5).then(|| {
+                        let times = std::mem::take(&mut chip.cycle_times);
+                        times.iter().sum::<f64>() / times.len() as f64
+                    })
+                });
+                if let Some(average) = average {
+                    let _ = ctx.send(&mut frequency, (1, average)).await;
+                }
+            }
+        }
+    };
+    let (freeze_port, relay) = (
+        line_ports.ready_to_chip.clone(),
+        sim.relay(line, Station::Chip),
+    );
+    spec.task(n.chip_it.clone(), background)
+        .task("FREEZE_CARD", move |ctx| {
+            let (port, relay) = (freeze_port.clone(), relay.clone());
+            async move {
+                let mut ready_to_chip = port.user_named("FREEZE_CARD")?;
+                loop {
+                    match relay.wait_in_place().await {
+                        Ok(pallet) => {
+                            while let Err(error) = ctx.send(&mut ready_to_chip, pallet).await {
+                                ctx.alarm(format!("{pallet}: {error}; asking again"));
+                                ctx.delay(Duration::from_secs(1)).await;
+                            }
+                            relay.release()?;
+                        }
+                        Err(error @ DeviceError::Jam { .. }) => {
+                            ctx.alarm(format!("{error}: taking the pallet off the line"));
+                            relay.clear_jam();
+                        }
+                        Err(error) => return Err(error.into()),
+                    }
+                }
+            }
+        })
+        .exception(
+            format!("{}.TIMEOUT", n.ready_to_chip),
+            |ctx: Ctx<ChipItState>, _| async move {
+                ctx.alarm("no card at the chip station for 60 s");
+            },
+        )
+}
+
+fn record_wait(waits: &SharedWaits, line: Line, ok: bool, waited: f64) {
+    let mut waits = waits.lock().unwrap_or_else(PoisonError::into_inner);
+    let waits = &mut waits[line.index_in_cell()];
+    waits.asks += 1;
+    waits.refused += u32::from(!ok);
+    waits.waited += waited;
+}
+
+/// One step: GRASP (enter the zone, grasp from the feeder, leave the zone), then INSERT.
+async fn chip_step(
+    ctx: &Ctx<ChipItState>,
+    robot: &Robot,
+    step: ChipStep,
+    access: &mut Access,
+) -> Result<(), DeviceError> {
+    let grasped = ctx
+        .section("GRASP", async {
+            let grasped = async {
+                retried(ctx, "reaching into the feeders", || {
+                    robot.move_to(Target::Feeder(step.feeder))
+                })
+                .await?;
+                retried(ctx, "grasping a chip", || robot.grasp(step.feeder)).await
+            }
+            .await;
+            // Out of the zone before anything else, whatever happened in it.
+            insisted(ctx, "leaving the feeder zone", || {
+                robot.move_to(Target::Card)
+            })
+            .await;
+            access.left(ctx).await;
+            grasped
+        })
+        .await;
+    if let Err(error) = grasped {
+        // Note 5: an empty feeder is reported, and the other steps still run.
+        ctx.alarm(format!("{error}: skipping this chip"));
+        return Err(error);
+    }
+    ctx.section("INSERT", async {
+        retried(ctx, "inserting the chip", || robot.insert())
+            .await
+            .map(|_| ())
+    })
+    .await
+}
+
+/// FEEDER_MONITOR: hands the feeder zone to one chip robot at a time.
+pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {
+    let (request, release): (ZonePort, ZonePort) =
+        (ports.zone_request.clone(), ports.zone_release.clone());
+    ModuleSpec::new(FEEDER_MONITOR, ())
+        .owns(ZONE_REQUEST)
+        .owns(ZONE_RELEASE)
+        .task(FEEDER_MONITOR, move |ctx| {
+            let (request, release) = (request.clone(), release.clone());
+            async move {
+                let (mut request, mut release) = (request.owner()?, release.owner()?);
+                loop {
+                    // Grant the zone to the first to ask; take no other request until it is back.
+                    let (_, granted) = ctx.receive(&mut request).await?;
+                    granted.reply(());
+                    let (_, returned) = ctx.receive(&mut release).await?;
+                    returned.reply(());
+                }
+            }
+        })
+}
+
+/// A line's place in the cell's per-line arrays.
+pub(crate) trait LineIndex {
+    fn index_in_cell(self) -> usize;
+}
+
+impl LineIndex for Line {
+    fn index_in_cell(self) -> usize {
+        match self {
+            Line::A => 0,
+            Line::B => 1,
+        }
+    }
+}

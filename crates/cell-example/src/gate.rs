@@ -1,0 +1,142 @@
+//! GATE: lets a pallet onto the conveyor every CYCLE_TIME, which it keeps at half the faster
+//! workcell's reported cycle time (Appendix, MODULE GATE).
+
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Duration;
+
+use imrs_sim::imrs_core::imrs_ports::{BoundedBuffer, Instant};
+use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::{Line, Sim};
+
+use crate::names::LineNames;
+use crate::ports::LinePorts;
+
+/// GATE's variables.
+#[derive(Debug)]
+pub struct GateState {
+    /// CYCLE_TIME: the delay between pallets, in seconds.
+    pub cycle_time: f64,
+    /// SPEEDS: the cycle times LOAD_IT (0) and CHIP_IT (1) reported.
+    pub speeds: [f64; 2],
+    /// NUM_RELEASED.
+    pub num_released: u32,
+    /// How many cycles in a row the line was backed up to the gate.
+    backed_up: u32,
+}
+
+/// When RELEASE is to die (the `--fault release@T` injection), taken by the copy it kills.
+pub type ReleaseDeath = Arc<Mutex<Option<Instant>>>;
+
+/// The GATE module of `line`.
+pub fn gate(
+    line: Line,
+    ports: &LinePorts,
+    sim: &Sim,
+    death: ReleaseDeath,
+) -> ModuleSpec<GateState> {
+    let n = LineNames::of(line);
+    let timeout = format!("{}.TIMEOUT", n.let_1_go);
+    let state = GateState {
+        cycle_time: 10.0,
+        speeds: [20.0, 40.0],
+        num_released: 0,
+        backed_up: 0,
+    };
+    let (let_1_go, frequency) = (ports.let_1_go.clone(), ports.frequency.clone());
+    let (release_port, buffer_port) = (ports.let_1_go.clone(), ports.frequency.clone());
+    let device = sim.gate(line);
+    ModuleSpec::new(n.gate.clone(), state)
+        .order([timeout.clone(), n.gate.clone()])
+        .hardware([format!("gate relay and photocell of line {line:?}")])
+        .owns(n.let_1_go.clone())
+        .filters(n.frequency.clone(), UsageKind::Receive)
+        .task(n.gate.clone(), move |ctx| {
+            let (let_1_go, frequency) = (let_1_go.clone(), frequency.clone());
+            async move {
+                let mut let_1_go = let_1_go.owner()?;
+                let mut frequency = frequency.owner()?;
+                loop {
+                    let cycle = ctx.state().read(|gate| gate.cycle_time);
+                    ctx.delay(Duration::from_secs_f64(cycle)).await;
+                    match ctx.send(&mut let_1_go, ()).await {
+                        Ok(0) => ctx.state().update(|gate| {
+                            gate.num_released += 1;
+                            gate.backed_up = 0;
+                        }),
+                        Ok(_) => {
+                            let cycles = ctx.state().update(|gate| {
+                                gate.backed_up += 1;
+                                gate.backed_up
+                            });
+                            if cycles % 10 == 0 {
+                                ctx.alarm(format!(
+                                    "line backed up to the gate for {cycles} cycles"
+                                ));
+                            }
+                        }
+                        // A timeout is the handler's business; a RELEASE that died holding
+                        // the message is restarted here.
+                        Err(error) if !error.is_timeout() => {
+                            ctx.alarm(format!("RELEASE failed: {error}; restarting it"));
+                            ctx.restart_task("RELEASE");
+                        }
+                        Err(_) => {}
+                    }
+                    // SEND FREQUENCY(TASK_NUM, TEMP_TIME): the buffer's oldest report, if any.
+                    if let Ok(Some((task_num, time))) = ctx.send(&mut frequency, ()).await {
+                        ctx.state().update(|gate| {
+                            gate.speeds[task_num as usize] = time;
+                            gate.cycle_time = gate.speeds[0].min(gate.speeds[1]) / 2.0;
+                        });
+                    }
+                }
+            }
+        })
+        .task("RELEASE", move |ctx| {
+            let (port, device, death) = (release_port.clone(), device.clone(), Arc::clone(&death));
+            async move {
+                let mut let_1_go = port.user_named("RELEASE")?;
+                let dies_at = *death.lock().unwrap_or_else(PoisonError::into_inner);
+                loop {
+                    let dying = async {
+                        match dies_at {
+                            Some(at) => ctx.clock().sleep_until(at).await,
+                            None => std::future::pending().await,
+                        }
+                    };
+                    tokio::select! {
+                        biased;
+                        () = dying => {
+                            death.lock().unwrap_or_else(PoisonError::into_inner).take();
+                            return Err("RELEASE died (injected fault)".into());
+                        }
+                        received = ctx.receive(&mut let_1_go) => {
+                            let ((), rc) = received?;
+                            rc.reply(device.release().await.rc());
+                        }
+                    }
+                }
+            }
+        })
+        .task("BOUNDED_BUFFER", move |_ctx| {
+            let port = buffer_port.clone();
+            async move {
+                BoundedBuffer::<(i32, f64), 20>::new()
+                    .run(port.filter()?)
+                    .await;
+                Ok(())
+            }
+        })
+        .exception(timeout, |ctx: Ctx<GateState>, _| async move {
+            // {Signal for help. Perhaps reset timer, perhaps kill and restart RELEASE}
+            ctx.alarm("RELEASE did not answer within 2 s: killing it and starting a new copy");
+            ctx.restart_task("RELEASE");
+        })
+        .exception(
+            "RELEASE.FAILED",
+            |ctx: Ctx<GateState>, exception| async move {
+                // The next LET_1_GO times out and restarts it (the Appendix's note 2).
+                ctx.alarm(format!("RELEASE failed: {}", exception.detail));
+            },
+        )
+}

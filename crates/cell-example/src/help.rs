@@ -1,0 +1,50 @@
+//! What a cell operator would want where the Appendix writes `{signal for help}`.
+
+use std::future::Future;
+use std::time::Duration;
+
+use imrs_sim::DeviceError;
+use imrs_sim::imrs_core::Ctx;
+
+/// How long an operator takes to reset a faulted robot.
+pub const RESET_TIME: Duration = Duration::from_secs(1);
+
+/// Runs a device operation; when the robot faults, raises an alarm, waits for the
+/// operator's reset, and tries once more.
+pub async fn retried<S, T, F, Fut>(
+    ctx: &Ctx<S>,
+    what: &str,
+    mut operation: F,
+) -> Result<T, DeviceError>
+where
+    S: Send + Sync + 'static,
+    F: FnMut() -> Fut,
+    Fut: Future<Output = Result<T, DeviceError>>,
+{
+    match operation().await {
+        Err(DeviceError::RobotFault { robot }) => {
+            ctx.alarm(format!(
+                "{robot} faulted while {what}: reset by the operator, retrying"
+            ));
+            ctx.delay(RESET_TIME).await;
+            operation().await
+        }
+        other => other,
+    }
+}
+
+/// Runs a device operation until it succeeds, with an alarm and a reset after each failure:
+/// for moves that must complete (leaving the shared zone).
+pub async fn insisted<S, F, Fut>(ctx: &Ctx<S>, what: &str, mut operation: F)
+where
+    S: Send + Sync + 'static,
+    F: FnMut() -> Fut,
+    Fut: Future<Output = Result<(), DeviceError>>,
+{
+    while let Err(error) = operation().await {
+        ctx.alarm(format!(
+            "{error} while {what}: reset by the operator, retrying"
+        ));
+        ctx.delay(RESET_TIME).await;
+    }
+}

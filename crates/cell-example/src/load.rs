@@ -1,0 +1,320 @@
+//! The load workcell: LOAD_IT and its children LOAD_CARD and SCREW_IN_CARD (Appendix, MODULE
+//! LOAD_IT, LOAD_CARD, SCREW_IN_CARD): a serialized motion process.
+
+use std::time::Duration;
+
+use imrs_sim::imrs_core::imrs_ports::Respond;
+use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::{DeviceError, Line, RobotId, Role, Sim, Station, Target};
+
+use crate::help::{insisted, retried};
+use crate::names::LineNames;
+use crate::ports::LinePorts;
+
+/// How LOAD_IT's children are restarted when they stop answering.
+const CHILD_RESTARTS: RestartPolicy = RestartPolicy::restart(5, Duration::from_secs(1));
+
+/// LOAD_IT's variables.
+#[derive(Debug, Default)]
+pub struct LoadItState {
+    /// NUM_LOADED, as LOAD_CARD last reported it.
+    pub num_loaded: u32,
+    /// Cycle times reported since the last FREQUENCY message.
+    cycle_times: Vec<f64>,
+}
+
+/// LOAD_CARD's variables.
+#[derive(Debug, Default)]
+pub struct LoadCardState {
+    /// NUM_LOADED.
+    pub num_loaded: u32,
+    /// CYCLE_TIME: the last cycle's time, in seconds.
+    pub cycle_time: f64,
+}
+
+/// A module that cannot start because a port refused it: it fails at once, with the
+/// refusal as its reason, so that its supervisor reports it.
+fn refused<S: Send + Sync + 'static>(
+    spec: ModuleSpec<S>,
+    error: impl std::fmt::Display,
+) -> ModuleSpec<S> {
+    let reason = error.to_string();
+    spec.task("WIRING", move |_ctx| {
+        let reason = reason.clone();
+        async move { Err(reason.into()) }
+    })
+}
+
+/// Adds a response handler, or makes the module fail with the wiring error.
+fn with_response<S, E>(
+    spec: ModuleSpec<S>,
+    name: String,
+    end: Result<E, impl std::fmt::Display>,
+) -> ModuleSpec<S>
+where
+    S: Send + Sync + 'static,
+    E: Respond<S> + Send + 'static,
+{
+    match end {
+        Ok(end) => spec.response(name, end),
+        Err(error) => refused(spec, error),
+    }
+}
+
+/// The LOAD_IT module of `line`, which costarts LOAD_CARD and SCREW_IN_CARD.
+pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItState> {
+    let n = LineNames::of(line);
+    let (timeout1, timeout2) = (
+        format!("{}.TIMEOUT", n.ask_child1),
+        format!("{}.TIMEOUT", n.ask_child2),
+    );
+    let ports = ports.clone();
+    let sim = sim.clone();
+    let (load_card_name, screw_name) = (n.load_card.clone(), n.screw_in_card.clone());
+    ModuleSpec::new(n.load_it.clone(), LoadItState::default())
+        .order([timeout1.clone(), timeout2.clone(), n.load_it.clone()])
+        .owns(n.ask_child1.clone())
+        .owns(n.ask_child2.clone())
+        .uses(n.frequency.clone(), UsageKind::Send)
+        .task(n.load_it.clone(), move |ctx| {
+            let (ports, sim, n) = (ports.clone(), sim.clone(), n.clone());
+            async move {
+                let (child_ports, child_sim) = (ports.clone(), sim.clone());
+                ctx.costart_supervised(CHILD_RESTARTS, move || {
+                    load_card(line, &child_ports, &child_sim)
+                });
+                let (child_ports, child_sim) = (ports.clone(), sim.clone());
+                ctx.costart_supervised(CHILD_RESTARTS, move || {
+                    screw_in_card(line, &child_ports, &child_sim)
+                });
+                let mut ask_child1 = ports.ask_child1.owner()?;
+                let mut ask_child2 = ports.ask_child2.owner()?;
+                let mut frequency = ports.frequency.user_named(n.load_it.clone())?;
+                loop {
+                    ctx.delay(Duration::from_secs(4)).await;
+                    // QUERY ASK_CHILD1.STATUS(RC, NUM_LOADED, CYCLE_TIME): is LOAD_CARD ok?
+                    if let Ok((rc, num_loaded, cycle_time)) = ctx.query(&mut ask_child1, ()).await {
+                        if rc != 0 {
+                            ctx.alarm(format!("{} reports RC={rc}", n.load_card));
+                        }
+                        ctx.state().update(|load_it| {
+                            load_it.num_loaded = num_loaded;
+                            if cycle_time > 0.0 {
+                                load_it.cycle_times.push(cycle_time);
+                            }
+                        });
+                    }
+                    // QUERY ASK_CHILD2.STATUS(RC): is SCREW_IN_CARD ok?
+                    if let Ok(rc) = ctx.query(&mut ask_child2, ()).await
+                        && rc != 0
+                    {
+                        ctx.alarm(format!("{} reports RC={rc}", n.screw_in_card));
+                    }
+                    // Average many cycle times, and once in a while SEND FREQUENCY(0, CYCLE_TIME).
+                    let average = ctx.state().update(|load_it| {
+                        (load_it.cycle_times.len() >= 5).then(|| {
+                            let times = std::mem::take(&mut load_it.cycle_times);
+                            times.iter().sum::<f64>() / times.len() as f64
+                        })
+                    });
+                    if let Some(average) = average {
+                        let _ = ctx.send(&mut frequency, (0, average)).await;
+                    }
+                }
+            }
+        })
+        .exception(timeout1, move |ctx: Ctx<LoadItState>, _| {
+            let child = load_card_name.clone();
+            async move {
+                ctx.alarm(format!(
+                    "{child} does not answer: killing it and starting a new copy"
+                ));
+                ctx.kill(&child);
+            }
+        })
+        .exception(timeout2, move |ctx: Ctx<LoadItState>, _| {
+            let child = screw_name.clone();
+            async move {
+                ctx.alarm(format!(
+                    "{child} does not answer: killing it and starting a new copy"
+                ));
+                ctx.kill(&child);
+            }
+        })
+}
+
+/// The LOAD_CARD module of `line`: its robot lays a card on each pallet.
+pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCardState> {
+    let n = LineNames::of(line);
+    let spec = ModuleSpec::new(n.load_card.clone(), LoadCardState::default())
+        .order([
+            format!("{}.TIMEOUT", n.pallet_in_place),
+            format!("{}.STATUS", n.ask_child1),
+            n.load_card.clone(),
+        ])
+        .hardware([
+            format!("load robot of line {line:?}"),
+            "load station freeze relay".into(),
+        ])
+        .owns(n.pallet_in_place.clone())
+        .owns(n.card_in_place.clone())
+        .uses(n.ask_child1.clone(), UsageKind::Response);
+    // WHEN ASK_CHILD1.STATUS(RC1, NUM1, CYCLE1) ==> RC1 := 0; NUM1 := NUM_LOADED; ...
+    let status = ports
+        .ask_child1
+        .responder_named(n.load_card.clone(), |card: &LoadCardState, ()| {
+            (0, card.num_loaded, card.cycle_time)
+        });
+    let spec = with_response(spec, format!("{}.STATUS", n.ask_child1), status);
+    let (pallet_port, card_port) = (ports.pallet_in_place.clone(), ports.card_in_place.clone());
+    let robot = sim.robot(RobotId::new(line, Role::LoadCard));
+    let freeze_port = ports.pallet_in_place.clone();
+    let relay = sim.relay(line, Station::Load);
+    spec.task(n.load_card.clone(), move |ctx| {
+        let (pallet_port, card_port, robot) =
+            (pallet_port.clone(), card_port.clone(), robot.clone());
+        async move {
+            let mut pallet_in_place = pallet_port.owner()?;
+            let mut card_in_place = card_port.owner()?;
+            loop {
+                let start = ctx.now();
+                // {grab next card and move to ready position}
+                retried(&ctx, "going to the magazine", || {
+                    robot.move_to(Target::Magazine)
+                })
+                .await?;
+                retried(&ctx, "picking a card", || robot.pick_card()).await?;
+                retried(&ctx, "going to the ready position", || {
+                    robot.move_to(Target::Home)
+                })
+                .await?;
+                // RECEIVE PALLET_IN_PLACE(TASK_ID): don't reply until the pallet can go.
+                let (pallet, task_id) = match ctx.receive(&mut pallet_in_place).await {
+                    Ok(received) => received,
+                    Err(error) if error.is_timeout() => continue,
+                    Err(error) => return Err(error.into()),
+                };
+                // {move card to pallet}
+                let placed = async {
+                    retried(&ctx, "moving the card to the pallet", || {
+                        robot.move_to(Target::Card)
+                    })
+                    .await?;
+                    retried(&ctx, "laying the card", || robot.place_card()).await
+                }
+                .await;
+                insisted(&ctx, "clearing the pallet", || robot.move_to(Target::Home)).await;
+                if let Err(error) = placed {
+                    ctx.alarm(format!("{pallet}: no card laid ({error}); letting it go"));
+                    task_id.reply(());
+                    continue;
+                }
+                // SEND CARD_IN_PLACE(RC): SCREW_IN_CARD anchors it.
+                match ctx.send(&mut card_in_place, pallet).await {
+                    Ok(0) => {
+                        let cycle = (ctx.now() - start).as_secs_f64();
+                        ctx.state().update(|card| {
+                            card.cycle_time = cycle;
+                            card.num_loaded += 1;
+                        });
+                    }
+                    Ok(rc) => ctx.alarm(format!("{pallet}: the card was not screwed (RC={rc})")),
+                    Err(error) => ctx.alarm(format!("{pallet}: {error}")),
+                }
+                // REPLY PALLET_IN_PLACE(TASK_ID): release the pallet.
+                task_id.reply(());
+            }
+        }
+    })
+    .task("FREEZE_PALLET", move |ctx| {
+        let (port, relay) = (freeze_port.clone(), relay.clone());
+        async move {
+            let mut pallet_in_place = port.user_named("FREEZE_PALLET")?;
+            loop {
+                match relay.wait_in_place().await {
+                    Ok(pallet) => {
+                        // Hold the pallet until LOAD_CARD (or a new copy of it) lets it go.
+                        while let Err(error) = ctx.send(&mut pallet_in_place, pallet).await {
+                            ctx.alarm(format!("{pallet}: {error}; asking again"));
+                            ctx.delay(Duration::from_secs(1)).await;
+                        }
+                        relay.release()?;
+                    }
+                    Err(error @ DeviceError::Jam { .. }) => {
+                        ctx.alarm(format!("{error}: taking the pallet off the line"));
+                        relay.clear_jam();
+                    }
+                    Err(error) => return Err(error.into()),
+                }
+            }
+        }
+    })
+    .exception(
+        format!("{}.TIMEOUT", n.pallet_in_place),
+        |ctx: Ctx<LoadCardState>, _| async move {
+            ctx.alarm("no pallet at the load station for 30 s");
+        },
+    )
+    .exception(
+        format!("{}.TIMEOUT", n.card_in_place),
+        |ctx: Ctx<LoadCardState>, _| async move {
+            ctx.alarm("SCREW_IN_CARD did not answer within 30 s");
+        },
+    )
+}
+
+/// The SCREW_IN_CARD module of `line`: its robot screws each laid card to its pallet.
+pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()> {
+    let n = LineNames::of(line);
+    let timeout = format!("{}.TIMEOUT", n.card_in_place);
+    let spec = ModuleSpec::new(n.screw_in_card.clone(), ())
+        .order([
+            timeout.clone(),
+            format!("{}.STATUS", n.ask_child2),
+            n.screw_in_card.clone(),
+        ])
+        .hardware([format!("screw robot of line {line:?}")])
+        .uses(n.ask_child2.clone(), UsageKind::Response)
+        .uses(n.card_in_place.clone(), UsageKind::Receive);
+    // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
+    let status = ports
+        .ask_child2
+        .responder_named(n.screw_in_card.clone(), |_: &(), ()| 0);
+    let spec = with_response(spec, format!("{}.STATUS", n.ask_child2), status);
+    let port = ports.card_in_place.clone();
+    let robot = sim.robot(RobotId::new(line, Role::ScrewInCard));
+    let name = n.screw_in_card.clone();
+    spec.task(n.screw_in_card.clone(), move |ctx| {
+        let (port, robot, name) = (port.clone(), robot.clone(), name.clone());
+        async move {
+            let mut card_in_place = port.user_named(name)?.with_timeout(Duration::from_secs(30));
+            loop {
+                // {Prepare to screw in next card}
+                insisted(&ctx, "going home", || robot.move_to(Target::Home)).await;
+                let (pallet, task_id) = match ctx.receive(&mut card_in_place).await {
+                    Ok(received) => received,
+                    Err(error) if error.is_timeout() => continue,
+                    Err(error) => return Err(error.into()),
+                };
+                // {screw card in, set RC=0 if OK, <>0 if error}
+                let screwed = async {
+                    retried(&ctx, "moving to the card", || robot.move_to(Target::Card)).await?;
+                    retried(&ctx, "screwing", || robot.screw()).await
+                }
+                .await;
+                insisted(&ctx, "clearing the pallet", || robot.move_to(Target::Home)).await;
+                let rc = match screwed {
+                    Ok(()) => 0,
+                    Err(error) => {
+                        ctx.alarm(format!("{pallet}: {error}"));
+                        1
+                    }
+                };
+                task_id.reply(rc);
+            }
+        }
+    })
+    .exception(timeout, |ctx: Ctx<()>, _| async move {
+        ctx.alarm("no card to screw for 30 s");
+    })
+}

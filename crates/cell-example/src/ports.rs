@@ -1,0 +1,145 @@
+//! Every port of the cell, declared as the Appendix declares it.
+
+use std::time::Duration;
+
+use imrs_sim::imrs_core::Cell;
+use imrs_sim::imrs_core::imrs_ports::{
+    AnyUser, BoundedBufferPort, Port, PortSpec, SharedClock, WireError, usage,
+};
+use imrs_sim::{Line, PalletId};
+
+use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+
+/// FREQUENCY(TASK_NUM: INTEGER; TIME_FOR_ONE: REAL), through the bounded buffer.
+pub type Frequency = BoundedBufferPort<(i32, f64), AnyUser, 2>;
+/// LET_1_GO(RC: INTEGER): USAGE=SEND, #USERS=1, TIMEOUT=2 sec.
+pub type Let1Go = Port<(), i32, usage::Send, AnyUser, 1>;
+/// ASK_CHILD1(RC, NUM_DONE: INTEGER; TIME_FOR_ONE: REAL): USAGE=QUERY.
+pub type AskChild1 = Port<(), (i32, u32, f64), usage::Query>;
+/// ASK_CHILD2(RC: INTEGER): USAGE=QUERY.
+pub type AskChild2 = Port<(), i32, usage::Query>;
+/// PALLET_IN_PLACE(): USAGE=RECEIVE, #USERS=1, TIMEOUT=30 SEC (it names the pallet).
+pub type PalletInPlace = Port<PalletId, (), usage::Receive, AnyUser, 1>;
+/// CARD_IN_PLACE(RC: INTEGER): USAGE=SEND, USERLIST=(SCREW_IN_CARD), TIMEOUT=30 SEC.
+pub type CardInPlace = Port<PalletId, i32, usage::Send>;
+/// READY_TO_CHIP(): USAGE=RECEIVE, #USERS=1, TIMEOUT=60 SEC (it names the pallet).
+pub type ReadyToChip = Port<PalletId, (), usage::Receive, AnyUser, 1>;
+/// SHARE_FEEDER(CLEAR: INTEGER): USAGE=QUERY, USERLIST=(twin), TIMEOUT=3 SEC.
+pub type ShareFeeder = Port<(), i32, usage::Query>;
+/// The arbiter's ports: a chip robot sends and waits until it may enter (or has left).
+pub type ZonePort = Port<String, (), usage::Receive, AnyUser, 2>;
+
+/// One line's ports.
+#[derive(Debug, Clone)]
+pub struct LinePorts {
+    /// FREQUENCY, owned by GATE, filtered by BOUNDED_BUFFER.
+    pub frequency: Frequency,
+    /// LET_1_GO, owned by GATE.
+    pub let_1_go: Let1Go,
+    /// ASK_CHILD1, owned by LOAD_IT.
+    pub ask_child1: AskChild1,
+    /// ASK_CHILD2, owned by LOAD_IT.
+    pub ask_child2: AskChild2,
+    /// PALLET_IN_PLACE, owned by LOAD_CARD.
+    pub pallet_in_place: PalletInPlace,
+    /// CARD_IN_PLACE, owned by LOAD_CARD.
+    pub card_in_place: CardInPlace,
+    /// READY_TO_CHIP, owned by CHIP_IT.
+    pub ready_to_chip: ReadyToChip,
+    /// The feeder port this line's CHIP_IT owns.
+    pub share_feeder: ShareFeeder,
+}
+
+/// Every port of the cell.
+#[derive(Debug, Clone)]
+pub struct CellPorts {
+    /// Per line, A then B.
+    pub lines: [LinePorts; 2],
+    /// The arbiter's request port.
+    pub zone_request: ZonePort,
+    /// The arbiter's release port.
+    pub zone_release: ZonePort,
+}
+
+fn spec(name: &str, owner: &str, clock: &SharedClock) -> PortSpec {
+    PortSpec::new(name, owner).clock(clock.clone())
+}
+
+fn secs(seconds: u64) -> Duration {
+    Duration::from_secs(seconds)
+}
+
+impl LinePorts {
+    fn declare(line: Line, clock: &SharedClock) -> Self {
+        let n = LineNames::of(line);
+        let twin = LineNames::of(match line {
+            Line::A => Line::B,
+            Line::B => Line::A,
+        });
+        Self {
+            frequency: Frequency::declare(
+                spec(&n.frequency, &n.gate, clock)
+                    .user_list([n.load_it.clone(), n.chip_it.clone()]),
+                "BOUNDED_BUFFER",
+            ),
+            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).timeout(secs(2))),
+            ask_child1: AskChild1::declare(
+                spec(&n.ask_child1, &n.load_it, clock)
+                    .user_list([n.load_card.clone()])
+                    .timeout(secs(2)),
+            ),
+            ask_child2: AskChild2::declare(
+                spec(&n.ask_child2, &n.load_it, clock)
+                    .user_list([n.screw_in_card.clone()])
+                    .timeout(secs(2)),
+            ),
+            pallet_in_place: PalletInPlace::declare(
+                spec(&n.pallet_in_place, &n.load_card, clock).timeout(secs(30)),
+            ),
+            card_in_place: CardInPlace::declare(
+                spec(&n.card_in_place, &n.load_card, clock)
+                    .user_list([n.screw_in_card.clone()])
+                    .timeout(secs(30)),
+            ),
+            ready_to_chip: ReadyToChip::declare(
+                spec(&n.ready_to_chip, &n.chip_it, clock).timeout(secs(60)),
+            ),
+            share_feeder: ShareFeeder::declare(
+                spec(&n.share_feeder, &n.chip_it, clock)
+                    .user_list([twin.chip_it.clone()])
+                    .timeout(secs(3)),
+            ),
+        }
+    }
+}
+
+impl CellPorts {
+    /// Declares every port on `clock`, and makes each known to `cell` for the wiring check;
+    /// the arbiter's ports only when `arbiter` runs.
+    pub fn declare(cell: &Cell, arbiter: bool) -> Result<Self, WireError> {
+        let clock = cell.clock();
+        let ports = Self {
+            lines: [
+                LinePorts::declare(Line::A, clock),
+                LinePorts::declare(Line::B, clock),
+            ],
+            zone_request: ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)),
+            zone_release: ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)),
+        };
+        for line in &ports.lines {
+            cell.declare_filtered(&line.frequency)?;
+            cell.declare(&line.let_1_go)?;
+            cell.declare(&line.ask_child1)?;
+            cell.declare(&line.ask_child2)?;
+            cell.declare(&line.pallet_in_place)?;
+            cell.declare(&line.card_in_place)?;
+            cell.declare(&line.ready_to_chip)?;
+            cell.declare(&line.share_feeder)?;
+        }
+        if arbiter {
+            cell.declare(&ports.zone_request)?;
+            cell.declare(&ports.zone_release)?;
+        }
+        Ok(ports)
+    }
+}

@@ -1,0 +1,210 @@
+//! Running the cell: on virtual time (the default) or on the wall clock.
+
+use std::io::{IsTerminal, Write};
+use std::sync::{Arc, PoisonError};
+use std::time::Duration;
+
+use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
+use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::imrs_core::{CellErrors, time::drive};
+use imrs_sim::{
+    Fault, FaultKind, Line, PalletId, RobotId, Role, Sim, SimConfig, SimEvent, Station,
+};
+
+use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, chip_it, feeder_monitor};
+use crate::faults::{CellFault, CellFaultKind};
+use crate::gate::{ReleaseDeath, gate};
+use crate::load::{load_card, load_it, screw_in_card};
+use crate::ports::CellPorts;
+
+/// How a run is made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellConfig {
+    /// Simulated hours.
+    pub hours: f64,
+    /// Seeds every random choice.
+    pub seed: u64,
+    /// How the chip robots share the feeders.
+    pub feeder: FeederPolicy,
+    /// Run on the wall clock instead of virtual time.
+    pub realtime: bool,
+    /// Faults to inject.
+    pub faults: Vec<CellFault>,
+    /// Show a progress bar on a terminal.
+    pub progress: bool,
+}
+
+impl Default for CellConfig {
+    fn default() -> Self {
+        Self {
+            hours: 1.0,
+            seed: 1985,
+            feeder: FeederPolicy::Arbiter,
+            realtime: false,
+            faults: Vec::new(),
+            progress: false,
+        }
+    }
+}
+
+/// Everything a run measured and logged.
+#[derive(Debug, Clone)]
+pub struct RunRecord {
+    /// The configuration it ran with.
+    pub config: CellConfig,
+    /// The physical facts, from the simulation.
+    pub sim_events: Vec<SimEvent>,
+    /// The modules' event log.
+    pub cell_events: Vec<Event>,
+    /// The pallets still on the conveyors at the end.
+    pub pallets_left: Vec<(Line, PalletId, [f32; 3])>,
+    /// The chip robots' waits for the zone.
+    pub waits: [ZoneWaits; 2],
+    /// Simulated time.
+    pub simulated: Duration,
+    /// Wall time the run took.
+    pub wall: Duration,
+}
+
+/// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.
+pub fn run(config: &CellConfig) -> Result<RunRecord, CellErrors> {
+    let wall = std::time::Instant::now();
+    let mut record = if config.realtime {
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .enable_all()
+            .build()
+            .expect("a tokio runtime starts");
+        runtime.block_on(simulate(config, Arc::new(RealClock::new()), None))
+    } else {
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .start_paused(true)
+            .build()
+            .expect("a tokio runtime starts");
+        let clock = VirtualClock::new();
+        runtime.block_on(simulate(config, Arc::new(clock.clone()), Some(clock)))
+    }?;
+    record.wall = wall.elapsed();
+    Ok(record)
+}
+
+async fn simulate(
+    config: &CellConfig,
+    clock: SharedClock,
+    driver: Option<VirtualClock>,
+) -> Result<RunRecord, CellErrors> {
+    let cell = Cell::new(clock.clone());
+    let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
+    let ports = CellPorts::declare(&cell, config.feeder == FeederPolicy::Arbiter)?;
+    let deaths: [ReleaseDeath; 2] = Default::default();
+    let waits: SharedWaits = Arc::default();
+    inject(config, &sim, &deaths);
+
+    // The load-time check, over every module the cell will run (children included).
+    let mut declarations = Vec::new();
+    for line in Line::ALL {
+        let lines = &ports.lines[line_index(line)];
+        declarations
+            .push(gate(line, lines, &sim, Arc::clone(&deaths[line_index(line)])).declaration());
+        declarations.push(load_it(line, lines, &sim).declaration());
+        declarations.push(load_card(line, lines, &sim).declaration());
+        declarations.push(screw_in_card(line, lines, &sim).declaration());
+        declarations
+            .push(chip_it(line, config.feeder, &ports, &sim, Arc::clone(&waits)).declaration());
+    }
+    if config.feeder == FeederPolicy::Arbiter {
+        declarations.push(feeder_monitor(&ports).declaration());
+    }
+    cell.check(&declarations)?;
+
+    sim.spawn();
+    let policy = RestartPolicy::restart(3, Duration::from_secs(5));
+    if config.feeder == FeederPolicy::Arbiter {
+        cell.start(feeder_monitor(&ports));
+    }
+    for line in Line::ALL {
+        let (lines, sim) = (ports.lines[line_index(line)].clone(), sim.clone());
+        let death = Arc::clone(&deaths[line_index(line)]);
+        let (gate_lines, gate_sim) = (lines.clone(), sim.clone());
+        cell.supervise(policy, move || {
+            gate(line, &gate_lines, &gate_sim, Arc::clone(&death))
+        });
+        cell.start(load_it(line, &lines, &sim));
+        let (all_ports, chip_sim, chip_waits, feeder) = (
+            ports.clone(),
+            sim.clone(),
+            Arc::clone(&waits),
+            config.feeder,
+        );
+        cell.supervise(policy, move || {
+            chip_it(line, feeder, &all_ports, &chip_sim, Arc::clone(&chip_waits))
+        });
+    }
+
+    let total = Duration::from_secs_f64(config.hours * 3600.0);
+    let end = Instant::from_start(total);
+    match driver {
+        Some(virtual_clock) => {
+            let chunk = Duration::from_secs(60);
+            let show = config.progress && std::io::stderr().is_terminal();
+            let mut reached = Instant::ZERO;
+            while reached < end {
+                reached = drive(&virtual_clock, (reached + chunk).min(end)).await;
+                if show {
+                    progress(reached, end);
+                }
+            }
+            if show {
+                eprintln!();
+            }
+        }
+        None => tokio::time::sleep(total).await,
+    }
+    let waits = *waits.lock().unwrap_or_else(PoisonError::into_inner);
+    Ok(RunRecord {
+        config: config.clone(),
+        sim_events: sim.log().snapshot(),
+        cell_events: cell.events().snapshot(),
+        pallets_left: sim.pallets(),
+        waits,
+        simulated: total,
+        wall: Duration::ZERO,
+    })
+}
+
+fn line_index(line: Line) -> usize {
+    match line {
+        Line::A => 0,
+        Line::B => 1,
+    }
+}
+
+fn inject(config: &CellConfig, sim: &Sim, deaths: &[ReleaseDeath; 2]) {
+    for fault in &config.faults {
+        let at = Instant::from_start(fault.at);
+        let kind = match fault.kind {
+            CellFaultKind::ReleaseDies(line) => {
+                *deaths[line_index(line)]
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner) = Some(at);
+                continue;
+            }
+            CellFaultKind::RobotFault(line) => FaultKind::Robot(RobotId::new(line, Role::ChipIt)),
+            CellFaultKind::FeederEmpty(feeder) => FaultKind::FeederEmpty(feeder),
+            CellFaultKind::PalletJam(line) => FaultKind::Jam(line, Station::Load),
+        };
+        sim.inject(Fault { at, kind });
+    }
+}
+
+fn progress(reached: Instant, end: Instant) {
+    let share = reached.since_start().as_secs_f64() / end.since_start().as_secs_f64().max(1e-9);
+    let filled = (share * 40.0).round() as usize;
+    eprint!(
+        "\r[{}{}] {:>5.1}% of the simulated run",
+        "#".repeat(filled),
+        ".".repeat(40 - filled.min(40)),
+        share * 100.0
+    );
+    let _ = std::io::stderr().flush();
+}
