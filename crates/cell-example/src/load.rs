@@ -238,7 +238,10 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
                             ctx.alarm(format!("{pallet}: {error}; asking again"));
                             ctx.delay(Duration::from_secs(1)).await;
                         }
-                        relay.release()?;
+                        if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
+                            ctx.alarm(format!("{error}: taking the pallet off the line"));
+                            relay.clear_jam();
+                        }
                     }
                     Err(error @ DeviceError::Jam { .. }) => {
                         ctx.alarm(format!("{error}: taking the pallet off the line"));

@@ -5,7 +5,8 @@ use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_core::imrs_ports::{Instant, SharedClock};
-use tokio::sync::{Notify, watch};
+use tokio::sync::Notify;
+use tokio::sync::futures::Notified;
 
 use crate::device::{Gate, Relay, Robot};
 use crate::event::{SimEvent, SimLog};
@@ -40,7 +41,9 @@ struct Shared {
     world: Mutex<World>,
     clock: SharedClock,
     activity: Notify,
-    steps: watch::Sender<u64>,
+    /// Wakes everyone waiting for the world to change, after every step. (Not a `watch`
+    /// channel: its waiters are woken in a random order, and runs must be reproducible.)
+    stepped: Notify,
     log: SimLog,
 }
 
@@ -52,7 +55,7 @@ impl Sim {
                 world: Mutex::new(World::new(config.seed, config.stocks)),
                 clock,
                 activity: Notify::new(),
-                steps: watch::channel(0).0,
+                stepped: Notify::new(),
                 log: SimLog::default(),
             }),
         }
@@ -75,7 +78,7 @@ impl Sim {
             events
                 .into_iter()
                 .for_each(|event| self.shared.log.record(event));
-            self.shared.steps.send_modify(|steps| *steps += 1);
+            self.shared.stepped.notify_waiters();
         }
     }
 
@@ -157,9 +160,9 @@ impl Sim {
         self.shared.activity.notify_one();
     }
 
-    /// A receiver that changes after every step.
-    pub(crate) fn steps(&self) -> watch::Receiver<u64> {
-        self.shared.steps.subscribe()
+    /// A future that completes after the next step; enable it before looking at the world.
+    pub(crate) fn next_step(&self) -> Notified<'_> {
+        self.shared.stepped.notified()
     }
 
     fn world(&self) -> MutexGuard<'_, World> {

@@ -87,17 +87,16 @@ impl Relay {
     /// Waits until a pallet is held in place, and says which. A jammed pallet fails the wait.
     pub async fn wait_in_place(&self) -> Result<PalletId, DeviceError> {
         let (line, station) = (self.line, self.station);
-        let mut steps = self.sim.steps();
         loop {
+            let mut stepped = std::pin::pin!(self.sim.next_step());
+            // Registered before looking, so that a step in between is not missed.
+            stepped.as_mut().enable();
             match self.sim.with(|world, _| world.station_state(line, station)) {
                 Some((pallet, false)) => return Ok(pallet),
                 Some((_, true)) => return Err(DeviceError::Jam { line, station }),
                 None => {}
             }
-            if steps.changed().await.is_err() {
-                // The simulation is gone: nothing will ever arrive.
-                std::future::pending::<()>().await;
-            }
+            stepped.await;
         }
     }
 
