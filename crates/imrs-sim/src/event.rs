@@ -104,6 +104,13 @@ pub enum SimEventKind {
         /// The chip number.
         chip: u32,
     },
+    /// The operator refilled an empty feeder.
+    FeederRefilled {
+        /// The feeder.
+        feeder: crate::ids::FeederId,
+        /// The chips put in.
+        chips: u32,
+    },
     /// An injected fault struck.
     FaultStruck {
         /// The fault.
@@ -151,6 +158,9 @@ impl fmt::Display for SimEvent {
             }
             SimEventKind::ChipInserted { line, pallet, chip } => {
                 write!(f, "line {line:?}: chip {chip} inserted on {pallet}")
+            }
+            SimEventKind::FeederRefilled { feeder, chips } => {
+                write!(f, "{feeder} refilled with {chips} chips")
             }
             SimEventKind::FaultStruck { fault } => write!(f, "fault: {fault:?}"),
         }

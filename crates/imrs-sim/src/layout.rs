@@ -58,6 +58,11 @@ pub const PICK_CARD_TIME: Duration = Duration::from_millis(600);
 pub const PLACE_CARD_TIME: Duration = Duration::from_millis(700);
 /// Screwing a card to the pallet.
 pub const SCREW_TIME: Duration = Duration::from_millis(2500);
+/// How long the operator takes to refill a feeder found empty.
+pub const REFILL_DELAY: Duration = Duration::from_secs(120);
+/// How many chips a refill puts in a feeder, at least and at most.
+pub const REFILL_CHIPS: (u32, u32) = (150, 250);
+
 /// The gate's relay letting one pallet go.
 pub const RELEASE_TIME: Duration = Duration::from_millis(300);
 

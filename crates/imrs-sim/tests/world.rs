@@ -332,3 +332,34 @@ fn the_same_seed_gives_the_same_event_stream() {
     assert!(first.len() > 20, "{} events", first.len());
     assert_eq!(first, scripted_run(11));
 }
+
+#[test]
+fn a_feeder_found_empty_is_refilled_by_the_operator_later() {
+    paused_runtime().block_on(async {
+        let (sim, clock) = cell(Some([0, 5, 5, 5]));
+        let (robot, sim_clock) = (sim.robot(CHIP_A), sim.clock().clone());
+        let work = tokio::spawn(async move {
+            robot.move_to(Target::Feeder(FeederId(0))).await.unwrap();
+            let empty = robot.grasp(FeederId(0)).await;
+            sim_clock.sleep(imrs_sim::layout::REFILL_DELAY).await;
+            (empty, robot.grasp(FeederId(0)).await)
+        });
+        drive(&clock, secs(200.0)).await;
+        let (empty, refilled) = work.await.unwrap();
+        assert_eq!(
+            empty,
+            Err(DeviceError::EmptyFeeder {
+                feeder: FeederId(0),
+                chip: 1
+            })
+        );
+        assert_eq!(refilled, Ok(1));
+        let refills: Vec<_> = sim
+            .log()
+            .snapshot()
+            .into_iter()
+            .filter(|event| matches!(event.kind, SimEventKind::FeederRefilled { .. }))
+            .collect();
+        assert_eq!(refills.len(), 1);
+    });
+}

@@ -57,22 +57,20 @@ impl Robot {
         outcome
     }
 
-    /// Grasps a chip from `feeder`, where the tool must be. Fails on an empty feeder.
+    /// Grasps a chip from `feeder`, where the tool must be. Fails on an empty feeder, which
+    /// calls the operator: it is refilled [`REFILL_DELAY`](crate::layout::REFILL_DELAY) later.
     pub async fn grasp(&self, feeder: FeederId) -> Result<u32, DeviceError> {
         self.require_at(Target::Feeder(feeder), "feeder")?;
         self.busy(GRASP_TIME).await?;
         let robot = self.id;
-        self.sim.with(|world, _| {
+        self.sim.with(|world, now| {
             let feeder = world
-                .feeders
-                .iter_mut()
-                .find(|f| f.id == feeder)
+                .feeder(feeder, now)
                 .expect("a robot at a feeder names an existing feeder");
             if feeder.stock == 0 {
-                return Err(DeviceError::EmptyFeeder {
-                    feeder: feeder.id,
-                    chip: feeder.chip,
-                });
+                let (id, chip) = (feeder.id, feeder.chip);
+                world.report_empty(id, now);
+                return Err(DeviceError::EmptyFeeder { feeder: id, chip });
             }
             feeder.stock -= 1;
             let chip = feeder.chip;

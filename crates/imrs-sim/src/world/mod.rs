@@ -17,7 +17,9 @@ use crate::error::DeviceError;
 use crate::event::{SimEvent, SimEventKind};
 use crate::fault::{Fault, FaultKind};
 use crate::ids::{FeederId, Line, PalletId, RobotId, Role, Station};
-use crate::layout::{CHIP_X, FEEDER_X, LOAD_X, REACH_TOLERANCE, ZONE_CENTRE, line_y};
+use crate::layout::{
+    CHIP_X, FEEDER_X, LOAD_X, REACH_TOLERANCE, REFILL_CHIPS, REFILL_DELAY, ZONE_CENTRE, line_y,
+};
 use crate::rng::Rng;
 use crate::scara::Elbow;
 
@@ -43,6 +45,8 @@ pub(crate) struct Feeder {
     pub(crate) chip: u32,
     pub(crate) stock: u32,
     at: [f32; 2],
+    /// When the operator, who saw it empty, will have refilled it.
+    refill_at: Option<Instant>,
 }
 
 /// The chip numbers of the feeders, as in the Appendix's work schedule (GRASP(1), GRASP(4),
@@ -61,6 +65,7 @@ pub(crate) struct World {
     last_step: Option<Instant>,
     next_pallet: u32,
     pending: Vec<SimEvent>,
+    rng: Rng,
 }
 
 /// Where each robot stands: its base, its resting tool position, its elbow side, and (for the
@@ -127,8 +132,12 @@ impl World {
             .map(|(index, &chip)| Feeder {
                 id: FeederId(index as u8),
                 chip,
-                stock: stocks.map_or_else(|| rng.range(150, 250), |stocks| stocks[index]),
+                stock: stocks.map_or_else(
+                    || rng.range(REFILL_CHIPS.0, REFILL_CHIPS.1),
+                    |stocks| stocks[index],
+                ),
                 at: [FEEDER_X[index], ZONE_CENTRE[1]],
+                refill_at: None,
             })
             .collect();
         let mut world = Self {
@@ -142,6 +151,7 @@ impl World {
             last_step: None,
             next_pallet: 0,
             pending: Vec::new(),
+            rng,
         };
         world.physics.detect();
         world
@@ -155,6 +165,7 @@ impl World {
     /// Advances the world to `now`: pallets, arms, collision detection, and what it measured.
     pub(crate) fn step(&mut self, now: Instant) -> Vec<SimEvent> {
         self.apply_due_faults(now);
+        self.refill_due(now);
         let seconds = self.last_step.map_or(0.0, |last| {
             now.saturating_duration_since(last).as_secs_f32()
         });
@@ -212,6 +223,35 @@ impl World {
                     }
                     _ => {}
                 }
+            }
+        }
+    }
+
+    /// The feeder `feeder`, once the operator's refills due by `now` are done.
+    pub(crate) fn feeder(&mut self, feeder: FeederId, now: Instant) -> Option<&mut Feeder> {
+        self.refill_due(now);
+        self.feeders.iter_mut().find(|f| f.id == feeder)
+    }
+
+    /// Calls the operator to a feeder found empty; it will be refilled after a while.
+    pub(crate) fn report_empty(&mut self, feeder: FeederId, now: Instant) {
+        if let Some(feeder) = self.feeders.iter_mut().find(|f| f.id == feeder) {
+            feeder.refill_at.get_or_insert(now + REFILL_DELAY);
+        }
+    }
+
+    fn refill_due(&mut self, now: Instant) {
+        for feeder in &mut self.feeders {
+            if feeder.refill_at.is_some_and(|at| at <= now) {
+                feeder.refill_at = None;
+                feeder.stock = self.rng.range(REFILL_CHIPS.0, REFILL_CHIPS.1);
+                self.pending.push(SimEvent {
+                    at: now,
+                    kind: SimEventKind::FeederRefilled {
+                        feeder: feeder.id,
+                        chips: feeder.stock,
+                    },
+                });
             }
         }
     }
