@@ -1,0 +1,90 @@
+//! A query into a response handler through the order scheduler, with the responder idle and
+//! with the responder in a lower-ranked section at a suspension point; the same-thread
+//! send/receive/reply round trip as baseline.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use imrs_benches::current_thread;
+use imrs_core::prelude::*;
+use imrs_ports::RealClock;
+
+/// `iters` queries of a module whose task is `busy` (in INSERT, yielding at every turn) or
+/// idle (parked in its background code).
+fn query(iters: u64, busy: bool) -> Duration {
+    current_thread().block_on(async move {
+        let cell = Cell::new(std::sync::Arc::new(RealClock::new()));
+        let port = Port::<u64, u64, usage::Query>::declare(PortSpec::new("STATUS", "ASKER"));
+        let responder = ModuleSpec::new("ROBOT", 7u64)
+            // The handler outranks the background (idle: parked there) and INSERT (busy).
+            .order(["STATUS.STATE", "ROBOT", "INSERT"])
+            .sections(["INSERT"])
+            .response(
+                "STATUS.STATE",
+                port.responder_named("ROBOT", |s: &u64, q: u64| s + q)
+                    .unwrap(),
+            )
+            .task("ROBOT", move |ctx| async move {
+                if busy {
+                    // In INSERT, ranked below the handler: each suspension point admits it.
+                    ctx.section("INSERT", async {
+                        loop {
+                            tokio::task::yield_now().await;
+                        }
+                    })
+                    .await;
+                }
+                std::future::pending::<()>().await;
+                Ok(())
+            });
+        let robot = cell.start(responder);
+        let mut asker = port.owner().unwrap();
+        let start = Instant::now();
+        for n in 0..iters {
+            black_box(asker.query(black_box(n)).await.unwrap());
+        }
+        let timed = start.elapsed();
+        robot.stop();
+        timed
+    })
+}
+
+/// The same-thread rendezvous, for the ratio.
+fn rendezvous(iters: u64) -> Duration {
+    current_thread().block_on(async move {
+        let port = Port::<u64, u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let mut server = port.owner().unwrap();
+        let mut client = port.user_named("CLIENT").unwrap();
+        tokio::spawn(async move {
+            while let Ok((n, reply)) = server.receive().await {
+                reply.reply(n + 7);
+            }
+        });
+        let start = Instant::now();
+        for n in 0..iters {
+            black_box(client.send(black_box(n)).await.unwrap());
+        }
+        start.elapsed()
+    })
+}
+
+fn benches(c: &mut Criterion) {
+    let mut group = c.benchmark_group("query");
+    group.bench_function("responder_idle", |b| b.iter_custom(|n| query(n, false)));
+    group.bench_function("responder_in_lower_section", |b| {
+        b.iter_custom(|n| query(n, true))
+    });
+    group.bench_function("same_thread_rendezvous", |b| b.iter_custom(rendezvous));
+    group.finish();
+}
+
+criterion_group! {
+    name = query_benches;
+    config = Criterion::default()
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(20);
+    targets = benches
+}
+criterion_main!(query_benches);

@@ -1,0 +1,245 @@
+//! A send → receive → reply round trip: (a) between two tasks on one thread, (b) across two
+//! threads with the receiver parked, (c) across two threads on a TIGHT port; for an 8-byte
+//! and a 1 KiB message. Baselines in the same groups: tokio mpsc + oneshot "ask" on the
+//! current-thread and the multi-thread runtime, a crossbeam ping-pong, an atomic spin
+//! ping-pong.
+
+use std::hint::black_box;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::thread;
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use imrs_benches::{Tail, benchmarking, current_thread};
+use imrs_ports::{Port, PortSpec, ProcessType, usage};
+use tokio::sync::{mpsc, oneshot};
+
+type Ask<const N: usize> = (Box<[u8; N]>, oneshot::Sender<u64>);
+
+/// Runs `iters` round trips of `$round_trip` (an expression to await), timing all of them,
+/// and each one into `$tail` when there is one.
+macro_rules! round_trips {
+    ($iters:expr, $tail:expr, $round_trip:expr) => {{
+        let mut tail: Option<&mut Tail> = $tail;
+        let start = Instant::now();
+        for _ in 0..$iters {
+            let one = Instant::now();
+            black_box($round_trip.await.unwrap());
+            if let Some(tail) = tail.as_deref_mut() {
+                tail.push(one.elapsed());
+            }
+        }
+        start.elapsed()
+    }};
+}
+
+/// imrs, both ends on one current-thread runtime.
+fn imrs_same_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
+    current_thread().block_on(async move {
+        let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let mut server = port.owner().unwrap();
+        let mut client = port.user_named("CLIENT").unwrap();
+        let serving = tokio::spawn(async move {
+            for _ in 0..iters {
+                let (message, reply) = server.receive().await.unwrap();
+                reply.reply(u64::from(message[0]));
+            }
+        });
+        let timed = round_trips!(iters, tail, client.send(black_box([1u8; N])));
+        serving.await.unwrap();
+        timed
+    })
+}
+
+/// imrs, the receiver on its own thread (parked between messages, or spinning on TIGHT).
+fn imrs_cross_thread<const N: usize>(
+    iters: u64,
+    process_type: ProcessType,
+    tail: Option<&mut Tail>,
+) -> Duration {
+    let port = Port::<[u8; N], u64, usage::Receive>::declare(
+        PortSpec::new("P", "SERVER").process_type(process_type),
+    );
+    let mut server = port.owner().unwrap();
+    let mut client = port.user_named("CLIENT").unwrap();
+    let serving = thread::spawn(move || {
+        current_thread().block_on(async move {
+            for _ in 0..iters {
+                let (message, reply) = server.receive().await.unwrap();
+                reply.reply(u64::from(message[0]));
+            }
+        })
+    });
+    let timed = current_thread()
+        .block_on(async { round_trips!(iters, tail, client.send(black_box([1u8; N]))) });
+    serving.join().unwrap();
+    timed
+}
+
+/// An ask: the message and a oneshot for the answer, the usual tokio actor pattern.
+async fn ask<const N: usize>(asks: &mpsc::Sender<Ask<N>>) -> Result<u64, &'static str> {
+    let (reply, answer) = oneshot::channel();
+    asks.send((Box::new(black_box([1u8; N])), reply))
+        .await
+        .map_err(|_| "closed")?;
+    answer.await.map_err(|_| "dropped")
+}
+
+async fn serve_asks<const N: usize>(mut inbox: mpsc::Receiver<Ask<N>>) {
+    while let Some((message, reply)) = inbox.recv().await {
+        let _ = reply.send(u64::from(message[0]));
+    }
+}
+
+/// tokio mpsc + oneshot, server task on the same current-thread runtime.
+fn tokio_ask_current_thread<const N: usize>(iters: u64) -> Duration {
+    current_thread().block_on(async move {
+        let (asks, inbox) = mpsc::channel::<Ask<N>>(1);
+        let serving = tokio::spawn(serve_asks(inbox));
+        let timed = round_trips!(iters, None, ask(&asks));
+        drop(asks);
+        serving.await.unwrap();
+        timed
+    })
+}
+
+/// tokio mpsc + oneshot, server on a multi-thread runtime, asked from another thread.
+fn tokio_ask_multi_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap();
+    let (asks, inbox) = mpsc::channel::<Ask<N>>(1);
+    runtime.spawn(serve_asks(inbox));
+    current_thread().block_on(async { round_trips!(iters, tail, ask(&asks)) })
+}
+
+/// crossbeam channels, ping-pong between two threads.
+fn crossbeam_ping_pong<const N: usize>(iters: u64) -> Duration {
+    let (ping, pinged) = crossbeam_channel::bounded::<[u8; N]>(1);
+    let (pong, ponged) = crossbeam_channel::bounded::<u64>(1);
+    let serving = thread::spawn(move || {
+        for message in pinged.iter() {
+            pong.send(u64::from(message[0])).unwrap();
+        }
+    });
+    let start = Instant::now();
+    for _ in 0..iters {
+        ping.send(black_box([1u8; N])).unwrap();
+        black_box(ponged.recv().unwrap());
+    }
+    let timed = start.elapsed();
+    drop(ping);
+    serving.join().unwrap();
+    timed
+}
+
+/// Two threads spinning on one atomic: the cache-line floor of a cross-thread round trip.
+fn atomic_spin_ping_pong(iters: u64, mut tail: Option<&mut Tail>) -> Duration {
+    let turn = Arc::new(AtomicU64::new(0));
+    let other = Arc::clone(&turn);
+    let serving = thread::spawn(move || {
+        for round in 0..iters {
+            while other.load(Ordering::Acquire) != 2 * round + 1 {
+                std::hint::spin_loop();
+            }
+            other.store(2 * round + 2, Ordering::Release);
+        }
+    });
+    let start = Instant::now();
+    for round in 0..iters {
+        let one = Instant::now();
+        turn.store(2 * round + 1, Ordering::Release);
+        while turn.load(Ordering::Acquire) != 2 * round + 2 {
+            std::hint::spin_loop();
+        }
+        if let Some(tail) = tail.as_deref_mut() {
+            tail.push(one.elapsed());
+        }
+    }
+    let timed = start.elapsed();
+    serving.join().unwrap();
+    timed
+}
+
+fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
+    let mut group = c.benchmark_group("rendezvous_same_thread");
+    group.bench_function(BenchmarkId::new("imrs", size), |b| {
+        b.iter_custom(|n| imrs_same_thread::<N>(n, None))
+    });
+    group.bench_function(BenchmarkId::new("tokio_ask_current_thread", size), |b| {
+        b.iter_custom(tokio_ask_current_thread::<N>)
+    });
+    group.finish();
+
+    let mut group = c.benchmark_group("rendezvous_cross_thread_cold");
+    group.bench_function(BenchmarkId::new("imrs", size), |b| {
+        b.iter_custom(|n| imrs_cross_thread::<N>(n, ProcessType::Loose, None))
+    });
+    group.bench_function(BenchmarkId::new("tokio_ask_multi_thread", size), |b| {
+        b.iter_custom(|n| tokio_ask_multi_thread::<N>(n, None))
+    });
+    group.bench_function(BenchmarkId::new("crossbeam_ping_pong", size), |b| {
+        b.iter_custom(crossbeam_ping_pong::<N>)
+    });
+    group.finish();
+
+    let mut group = c.benchmark_group("rendezvous_tight");
+    group.bench_function(BenchmarkId::new("imrs", size), |b| {
+        b.iter_custom(|n| imrs_cross_thread::<N>(n, ProcessType::Tight, None))
+    });
+    group.bench_function(BenchmarkId::new("atomic_spin_ping_pong", size), |b| {
+        b.iter_custom(|n| atomic_spin_ping_pong(n, None))
+    });
+    group.finish();
+}
+
+/// A round-trip driver: `n` round trips, each timed into the tail when one is given.
+type TimedRun = fn(u64, Option<&mut Tail>) -> Duration;
+
+/// p50, p99 and p99.9 of single round trips: robot cells care about the worst case.
+fn tails() {
+    let count = if benchmarking() { 20_000 } else { 50 };
+    let cases: [(&str, TimedRun); 5] = [
+        ("rendezvous_same_thread/imrs/8B", |n, t| {
+            imrs_same_thread::<8>(n, t)
+        }),
+        ("rendezvous_cross_thread_cold/imrs/8B", |n, t| {
+            imrs_cross_thread::<8>(n, ProcessType::Loose, t)
+        }),
+        (
+            "rendezvous_cross_thread_cold/tokio_ask_multi_thread/8B",
+            |n, t| tokio_ask_multi_thread::<8>(n, t),
+        ),
+        ("rendezvous_tight/imrs/8B", |n, t| {
+            imrs_cross_thread::<8>(n, ProcessType::Tight, t)
+        }),
+        (
+            "rendezvous_tight/atomic_spin_ping_pong/8B",
+            atomic_spin_ping_pong,
+        ),
+    ];
+    for (case, run) in cases {
+        let mut tail = Tail::with_capacity(count);
+        run(count as u64, Some(&mut tail));
+        tail.report(case);
+    }
+}
+
+fn rendezvous(c: &mut Criterion) {
+    sizes::<8>(c, "8B");
+    sizes::<1024>(c, "1KiB");
+    tails();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(20);
+    targets = rendezvous
+}
+criterion_main!(benches);

@@ -1,0 +1,62 @@
+//! The n-way rendezvous `waitfor`, for n = 2, 4, 16 and 64 tasks: the time of one round.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use imrs_benches::current_thread;
+use imrs_core::WaitFor;
+use imrs_ports::RealClock;
+
+/// `rounds` rounds of a waitfor of `n` tasks; the time from the first call to the last return.
+fn rounds(n: usize, rounds: u64) -> Duration {
+    current_thread().block_on(async move {
+        let names: Vec<String> = (0..n).map(|i| format!("T{i}")).collect();
+        let barrier = WaitFor::<u64>::new("MEET", names.clone(), Arc::new(RealClock::new()));
+        let start = Instant::now();
+        let tasks: Vec<_> = names
+            .into_iter()
+            .map(|name| {
+                let barrier = barrier.clone();
+                tokio::spawn(async move {
+                    for round in 0..rounds {
+                        let sum = barrier
+                            .waitfor(
+                                &name,
+                                round,
+                                |pool| pool.iter().map(|(_, m)| *m).sum::<u64>(),
+                                None,
+                            )
+                            .await
+                            .unwrap();
+                        std::hint::black_box(sum);
+                    }
+                })
+            })
+            .collect();
+        for task in tasks {
+            task.await.unwrap();
+        }
+        start.elapsed()
+    })
+}
+
+fn benches(c: &mut Criterion) {
+    let mut group = c.benchmark_group("waitfor");
+    for n in [2, 4, 16, 64] {
+        group.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter_custom(|iters| rounds(n, iters))
+        });
+    }
+    group.finish();
+}
+
+criterion_group! {
+    name = waitfor_benches;
+    config = Criterion::default()
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(20);
+    targets = benches
+}
+criterion_main!(waitfor_benches);
