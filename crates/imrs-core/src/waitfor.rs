@@ -115,6 +115,8 @@ struct Shared<M> {
 struct Round<M> {
     generation: u64,
     arrived: Vec<Option<M>>,
+    /// How many members have arrived this round: kept, so that an arrival costs O(1).
+    count: usize,
     wakers: Vec<Option<Waker>>,
     /// The pool of the last completed round, for members that have not picked it up yet.
     released: Option<Arc<Pool<M>>>,
@@ -145,6 +147,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 round: Mutex::new(Round {
                     generation: 0,
                     arrived: (0..count).map(|_| None).collect(),
+                    count: 0,
                     wakers: vec![None; count],
                     released: None,
                 }),
@@ -189,8 +192,9 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 });
             }
             round.arrived[index] = Some(message);
+            round.count += 1;
             let generation = round.generation;
-            if round.arrived.iter().all(Option::is_some) {
+            if round.count == round.arrived.len() {
                 self.release(&mut round);
             }
             generation
@@ -227,6 +231,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             let message = round.arrived[index]
                 .take()
                 .expect("the caller's message waits");
+            round.count -= 1;
             let missing = shared
                 .members
                 .iter()
@@ -251,6 +256,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             .iter_mut()
             .map(|slot| slot.take().expect("every member arrived"))
             .collect();
+        round.count = 0;
         round.released = Some(Arc::new(Pool {
             members: Arc::clone(&self.shared.members),
             messages,
