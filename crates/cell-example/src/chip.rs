@@ -8,7 +8,7 @@ use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{DeviceError, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{insisted, retried};
+use crate::help::{drive_relay, insisted, retried};
 use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
 use crate::ports::{CellPorts, ZonePort};
 
@@ -274,25 +274,8 @@ pub fn chip_it(
             let (port, relay) = (freeze_port.clone(), relay.clone());
             async move {
                 let mut ready_to_chip = port.user_named("FREEZE_CARD")?;
-                loop {
-                    match relay.wait_in_place().await {
-                        Ok(pallet) => {
-                            while let Err(error) = ctx.send(&mut ready_to_chip, pallet).await {
-                                ctx.alarm(format!("{pallet}: {error}; asking again"));
-                                ctx.delay(Duration::from_secs(1)).await;
-                            }
-                            if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
-                                ctx.alarm(format!("{error}: taking the pallet off the line"));
-                                relay.clear_jam();
-                            }
-                        }
-                        Err(error @ DeviceError::Jam { .. }) => {
-                            ctx.alarm(format!("{error}: taking the pallet off the line"));
-                            relay.clear_jam();
-                        }
-                        Err(error) => return Err(error.into()),
-                    }
-                }
+                drive_relay(&ctx, &relay, &mut ready_to_chip).await?;
+                Ok(())
             }
         })
         .exception(

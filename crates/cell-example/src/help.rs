@@ -3,8 +3,9 @@
 use std::future::Future;
 use std::time::Duration;
 
-use imrs_sim::DeviceError;
 use imrs_sim::imrs_core::Ctx;
+use imrs_sim::imrs_core::imrs_ports::{End, usage};
+use imrs_sim::{DeviceError, PalletId, Relay};
 
 /// How long an operator takes to reset a faulted robot.
 pub const RESET_TIME: Duration = Duration::from_secs(1);
@@ -46,5 +47,38 @@ where
             "{error} while {what}: reset by the operator, retrying"
         ));
         ctx.delay(RESET_TIME).await;
+    }
+}
+
+/// A freeze-relay driver task (FREEZE_PALLET, FREEZE_CARD): it waits for a pallet to be held
+/// in place, sends on `port` and waits for the module to let the pallet go, then frees it.
+/// A jammed pallet is taken off the line, with an alarm.
+pub async fn drive_relay<S>(
+    ctx: &Ctx<S>,
+    relay: &Relay,
+    port: &mut End<PalletId, (), usage::Send>,
+) -> Result<(), DeviceError>
+where
+    S: Send + Sync + 'static,
+{
+    loop {
+        match relay.wait_in_place().await {
+            Ok(pallet) => {
+                // Hold the pallet until the module (or a new copy of it) lets it go.
+                while let Err(error) = ctx.send(port, pallet).await {
+                    ctx.alarm(format!("{pallet}: {error}; asking again"));
+                    ctx.delay(RESET_TIME).await;
+                }
+                if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
+                    ctx.alarm(format!("{error}: taking the pallet off the line"));
+                    relay.clear_jam();
+                }
+            }
+            Err(error @ DeviceError::Jam { .. }) => {
+                ctx.alarm(format!("{error}: taking the pallet off the line"));
+                relay.clear_jam();
+            }
+            Err(error) => return Err(error),
+        }
     }
 }

@@ -5,9 +5,9 @@ use std::time::Duration;
 
 use imrs_sim::imrs_core::imrs_ports::Respond;
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::{DeviceError, Line, RobotId, Role, Sim, Station, Target};
+use imrs_sim::{Line, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{insisted, retried};
+use crate::help::{drive_relay, insisted, retried};
 use crate::names::LineNames;
 use crate::ports::LinePorts;
 
@@ -230,26 +230,8 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
         let (port, relay) = (freeze_port.clone(), relay.clone());
         async move {
             let mut pallet_in_place = port.user_named("FREEZE_PALLET")?;
-            loop {
-                match relay.wait_in_place().await {
-                    Ok(pallet) => {
-                        // Hold the pallet until LOAD_CARD (or a new copy of it) lets it go.
-                        while let Err(error) = ctx.send(&mut pallet_in_place, pallet).await {
-                            ctx.alarm(format!("{pallet}: {error}; asking again"));
-                            ctx.delay(Duration::from_secs(1)).await;
-                        }
-                        if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
-                            ctx.alarm(format!("{error}: taking the pallet off the line"));
-                            relay.clear_jam();
-                        }
-                    }
-                    Err(error @ DeviceError::Jam { .. }) => {
-                        ctx.alarm(format!("{error}: taking the pallet off the line"));
-                        relay.clear_jam();
-                    }
-                    Err(error) => return Err(error.into()),
-                }
-            }
+            drive_relay(&ctx, &relay, &mut pallet_in_place).await?;
+            Ok(())
         }
     })
     .exception(

@@ -2,19 +2,14 @@
 //! background code. It is reported by module and port names, and broken by asymmetric
 //! timeouts.
 
+mod common;
+
+use common::{at, secs};
+
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
-
-fn secs(n: u64) -> Duration {
-    Duration::from_secs(n)
-}
-
-fn at(n: u64) -> Instant {
-    Instant::from_start(secs(n))
-}
 
 type Log = Arc<Mutex<Vec<(String, u64)>>>;
 

@@ -1,27 +1,13 @@
 //! The order scheduler against the Appendix's CHIP_IT and GATE orders, on a scripted
 //! virtual clock.
 
-use std::time::Duration;
+mod common;
+
+use common::{at, paused_runtime, secs};
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
 use imrs_ports::AnyUser;
-
-fn secs(n: u64) -> Duration {
-    Duration::from_secs(n)
-}
-
-fn at(n: u64) -> Instant {
-    Instant::from_start(secs(n))
-}
-
-fn paused_runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap()
-}
 
 /// The events of `module`, in order.
 fn events_of(cell: &Cell, module: &str) -> Vec<Event> {

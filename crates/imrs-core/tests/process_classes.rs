@@ -1,27 +1,14 @@
 //! One small cell per process class of seed 000, section 2.
 
+mod common;
+
+use common::{at, paused_runtime, secs};
+
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
 use imrs_ports::{AnyUser, RealClock};
-
-fn secs(n: u64) -> Duration {
-    Duration::from_secs(n)
-}
-
-fn at(n: u64) -> Instant {
-    Instant::from_start(secs(n))
-}
-
-fn paused_runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap()
-}
 
 /// Independent processes: two stations update a shared conveyor state only through its
 /// proprietor, which owns it; a reader queries it.

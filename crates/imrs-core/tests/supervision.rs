@@ -1,30 +1,17 @@
 //! Supervision: killed and failed modules and tasks, restarted copies, and ports that
 //! outlive them.
 
+mod common;
+
+use common::{at, paused_runtime, secs};
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::Duration;
 
 use imrs_core::TaskError;
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
 use imrs_ports::QueryError;
-
-fn secs(n: u64) -> Duration {
-    Duration::from_secs(n)
-}
-
-fn at(n: u64) -> Instant {
-    Instant::from_start(secs(n))
-}
-
-fn paused_runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap()
-}
 
 fn kinds_of(cell: &Cell, module: &str) -> Vec<(Instant, EventKind)> {
     cell.events()

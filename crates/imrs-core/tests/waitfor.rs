@@ -1,19 +1,15 @@
 //! waitfor and getmess: n-way rendezvous of named tasks.
 
+mod common;
+
+use common::paused_runtime;
+
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
 use imrs_core::{Pool, WaitFor, WaitForError};
-
-fn paused_runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap()
-}
 
 /// `n` tasks named T0..Tn each pool their number after `i` seconds; each combines the pool
 /// its own way (its number times 1000 plus the sum of all). Returns, for each task, its

@@ -1,0 +1,25 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code, unreachable_pub)]
+
+use std::time::Duration;
+
+use imrs_core::imrs_ports::Instant;
+
+/// `n` seconds.
+pub fn secs(n: u64) -> Duration {
+    Duration::from_secs(n)
+}
+
+/// The instant `n` seconds after the clock started.
+pub fn at(n: u64) -> Instant {
+    Instant::from_start(secs(n))
+}
+
+/// A current-thread runtime on tokio's paused clock, as `imrs_core::time::drive` wants it.
+pub fn paused_runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .start_paused(true)
+        .build()
+        .unwrap()
+}
