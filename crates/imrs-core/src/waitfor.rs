@@ -122,6 +122,17 @@ struct Round<M> {
     released: Option<Arc<Pool<M>>>,
 }
 
+impl<M> Round<M> {
+    /// The pool of round `generation`, once that round has been released.
+    fn pool_after(&self, generation: u64) -> Option<Arc<Pool<M>>> {
+        (self.generation > generation).then(|| {
+            self.released
+                .clone()
+                .expect("a released round keeps its pool")
+        })
+    }
+}
+
 impl<M> Clone for WaitFor<M> {
     fn clone(&self) -> Self {
         Self {
@@ -202,11 +213,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
         let mut deadline = pin!(timeout.map(|timeout| shared.clock.sleep(timeout)));
         let pool = poll_fn(|cx| {
             let mut round = self.lock();
-            if round.generation > generation {
-                let pool = round
-                    .released
-                    .clone()
-                    .expect("a released round keeps its pool");
+            if let Some(pool) = round.pool_after(generation) {
                 return Poll::Ready(Ok(pool));
             }
             round.wakers[index] = Some(cx.waker().clone());
@@ -219,12 +226,8 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 return Poll::Pending;
             }
             let mut round = self.lock();
-            if round.generation > generation {
-                // The last member came in just as the time ran out: the rendezvous wins.
-                let pool = round
-                    .released
-                    .clone()
-                    .expect("a released round keeps its pool");
+            // The last member may have come in just as the time ran out: the rendezvous wins.
+            if let Some(pool) = round.pool_after(generation) {
                 return Poll::Ready(Ok(pool));
             }
             round.wakers[index] = None;

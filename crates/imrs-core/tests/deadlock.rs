@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{at, secs};
+use common::{at, paused_runtime, secs};
 
 use std::sync::{Arc, Mutex};
 
@@ -68,12 +68,7 @@ fn chip_robot(
 
 #[test]
 fn the_chip_robots_deadlock_is_reported_and_broken_by_asymmetric_timeouts() {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap();
-    runtime.block_on(async {
+    paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         // SHARE_FEEDER (CHIP_IT's, TIMEOUT=3 SEC) and SHARE_FEEDER1 (CHIP_IT2's, 5 s): the
         // asymmetry decides who gives way.

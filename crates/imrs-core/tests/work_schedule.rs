@@ -1,5 +1,9 @@
 //! Work schedules: perform, more, reinstate, and a failing step that is skipped.
 
+mod common;
+
+use common::paused_runtime;
+
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -68,12 +72,7 @@ async fn perform_runs_the_most_urgent_step_first_and_more_counts_down() {
 
 #[test]
 fn an_empty_feeder_skips_its_step_and_the_others_still_run() {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .start_paused(true)
-        .build()
-        .unwrap();
-    runtime.block_on(async {
+    paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         let inserted = Arc::new(Mutex::new(Vec::new()));
         let seen = Arc::clone(&inserted);
