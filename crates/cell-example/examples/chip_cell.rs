@@ -7,7 +7,7 @@
 
 use std::process::ExitCode;
 
-use cell_example::{CellConfig, CellFault, FeederPolicy, Report, run, speed_line};
+use cell_example::{CellConfig, CellFault, FeederPolicy, MAX_HOURS, Report, run, speed_line};
 
 const USAGE: &str = "usage: chip_cell [--hours H] [--seed S] [--feeder arbiter|appendix] [--realtime] \
                      [--fault KIND[:WHICH]@TIME]... (KIND: release, robot, feeder, jam)";
@@ -29,9 +29,9 @@ fn parse(args: impl Iterator<Item = String>) -> Result<CellConfig, String> {
                 config.hours = text
                     .parse::<f64>()
                     .ok()
-                    .filter(|hours| hours.is_finite() && *hours > 0.0)
+                    .filter(|hours| hours.is_finite() && *hours > 0.0 && *hours <= MAX_HOURS)
                     .ok_or_else(|| {
-                        format!("--hours {text:?}: expected a positive number of hours")
+                        format!("--hours {text:?}: expected a number of hours above 0, at most {MAX_HOURS}")
                     })?;
             }
             "--seed" => {
@@ -73,7 +73,7 @@ fn main() -> ExitCode {
     let report = match run(&config) {
         Ok(record) => Report::of(&record),
         Err(problems) => {
-            eprintln!("the cell is wired wrong:\n{problems}");
+            eprintln!("{problems}");
             return ExitCode::FAILURE;
         }
     };
@@ -98,7 +98,7 @@ fn main() -> ExitCode {
             println!("feeder policies side by side (same seed, hours and faults):");
             print!("{}", Report::side_by_side(appendix, arbiter));
         }
-        Err(problems) => eprintln!("the other feeder policy could not run:\n{problems}"),
+        Err(problems) => eprintln!("the other feeder policy could not run: {problems}"),
     }
     println!();
     println!("{}", speed_line(&report));

@@ -48,6 +48,9 @@ impl fmt::Display for FaultParseError {
 
 impl std::error::Error for FaultParseError {}
 
+/// The latest time a fault may be set for: a year.
+const MAX_FAULT_SECONDS: f64 = 365.0 * 24.0 * 3600.0;
+
 fn parse_time(text: &str) -> Option<Duration> {
     let (number, unit) = match text.char_indices().last()? {
         (at, 's') => (&text[..at], 1.0),
@@ -55,8 +58,10 @@ fn parse_time(text: &str) -> Option<Duration> {
         (at, 'h') => (&text[..at], 3600.0),
         _ => (text, 1.0),
     };
-    let seconds: f64 = number.parse().ok()?;
-    (seconds.is_finite() && seconds >= 0.0).then(|| Duration::from_secs_f64(seconds * unit))
+    let seconds = number.parse::<f64>().ok()? * unit;
+    // Beyond a year no run reaches it; the bound also keeps `Duration` from overflowing.
+    (seconds.is_finite() && (0.0..=MAX_FAULT_SECONDS).contains(&seconds))
+        .then(|| Duration::from_secs_f64(seconds))
 }
 
 fn parse_line(which: Option<&str>) -> Option<Line> {
@@ -76,8 +81,9 @@ impl FromStr for CellFault {
             why,
         };
         let (what, time) = value.split_once('@').ok_or_else(|| refuse("no @TIME"))?;
-        let at = parse_time(time)
-            .ok_or_else(|| refuse("the time is not a number of seconds, minutes or hours"))?;
+        let at = parse_time(time).ok_or_else(|| {
+            refuse("the time is not a number of seconds, minutes or hours within a year")
+        })?;
         let (kind, which) = match what.split_once(':') {
             Some((kind, which)) => (kind, Some(which)),
             None => (what, None),
@@ -152,5 +158,7 @@ mod tests {
         assert!(error.contains("unknown kind"), "{error}");
         let error = "jam@soon".parse::<CellFault>().unwrap_err().to_string();
         assert!(error.contains("the time is not a number"), "{error}");
+        let error = "jam@1e300h".parse::<CellFault>().unwrap_err().to_string();
+        assert!(error.contains("within a year"), "{error}");
     }
 }

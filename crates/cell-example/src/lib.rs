@@ -26,4 +26,4 @@ pub mod run;
 pub use chip::FeederPolicy;
 pub use faults::{CellFault, CellFaultKind};
 pub use report::{Report, speed_line};
-pub use run::{CellConfig, RunRecord, run};
+pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, run};

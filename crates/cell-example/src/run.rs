@@ -66,15 +66,49 @@ pub struct RunRecord {
     pub wall: Duration,
 }
 
+/// The longest run: a year of shifts.
+pub const MAX_HOURS: f64 = 8760.0;
+
+/// Why a run could not be made.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunError {
+    /// The cell is wired wrong: every problem, each naming its module and port.
+    Wiring(CellErrors),
+    /// The simulated hours are not a number above 0 and at most [`MAX_HOURS`].
+    Hours(f64),
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Wiring(problems) => write!(f, "the cell is wired wrong:\n{problems}"),
+            Self::Hours(hours) => {
+                write!(
+                    f,
+                    "{hours} hours: expected a number of hours above 0, at most {MAX_HOURS}"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
 /// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.
-pub fn run(config: &CellConfig) -> Result<RunRecord, CellErrors> {
+pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
+    let hours_ok = config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS;
+    if !hours_ok {
+        return Err(RunError::Hours(config.hours));
+    }
     let wall = std::time::Instant::now();
     let mut record = if config.realtime {
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .enable_all()
             .build()
             .expect("a tokio runtime starts");
-        runtime.block_on(simulate(config, Arc::new(RealClock::new()), None))
+        runtime
+            .block_on(simulate(config, Arc::new(RealClock::new()), None))
+            .map_err(RunError::Wiring)
     } else {
         let runtime = tokio::runtime::Builder::new_current_thread()
             .enable_all()
@@ -82,7 +116,9 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, CellErrors> {
             .build()
             .expect("a tokio runtime starts");
         let clock = VirtualClock::new();
-        runtime.block_on(simulate(config, Arc::new(clock.clone()), Some(clock)))
+        runtime
+            .block_on(simulate(config, Arc::new(clock.clone()), Some(clock)))
+            .map_err(RunError::Wiring)
     }?;
     record.wall = wall.elapsed();
     Ok(record)
