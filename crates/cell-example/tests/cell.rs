@@ -136,7 +136,15 @@ fn the_appendix_policy_deadlocks_as_the_paper_predicts_and_the_timeouts_break_it
 fn hours_out_of_range_are_refused_not_panicked_on() {
     for hours in [0.0, -1.0, f64::NAN, 1e300] {
         let refused = run(&config(hours, 1, FeederPolicy::Arbiter)).unwrap_err();
-        assert!(matches!(refused, cell_example::RunError::Hours(_)), "{refused}");
-        assert!(refused.to_string().contains("expected a number of hours above 0"), "{refused}");
+        assert!(
+            matches!(refused, cell_example::RunError::Hours(_)),
+            "{refused}"
+        );
+        assert!(
+            refused
+                .to_string()
+                .contains("expected a number of hours above 0"),
+            "{refused}"
+        );
     }
 }

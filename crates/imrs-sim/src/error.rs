@@ -19,6 +19,11 @@ pub enum DeviceError {
         /// The target, in metres.
         target: [i32; 2],
     },
+    /// No feeder has that number.
+    UnknownFeeder {
+        /// The feeder asked for.
+        feeder: FeederId,
+    },
     /// The feeder has no chips left.
     EmptyFeeder {
         /// The feeder.
@@ -72,6 +77,7 @@ impl fmt::Display for DeviceError {
                     target[0], target[1]
                 )
             }
+            Self::UnknownFeeder { feeder } => write!(f, "there is no {feeder}"),
             Self::EmptyFeeder { feeder, chip } => write!(f, "{feeder} (chip {chip}) is empty"),
             Self::NotThere { robot, at } => write!(f, "{robot} is not at the {at}"),
             Self::NothingHeld { robot } => write!(f, "{robot} holds nothing"),

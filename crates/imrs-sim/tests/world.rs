@@ -363,3 +363,42 @@ fn a_feeder_found_empty_is_refilled_by_the_operator_later() {
         assert_eq!(refills.len(), 1);
     });
 }
+
+#[test]
+fn an_unknown_feeder_or_a_point_that_is_no_point_is_refused() {
+    paused_runtime().block_on(async {
+        let (sim, clock) = cell(None);
+        let robot = sim.robot(CHIP_A);
+        let tries = tokio::spawn(async move {
+            (
+                robot.move_to(Target::Feeder(FeederId(9))).await,
+                robot.grasp(FeederId(9)).await,
+                robot.move_to(Target::Point([f32::NAN, 0.0])).await,
+                robot.move_to(Target::Point([10.0, 10.0])).await,
+            )
+        });
+        drive(&clock, secs(1.0)).await;
+        let (moved, grasped, nan, far) = tries.await.unwrap();
+        assert_eq!(
+            moved,
+            Err(DeviceError::UnknownFeeder {
+                feeder: FeederId(9)
+            })
+        );
+        assert_eq!(
+            grasped,
+            Err(DeviceError::UnknownFeeder {
+                feeder: FeederId(9)
+            })
+        );
+        assert_eq!(grasped.unwrap_err().to_string(), "there is no feeder-9");
+        assert!(matches!(nan, Err(DeviceError::OutOfReach { .. })));
+        assert!(matches!(
+            far,
+            Err(DeviceError::OutOfReach {
+                target: [10000, 10000],
+                ..
+            })
+        ));
+    });
+}

@@ -37,15 +37,7 @@ impl Robot {
     pub async fn move_to(&self, target: Target) -> Result<(), DeviceError> {
         let robot = self.id;
         let duration = self.sim.with(|world, now| {
-            if !world.reaches(robot, target) {
-                let point = world.point_of(robot, target);
-                let millimetres = point.map(|metres| (metres * 1000.0).round() as i32);
-                return Err(DeviceError::OutOfReach {
-                    robot,
-                    target: millimetres,
-                });
-            }
-            let to = world.point_of(robot, target);
+            let to = world.reachable(robot, target)?;
             Ok(world.arm(robot).start_move(now, to))
         })?;
         self.sim.wake_stepper();
@@ -66,7 +58,7 @@ impl Robot {
         self.sim.with(|world, now| {
             let feeder = world
                 .feeder(feeder, now)
-                .expect("a robot at a feeder names an existing feeder");
+                .ok_or(DeviceError::UnknownFeeder { feeder })?;
             if feeder.stock == 0 {
                 let (id, chip) = (feeder.id, feeder.chip);
                 world.report_empty(id, now);
@@ -169,7 +161,10 @@ impl Robot {
 
     fn require_at(&self, target: Target, what: &'static str) -> Result<(), DeviceError> {
         let robot = self.id;
-        let there = self.sim.with(|world, now| world.is_at(robot, target, now));
+        let there = self.sim.with(|world, now| {
+            world.point_of(robot, target)?;
+            Ok::<_, DeviceError>(world.is_at(robot, target, now))
+        })?;
         if there {
             Ok(())
         } else {

@@ -339,29 +339,36 @@ impl World {
         (&mut self.arms[robot.index()], &mut self.physics)
     }
 
-    /// The point a robot's target names.
-    pub(crate) fn point_of(&self, robot: RobotId, target: Target) -> [f32; 2] {
+    /// The point a robot's target names: an unknown feeder, or a point that is no point, is
+    /// an error.
+    pub(crate) fn point_of(&self, robot: RobotId, target: Target) -> Result<[f32; 2], DeviceError> {
         let y = line_y(robot.line.index());
         match target {
-            Target::Home => self.arms[robot.index()].home,
+            Target::Home => Ok(self.arms[robot.index()].home),
             Target::Feeder(feeder) => self
                 .feeders
                 .iter()
                 .find(|f| f.id == feeder)
-                .map_or(self.arms[robot.index()].home, |f| f.at),
-            Target::Card => match robot.role {
+                .map(|f| f.at)
+                .ok_or(DeviceError::UnknownFeeder { feeder }),
+            Target::Card => Ok(match robot.role {
                 Role::LoadCard | Role::ScrewInCard => [LOAD_X, y],
                 Role::ChipIt => [CHIP_X, y],
-            },
-            Target::Magazine => magazine(robot.line),
-            Target::Point(point) => point,
+            }),
+            Target::Magazine => Ok(magazine(robot.line)),
+            Target::Point(point) if point.iter().all(|c| c.is_finite()) => Ok(point),
+            Target::Point(_) => Err(DeviceError::OutOfReach {
+                robot,
+                target: [i32::MAX, i32::MAX],
+            }),
         }
     }
 
     /// Whether `robot`'s tool is (now) at `target`.
     pub(crate) fn is_at(&self, robot: RobotId, target: Target, now: Instant) -> bool {
         let arm = &self.arms[robot.index()];
-        distance(arm.tool_at(now), self.point_of(robot, target)) <= REACH_TOLERANCE
+        self.point_of(robot, target)
+            .is_ok_and(|point| distance(arm.tool_at(now), point) <= REACH_TOLERANCE)
     }
 
     pub(crate) fn station_of(robot: RobotId) -> Station {
@@ -421,10 +428,21 @@ impl World {
             .collect()
     }
 
-    /// How long a move of `robot` to `target` would take from where it is now.
-    pub(crate) fn reaches(&self, robot: RobotId, target: Target) -> bool {
-        let point = self.point_of(robot, target);
-        self.arms[robot.index()].reaches(point)
+    /// The point of `target`, if `robot` can reach it.
+    pub(crate) fn reachable(
+        &self,
+        robot: RobotId,
+        target: Target,
+    ) -> Result<[f32; 2], DeviceError> {
+        let point = self.point_of(robot, target)?;
+        if self.arms[robot.index()].reaches(point) {
+            Ok(point)
+        } else {
+            Err(DeviceError::OutOfReach {
+                robot,
+                target: point.map(|metres| (metres * 1000.0).round() as i32),
+            })
+        }
     }
 }
 
