@@ -259,3 +259,18 @@ fn a_tight_port_round_trips_across_threads() {
         serving.await.unwrap();
     });
 }
+
+#[test]
+fn an_endless_timeout_on_the_real_clock_is_no_overflow() {
+    on_both_runtimes(|| async {
+        let port = Port::<u8, u8, usage::Receive>::declare(
+            PortSpec::new("P", "OWNER").timeout(Duration::MAX),
+        );
+        let mut owner = port.owner().unwrap();
+        let mut user = port.user_named("USER").unwrap().with_timeout(Duration::MAX);
+        let sending = tokio::spawn(async move { user.send(3).await });
+        let (message, reply) = owner.receive().await.unwrap();
+        reply.reply(message + 1);
+        assert_eq!(sending.await.unwrap().unwrap(), 4);
+    });
+}

@@ -1,3 +1,5 @@
+use std::time::Duration;
+
 use super::{Clock, Instant, Sleep};
 
 /// The wall clock, through tokio's timer.
@@ -30,7 +32,13 @@ impl Clock for RealClock {
     }
 
     fn sleep_until(&self, deadline: Instant) -> Sleep {
-        let at = self.start + deadline.since_start();
+        // A deadline past what the system clock can name (a `Duration::MAX` timeout) is
+        // as good as never: thirty years out.
+        let never = Duration::from_secs(30 * 365 * 24 * 3600);
+        let at = self
+            .start
+            .checked_add(deadline.since_start())
+            .unwrap_or_else(|| std::time::Instant::now() + never);
         Sleep::real(tokio::time::sleep_until(at.into()))
     }
 }
