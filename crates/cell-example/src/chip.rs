@@ -8,7 +8,7 @@ use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{DeviceError, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{drive_relay, insisted, retried};
+use crate::help::{drive_relay, insisted, retried, with_response};
 use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
 use crate::ports::{CellPorts, ZonePort};
 
@@ -129,10 +129,7 @@ pub fn chip_it(
     waits: SharedWaits,
 ) -> ModuleSpec<ChipItState> {
     let n = LineNames::of(line);
-    let twin_line = match line {
-        Line::A => Line::B,
-        Line::B => Line::A,
-    };
+    let twin_line = line.other();
     let twin = LineNames::of(twin_line);
     let crit_section = format!("{}.CRIT_SECTION", twin.share_feeder);
     let own_timeout = format!("{}.TIMEOUT", n.share_feeder);
@@ -156,8 +153,8 @@ pub fn chip_it(
         ])
         .owns(n.ready_to_chip.clone())
         .uses(n.frequency.clone(), UsageKind::Send);
-    let line_ports = &ports.lines[line.index_in_cell()];
-    let twin_ports = &ports.lines[twin_line.index_in_cell()];
+    let line_ports = &ports.lines[line.index()];
+    let twin_ports = &ports.lines[twin_line.index()];
     // The Appendix's feeder ports are declared under both policies, so that the module keeps
     // the Appendix's shape; under the arbiter nobody queries them.
     // WHEN SHARE_FEEDER1.CRIT_SECTION(CLEAR) ==> CLEAR := 1: the order decides when.
@@ -167,16 +164,7 @@ pub fn chip_it(
     spec = spec
         .owns(n.share_feeder.clone())
         .uses(twin.share_feeder.clone(), UsageKind::Response);
-    spec = match handler {
-        Ok(end) => spec.response(crit_section, end),
-        Err(error) => {
-            let reason = error.to_string();
-            spec.task("WIRING", move |_ctx| {
-                let reason = reason.clone();
-                async move { Err(reason.into()) }
-            })
-        }
-    };
+    spec = with_response(spec, crit_section, handler);
     if policy == FeederPolicy::Arbiter {
         spec = spec
             .uses(ZONE_REQUEST, UsageKind::Send)
@@ -288,7 +276,7 @@ pub fn chip_it(
 
 fn record_wait(waits: &SharedWaits, line: Line, ok: bool, waited: f64) {
     let mut waits = waits.lock().unwrap_or_else(PoisonError::into_inner);
-    let waits = &mut waits[line.index_in_cell()];
+    let waits = &mut waits[line.index()];
     waits.asks += 1;
     waits.refused += u32::from(!ok);
     waits.waited += waited;
@@ -353,18 +341,4 @@ pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {
                 }
             }
         })
-}
-
-/// A line's place in the cell's per-line arrays.
-pub(crate) trait LineIndex {
-    fn index_in_cell(self) -> usize;
-}
-
-impl LineIndex for Line {
-    fn index_in_cell(self) -> usize {
-        match self {
-            Line::A => 0,
-            Line::B => 1,
-        }
-    }
 }

@@ -3,11 +3,10 @@
 
 use std::time::Duration;
 
-use imrs_sim::imrs_core::imrs_ports::Respond;
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{drive_relay, insisted, retried};
+use crate::help::{drive_relay, insisted, retried, with_response};
 use crate::names::LineNames;
 use crate::ports::LinePorts;
 
@@ -30,35 +29,6 @@ pub struct LoadCardState {
     pub num_loaded: u32,
     /// CYCLE_TIME: the last cycle's time, in seconds.
     pub cycle_time: f64,
-}
-
-/// A module that cannot start because a port refused it: it fails at once, with the
-/// refusal as its reason, so that its supervisor reports it.
-fn refused<S: Send + Sync + 'static>(
-    spec: ModuleSpec<S>,
-    error: impl std::fmt::Display,
-) -> ModuleSpec<S> {
-    let reason = error.to_string();
-    spec.task("WIRING", move |_ctx| {
-        let reason = reason.clone();
-        async move { Err(reason.into()) }
-    })
-}
-
-/// Adds a response handler, or makes the module fail with the wiring error.
-fn with_response<S, E>(
-    spec: ModuleSpec<S>,
-    name: String,
-    end: Result<E, impl std::fmt::Display>,
-) -> ModuleSpec<S>
-where
-    S: Send + Sync + 'static,
-    E: Respond<S> + Send + 'static,
-{
-    match end {
-        Ok(end) => spec.response(name, end),
-        Err(error) => refused(spec, error),
-    }
 }
 
 /// The LOAD_IT module of `line`, which costarts LOAD_CARD and SCREW_IN_CARD.

@@ -72,10 +72,7 @@ fn secs(seconds: u64) -> Duration {
 impl LinePorts {
     fn declare(line: Line, clock: &SharedClock) -> Self {
         let n = LineNames::of(line);
-        let twin = LineNames::of(match line {
-            Line::A => Line::B,
-            Line::B => Line::A,
-        });
+        let twin = LineNames::of(line.other());
         Self {
             frequency: Frequency::declare(
                 spec(&n.frequency, &n.gate, clock)

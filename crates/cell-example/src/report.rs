@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 
 use imrs_sim::imrs_core::EventKind;
-use imrs_sim::{Line, PalletId, RobotId, SimEventKind};
+use imrs_sim::{PalletId, RobotId, SimEventKind};
 
 use crate::chip::{FeederPolicy, ZoneWaits};
 use crate::run::RunRecord;
@@ -79,13 +79,6 @@ pub struct Report {
     pub wall: f64,
 }
 
-fn line_index(line: Line) -> usize {
-    match line {
-        Line::A => 0,
-        Line::B => 1,
-    }
-}
-
 impl Report {
     /// The report of `record`.
     pub fn of(record: &RunRecord) -> Self {
@@ -103,14 +96,14 @@ impl Report {
         for event in &record.sim_events {
             let at = event.at.since_start().as_secs_f64();
             match &event.kind {
-                SimEventKind::PalletReleased { line, .. } => lines[line_index(*line)].released += 1,
+                SimEventKind::PalletReleased { line, .. } => lines[line.index()].released += 1,
                 SimEventKind::PalletDone { line, chips, .. } => {
-                    let figures = &mut lines[line_index(*line)];
+                    let figures = &mut lines[line.index()];
                     figures.completed += 1;
                     figures.chips += chips;
-                    done_at[line_index(*line)].push(at);
+                    done_at[line.index()].push(at);
                 }
-                SimEventKind::PalletScrapped { line, .. } => lines[line_index(*line)].scrapped += 1,
+                SimEventKind::PalletScrapped { line, .. } => lines[line.index()].scrapped += 1,
                 SimEventKind::CardPlaced { line, pallet } => {
                     placed.insert((*line, *pallet));
                 }
@@ -124,10 +117,10 @@ impl Report {
                     if !screwed.contains(&(*line, *pallet)) {
                         early_chip.push(*pallet);
                     }
-                    chips_inserted_after[line_index(*line)] = Some(at);
+                    chips_inserted_after[line.index()] = Some(at);
                 }
                 SimEventKind::ZoneEntered { robot } => {
-                    zone_entries[line_index(robot.line)] += 1;
+                    zone_entries[robot.line.index()] += 1;
                     if !inside.is_empty() {
                         zone_conflicts += 1;
                         shared_since = Some(at);
@@ -148,7 +141,7 @@ impl Report {
             figures.in_progress = record
                 .pallets_left
                 .iter()
-                .filter(|(l, _, _)| line_index(*l) == line)
+                .filter(|(l, _, _)| l.index() == line)
                 .count() as u32;
             let gaps: Vec<f64> = done_at[line]
                 .windows(2)

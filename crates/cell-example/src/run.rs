@@ -139,9 +139,8 @@ async fn simulate(
     // The load-time check, over every module the cell will run (children included).
     let mut declarations = Vec::new();
     for line in Line::ALL {
-        let lines = &ports.lines[line_index(line)];
-        declarations
-            .push(gate(line, lines, &sim, Arc::clone(&deaths[line_index(line)])).declaration());
+        let lines = &ports.lines[line.index()];
+        declarations.push(gate(line, lines, &sim, Arc::clone(&deaths[line.index()])).declaration());
         declarations.push(load_it(line, lines, &sim).declaration());
         declarations.push(load_card(line, lines, &sim).declaration());
         declarations.push(screw_in_card(line, lines, &sim).declaration());
@@ -159,8 +158,8 @@ async fn simulate(
         cell.start(feeder_monitor(&ports));
     }
     for line in Line::ALL {
-        let (lines, sim) = (ports.lines[line_index(line)].clone(), sim.clone());
-        let death = Arc::clone(&deaths[line_index(line)]);
+        let (lines, sim) = (ports.lines[line.index()].clone(), sim.clone());
+        let death = Arc::clone(&deaths[line.index()]);
         let (gate_lines, gate_sim) = (lines.clone(), sim.clone());
         cell.supervise(policy, move || {
             gate(line, &gate_lines, &gate_sim, Arc::clone(&death))
@@ -208,19 +207,12 @@ async fn simulate(
     })
 }
 
-fn line_index(line: Line) -> usize {
-    match line {
-        Line::A => 0,
-        Line::B => 1,
-    }
-}
-
 fn inject(config: &CellConfig, sim: &Sim, deaths: &[ReleaseDeath; 2]) {
     for fault in &config.faults {
         let at = Instant::from_start(fault.at);
         let kind = match fault.kind {
             CellFaultKind::ReleaseDies(line) => {
-                *deaths[line_index(line)]
+                *deaths[line.index()]
                     .lock()
                     .unwrap_or_else(PoisonError::into_inner) = Some(at);
                 continue;

@@ -7,9 +7,10 @@
 //! [`EventLog::subscribe`].
 
 use std::fmt;
-use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::{Instant, Name};
+
+use crate::log::{Log, Record};
 
 /// One thing that happened in a cell.
 #[derive(Debug, Clone, PartialEq)]
@@ -195,86 +196,19 @@ impl fmt::Display for Event {
     }
 }
 
-type Sink = Box<dyn FnMut(&Event) + Send>;
-
-/// The event log of a cell: kept in memory, and streamed to subscribers as it grows.
-#[derive(Default)]
-pub struct EventLog {
-    inner: Mutex<Inner>,
-}
-
-#[derive(Default)]
-struct Inner {
-    events: Vec<Event>,
-    forget: bool,
-    sinks: Vec<Sink>,
-}
-
-impl EventLog {
-    /// An empty log that keeps every event.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Stops keeping events in memory (subscribers still see them): for long runs.
-    pub fn forget_events(&self) {
-        let mut inner = self.lock();
-        inner.forget = true;
-        inner.events = Vec::new();
-    }
-
-    /// Calls `sink` with every event recorded from now on, in order.
-    pub fn subscribe(&self, sink: impl FnMut(&Event) + Send + 'static) {
-        self.lock().sinks.push(Box::new(sink));
-    }
-
-    /// Records `event`.
-    pub fn record(&self, event: Event) {
-        match &event.kind {
+impl Record for Event {
+    /// Trouble at `warn`, everything else at `debug`, under the `imrs` target.
+    fn trace(&self) {
+        match &self.kind {
             EventKind::Deadlock { .. }
             | EventKind::Alarm { .. }
-            | EventKind::ModuleFailed { .. } => {
-                tracing::warn!(target: "imrs", "{event}");
-            }
-            EventKind::TaskFailed { .. } | EventKind::ExceptionUnhandled { .. } => {
-                tracing::warn!(target: "imrs", "{event}");
-            }
-            _ => tracing::debug!(target: "imrs", "{event}"),
+            | EventKind::ModuleFailed { .. }
+            | EventKind::TaskFailed { .. }
+            | EventKind::ExceptionUnhandled { .. } => tracing::warn!(target: "imrs", "{self}"),
+            _ => tracing::debug!(target: "imrs", "{self}"),
         }
-        let mut inner = self.lock();
-        for sink in &mut inner.sinks {
-            sink(&event);
-        }
-        if !inner.forget {
-            inner.events.push(event);
-        }
-    }
-
-    /// Every event kept so far.
-    pub fn snapshot(&self) -> Vec<Event> {
-        self.lock().events.clone()
-    }
-
-    /// How many events are kept.
-    pub fn len(&self) -> usize {
-        self.lock().events.len()
-    }
-
-    /// Whether no event is kept.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    fn lock(&self) -> MutexGuard<'_, Inner> {
-        // A panicking sink leaves the log as it was before that event: still consistent.
-        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
     }
 }
 
-impl fmt::Debug for EventLog {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("EventLog")
-            .field("events", &self.len())
-            .finish()
-    }
-}
+/// The event log of a cell.
+pub type EventLog = Log<Event>;

@@ -1,9 +1,9 @@
 //! What the simulation measures, with virtual timestamps: the physical truth of a run.
 
 use std::fmt;
-use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use imrs_core::imrs_ports::Instant;
+use imrs_core::{Log, Record};
 
 use crate::fault::FaultKind;
 use crate::ids::{Line, PalletId, RobotId, Station};
@@ -167,59 +167,7 @@ impl fmt::Display for SimEvent {
     }
 }
 
-type Sink = Box<dyn FnMut(&SimEvent) + Send>;
+impl Record for SimEvent {}
 
 /// The stream of measured facts: kept, and passed to subscribers as they happen.
-#[derive(Default)]
-pub struct SimLog {
-    inner: Mutex<Inner>,
-}
-
-#[derive(Default)]
-struct Inner {
-    events: Vec<SimEvent>,
-    forget: bool,
-    sinks: Vec<Sink>,
-}
-
-impl SimLog {
-    /// Calls `sink` with every event from now on.
-    pub fn subscribe(&self, sink: impl FnMut(&SimEvent) + Send + 'static) {
-        self.lock().sinks.push(Box::new(sink));
-    }
-
-    /// Stops keeping events in memory (subscribers still see them): for long runs.
-    pub fn forget_events(&self) {
-        let mut inner = self.lock();
-        inner.forget = true;
-        inner.events = Vec::new();
-    }
-
-    /// Every event kept so far.
-    pub fn snapshot(&self) -> Vec<SimEvent> {
-        self.lock().events.clone()
-    }
-
-    pub(crate) fn record(&self, event: SimEvent) {
-        let mut inner = self.lock();
-        for sink in &mut inner.sinks {
-            sink(&event);
-        }
-        if !inner.forget {
-            inner.events.push(event);
-        }
-    }
-
-    fn lock(&self) -> MutexGuard<'_, Inner> {
-        // A panicking sink leaves the log as it was before that event.
-        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
-    }
-}
-
-impl fmt::Debug for SimLog {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("SimLog")
-            .field("events", &self.lock().events.len())
-            .finish()
-    }
-}
+pub type SimLog = Log<SimEvent>;

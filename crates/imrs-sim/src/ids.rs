@@ -15,8 +15,17 @@ impl Line {
     /// Both lines.
     pub const ALL: [Line; 2] = [Line::A, Line::B];
 
-    pub(crate) fn index(self) -> usize {
+    /// The line's place in per-line arrays: 0 for A, 1 for B.
+    pub fn index(self) -> usize {
         self as usize
+    }
+
+    /// The line beside this one.
+    pub fn other(self) -> Line {
+        match self {
+            Line::A => Line::B,
+            Line::B => Line::A,
+        }
     }
 }
 

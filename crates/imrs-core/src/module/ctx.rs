@@ -5,7 +5,7 @@
 use std::collections::VecDeque;
 use std::fmt;
 use std::future::Future;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
@@ -56,6 +56,9 @@ pub(crate) struct ModuleShared<S> {
     pub(crate) cell: Arc<CellShared>,
     raised: Mutex<VecDeque<Exception>>,
     restarts: Mutex<Vec<Name>>,
+    /// Set while `raised` or `restarts` may hold something, so that the scheduler, which
+    /// looks after every poll, takes no lock when (as nearly always) there is nothing.
+    pending: AtomicBool,
 }
 
 impl<S> ModuleShared<S> {
@@ -74,6 +77,7 @@ impl<S> ModuleShared<S> {
             cell,
             raised: Mutex::new(VecDeque::new()),
             restarts: Mutex::new(Vec::new()),
+            pending: AtomicBool::new(false),
         }
     }
 
@@ -94,14 +98,35 @@ impl<S> ModuleShared<S> {
             },
         );
         lock(&self.raised).push_back(exception);
+        self.pending.store(true, Ordering::Release);
     }
 
-    pub(crate) fn raised(&self) -> MutexGuard<'_, VecDeque<Exception>> {
-        lock(&self.raised)
+    /// Takes the first raised exception that `may_start` allows now.
+    pub(crate) fn take_raised(&self, may_start: impl Fn(&Exception) -> bool) -> Option<Exception> {
+        if !self.pending.load(Ordering::Acquire) {
+            return None;
+        }
+        let mut raised = lock(&self.raised);
+        let position = raised.iter().position(may_start)?;
+        raised.remove(position)
     }
 
+    /// Whether any raised exception waits for its handler.
+    pub(crate) fn has_raised(&self) -> bool {
+        self.pending.load(Ordering::Acquire) && !lock(&self.raised).is_empty()
+    }
+
+    /// The tasks that were asked to restart since the last call. Also clears the `pending`
+    /// flag, unless exceptions still wait (whoever pushes sets it again after pushing).
     pub(crate) fn take_restart_requests(&self) -> Vec<Name> {
-        std::mem::take(&mut *lock(&self.restarts))
+        if !self.pending.swap(false, Ordering::AcqRel) {
+            return Vec::new();
+        }
+        let requests = std::mem::take(&mut *lock(&self.restarts));
+        if !lock(&self.raised).is_empty() {
+            self.pending.store(true, Ordering::Release);
+        }
+        requests
     }
 }
 
@@ -331,6 +356,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// Asks the module to kill task `task` (if it runs) and start a new copy of it.
     pub fn restart_task(&self, task: impl Into<Name>) {
         lock(&self.module.restarts).push(task.into());
+        self.module.pending.store(true, Ordering::Release);
     }
 
     /// Kills the running copy of module `module` (a supervised one gets a new copy). Returns

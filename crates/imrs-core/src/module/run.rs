@@ -225,16 +225,12 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         loop {
             let host = self.host_rank();
             let admissible = |rank: Rank| host.is_none_or(|host| rank.outranks(host));
-            let mut raised = self.shared.raised();
-            let Some(position) = raised.iter().position(|exception| {
+            let Some(exception) = self.shared.take_raised(|exception| {
                 let rank = self.handler_for(&exception.name).map(|(rank, _)| rank);
                 rank.is_none_or(admissible)
             }) else {
-                drop(raised);
                 break;
             };
-            let exception = raised.remove(position).expect("found just above");
-            drop(raised);
             self.start_handler(exception);
             started = true;
         }
@@ -420,7 +416,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// How the module ends, once no thread can go on: every task finished, or some gave up
     /// (while another task lives, a handler may still start a new copy of a failed one).
     fn exit(&self) -> Option<ModuleExit> {
-        if !self.handlers.is_empty() || !self.shared.raised().is_empty() {
+        if !self.handlers.is_empty() || self.shared.has_raised() {
             return None;
         }
         let live = self

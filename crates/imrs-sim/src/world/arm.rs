@@ -60,6 +60,9 @@ pub(crate) struct Arm {
     pub(crate) holding: Option<Held>,
     links: [RigidBodyHandle; 2],
     pub(crate) colliders: [ColliderHandle; 2],
+    /// Whether the links were placed since the world last measured them: an arm that has not
+    /// moved cannot have entered the zone or touched another unmoved arm.
+    pub(crate) moved: bool,
 }
 
 impl Arm {
@@ -72,7 +75,7 @@ impl Arm {
     ) -> Self {
         let (link1, collider1) = physics.add_link(LINK_1);
         let (link2, collider2) = physics.add_link(LINK_2);
-        let arm = Self {
+        let mut arm = Self {
             id,
             base,
             home,
@@ -82,6 +85,7 @@ impl Arm {
             holding: None,
             links: [link1, link2],
             colliders: [collider1, collider2],
+            moved: true,
         };
         arm.place(physics, home);
         arm
@@ -136,7 +140,8 @@ impl Arm {
         self.settle(now, physics);
     }
 
-    fn place(&self, physics: &mut Physics, tool: [f32; 2]) {
+    fn place(&mut self, physics: &mut Physics, tool: [f32; 2]) {
+        self.moved = true;
         // Both ends of a move are within reach; a straight path between them that grazes
         // the dead zone around the base keeps the last placement for that step.
         if let Some(elbow) = elbow(self.base, tool, LINK_1, LINK_2, self.side) {

@@ -185,6 +185,9 @@ impl World {
     /// Zone occupancy and contacts between robots, from rapier.
     fn measure(&mut self, now: Instant, events: &mut Vec<SimEvent>) {
         for (index, arm) in self.arms.iter().enumerate() {
+            if !arm.moved {
+                continue;
+            }
             let inside = arm.colliders.iter().any(|&c| self.physics.in_zone(c));
             if inside != self.in_zone[index] {
                 self.in_zone[index] = inside;
@@ -199,6 +202,9 @@ impl World {
         }
         for a in 0..self.arms.len() {
             for b in a + 1..self.arms.len() {
+                if !self.arms[a].moved && !self.arms[b].moved {
+                    continue;
+                }
                 let contact = self.arms[a].colliders.iter().find_map(|&ca| {
                     self.arms[b]
                         .colliders
@@ -224,6 +230,9 @@ impl World {
                     _ => {}
                 }
             }
+        }
+        for arm in &mut self.arms {
+            arm.moved = false;
         }
     }
 
