@@ -1,4 +1,5 @@
-//! A send → receive → reply round trip: (a) between two tasks on one thread, (b) across two
+//! A send → receive → reply round trip: (a) between two modules on one processor (and, for
+//! comparison, as two tokio tasks on one thread), (b) across two
 //! threads with the receiver parked, (c) across two threads on a TIGHT port; for an 8-byte
 //! and a 1 KiB message. Baselines in the same groups: tokio mpsc + oneshot "ask" on the
 //! current-thread and the multi-thread runtime, a crossbeam ping-pong, an atomic spin
@@ -12,6 +13,7 @@ use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use imrs_benches::{Tail, benchmarking, current_thread};
+use imrs_core::Processor;
 use imrs_ports::{Port, PortSpec, ProcessType, usage};
 use tokio::sync::{mpsc, oneshot};
 
@@ -34,8 +36,40 @@ macro_rules! round_trips {
     }};
 }
 
-/// imrs, both ends on one current-thread runtime.
+/// imrs, both ends on one processor: the modules' own co-scheduling on one thread.
 fn imrs_same_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
+    let keep = tail.is_some();
+    let (timed, samples) = current_thread().block_on(async move {
+        let processor = Processor::new("CPU1");
+        let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let mut server = port.owner().unwrap();
+        let mut client = port.user_named("CLIENT").unwrap();
+        processor.spawn(async move {
+            for _ in 0..iters {
+                let (message, reply) = server.receive().await.unwrap();
+                reply.reply(u64::from(message[0]));
+            }
+        });
+        let (done, timed) = oneshot::channel();
+        processor.spawn(async move {
+            let mut samples = Tail::with_capacity(if keep { iters as usize } else { 0 });
+            let timed = round_trips!(
+                iters,
+                keep.then_some(&mut samples),
+                client.send(black_box([1u8; N]))
+            );
+            let _ = done.send((timed, samples));
+        });
+        timed.await.unwrap()
+    });
+    if let Some(tail) = tail {
+        tail.absorb(samples);
+    }
+    timed
+}
+
+/// imrs, each end a tokio task of its own on one current-thread runtime.
+fn imrs_same_thread_tasks<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
     current_thread().block_on(async move {
         let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().unwrap();
@@ -169,6 +203,9 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     group.bench_function(BenchmarkId::new("imrs", size), |b| {
         b.iter_custom(|n| imrs_same_thread::<N>(n, None))
     });
+    group.bench_function(BenchmarkId::new("imrs_two_tasks", size), |b| {
+        b.iter_custom(|n| imrs_same_thread_tasks::<N>(n, None))
+    });
     group.bench_function(BenchmarkId::new("tokio_ask_current_thread", size), |b| {
         b.iter_custom(tokio_ask_current_thread::<N>)
     });
@@ -202,9 +239,12 @@ type TimedRun = fn(u64, Option<&mut Tail>) -> Duration;
 /// p50, p99 and p99.9 of single round trips: robot cells care about the worst case.
 fn tails() {
     let count = if benchmarking() { 20_000 } else { 50 };
-    let cases: [(&str, TimedRun); 5] = [
+    let cases: [(&str, TimedRun); 6] = [
         ("rendezvous_same_thread/imrs/8B", |n, t| {
             imrs_same_thread::<8>(n, t)
+        }),
+        ("rendezvous_same_thread/imrs_two_tasks/8B", |n, t| {
+            imrs_same_thread_tasks::<8>(n, t)
         }),
         ("rendezvous_cross_thread_cold/imrs/8B", |n, t| {
             imrs_cross_thread::<8>(n, ProcessType::Loose, t)

@@ -58,6 +58,11 @@ impl Tail {
         self.samples.push(sample);
     }
 
+    /// Adds the samples of `other`, e.g. timed inside a task that had to own its record.
+    pub fn absorb(&mut self, other: Tail) {
+        self.samples.extend(other.samples);
+    }
+
     /// The `p`-th percentile (0 to 100).
     pub fn percentile(&mut self, p: f64) -> Duration {
         if self.samples.is_empty() {

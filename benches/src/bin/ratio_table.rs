@@ -45,6 +45,12 @@ fn main() {
             "<= 0.25",
         ));
         rows.push((
+            format!("rendezvous_same_thread/imrs_two_tasks/{size}"),
+            format!("rendezvous_same_thread/tokio_ask_current_thread/{size}"),
+            1.0,
+            "(one task per end)",
+        ));
+        rows.push((
             format!("rendezvous_cross_thread_cold/imrs/{size}"),
             format!("rendezvous_cross_thread_cold/tokio_ask_multi_thread/{size}"),
             1.0,

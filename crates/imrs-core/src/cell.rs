@@ -15,6 +15,7 @@ use crate::deadlock::WaitGraph;
 use crate::event::{Event, EventKind, EventLog};
 use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
 use crate::module::spec::{ModuleDecl, ModuleSpec};
+use crate::processor::Processor;
 use crate::supervision::RestartPolicy;
 
 pub(crate) struct CellShared {
@@ -179,6 +180,47 @@ impl Cell {
         )
     }
 
+    /// Starts `spec` as a top-level module on `processor`, co-scheduled with the other
+    /// modules there: a rendezvous between them does not go through the runtime.
+    pub fn start_on<S: Send + Sync + 'static>(
+        &self,
+        processor: &Processor,
+        spec: ModuleSpec<S>,
+    ) -> ModuleHandle {
+        let (handle, supervisor) = supervisor(
+            Arc::clone(&self.shared),
+            None,
+            RestartPolicy::NEVER,
+            spec,
+            None,
+        );
+        processor.spawn(supervisor);
+        handle
+    }
+
+    /// [`Cell::supervise`], on `processor`: every copy of the module runs there.
+    pub fn supervise_on<S, F>(
+        &self,
+        processor: &Processor,
+        policy: RestartPolicy,
+        mut factory: F,
+    ) -> ModuleHandle
+    where
+        S: Send + Sync + 'static,
+        F: FnMut() -> ModuleSpec<S> + Send + 'static,
+    {
+        let first = factory();
+        let (handle, supervisor) = supervisor(
+            Arc::clone(&self.shared),
+            None,
+            policy,
+            first,
+            Some(Box::new(factory)),
+        );
+        processor.spawn(supervisor);
+        handle
+    }
+
     /// Kills the running copy of `module`; a supervised module gets a new copy. Returns
     /// whether a module of that name runs.
     pub fn kill(&self, module: &str) -> bool {
@@ -256,15 +298,28 @@ impl ModuleHandle {
 
 type Factory<S> = Box<dyn FnMut() -> ModuleSpec<S> + Send>;
 
-/// Spawns the supervisor of one module: it runs copies of the module until one finishes,
-/// or the policy is spent, or the module is stopped.
+/// Spawns the supervisor of one module as a tokio task of its own.
 pub(crate) fn spawn_module<S: Send + Sync + 'static>(
     cell: Arc<CellShared>,
     parent: Option<Name>,
     policy: RestartPolicy,
     first: ModuleSpec<S>,
-    mut factory: Option<Factory<S>>,
+    factory: Option<Factory<S>>,
 ) -> ModuleHandle {
+    let (handle, supervisor) = supervisor(cell, parent, policy, first, factory);
+    tokio::spawn(supervisor);
+    handle
+}
+
+/// The supervisor of one module: it runs copies of the module until one finishes, or the
+/// policy is spent, or the module is stopped. The caller places it on a task.
+fn supervisor<S: Send + Sync + 'static>(
+    cell: Arc<CellShared>,
+    parent: Option<Name>,
+    policy: RestartPolicy,
+    first: ModuleSpec<S>,
+    mut factory: Option<Factory<S>>,
+) -> (ModuleHandle, impl Future<Output = ()> + Send + 'static) {
     let name = first.name.clone();
     let kill = Arc::new(KillSwitch::default());
     lock(&cell.modules).insert(name.clone(), Arc::clone(&kill));
@@ -280,7 +335,7 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
             parent: parent.clone(),
         },
     );
-    tokio::spawn(async move {
+    let supervisor = async move {
         let mut next = Some(first);
         let mut attempt = 0;
         let outcome = loop {
@@ -326,6 +381,6 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
         };
         lock(&cell.modules).remove(&name);
         report.send_replace(Some(outcome));
-    });
-    handle
+    };
+    (handle, supervisor)
 }

@@ -64,6 +64,7 @@ mod exception;
 mod log;
 mod module;
 mod order;
+mod processor;
 mod supervision;
 pub mod time;
 mod waitfor;
@@ -78,6 +79,7 @@ pub use log::{Log, Record};
 pub use module::ctx::Ctx;
 pub use module::spec::{ModuleDecl, ModuleSpec, TaskError, TaskResult};
 pub use order::{Order, Rank};
+pub use processor::Processor;
 pub use supervision::RestartPolicy;
 pub use waitfor::{Pool, WaitFor, WaitForError};
 pub use work::{Performed, WorkSchedule};
@@ -86,7 +88,7 @@ pub use work::{Performed, WorkSchedule};
 pub mod prelude {
     pub use crate::{
         Cell, Ctx, Event, EventKind, Exception, ModuleHandle, ModuleOutcome, ModuleSpec, Performed,
-        RestartPolicy, TaskError, TaskResult, WaitFor, WorkSchedule,
+        Processor, RestartPolicy, TaskError, TaskResult, WaitFor, WorkSchedule,
     };
     pub use imrs_ports::prelude::*;
     pub use imrs_ports::{Instant, Name, SharedClock, UsageKind};

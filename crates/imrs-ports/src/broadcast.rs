@@ -9,7 +9,7 @@ use pin_project_lite::pin_project;
 
 use crate::attachment::Attachment;
 use crate::clock::{Sleep, deadline_passed};
-use crate::core::register_broadcast;
+use crate::core::{SlotId, register_broadcast};
 use crate::error::BroadcastError;
 use crate::loom::Ordering;
 use crate::meta::Name;
@@ -112,7 +112,7 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
                 let user = &core.users[index];
                 // SAFETY: on a SENDALL/CALLALL port the owner end is the only poster of
                 // every user slot, and it is borrowed mutably by this future.
-                if unsafe { user.slot.post(message.clone(), core.ticket()) }.is_ok() {
+                if unsafe { user.slot.post(message.clone(), core.ticket(SlotId::Owner)) }.is_ok() {
                     user.in_broadcast.store(true, Ordering::Relaxed);
                     user.waker.wake();
                 }

@@ -84,18 +84,32 @@ impl<Req, Rep> Core<Req, Rep> {
         }
     }
 
-    pub(crate) fn ticket(&self) -> u64 {
-        self.next_ticket.fetch_add(1, Ordering::Relaxed)
+    /// The ticket for a post from `poster`: it orders the requests of several users, so a
+    /// port with one user, or the owner's own slot, needs none (and skips the shared
+    /// counter, which every poster would otherwise write).
+    pub(crate) fn ticket(&self, poster: SlotId) -> u64 {
+        match poster {
+            SlotId::User(_) if self.users.len() > 1 => {
+                self.next_ticket.fetch_add(1, Ordering::Relaxed)
+            }
+            _ => 0,
+        }
     }
 
     /// The user slot holding the oldest waiting request, if any.
     pub(crate) fn oldest_posted_user(&self) -> Option<usize> {
-        self.users
-            .iter()
-            .enumerate()
-            .filter_map(|(index, user)| Some((user.slot.posted_ticket()?, index)))
-            .min()
-            .map(|(_, index)| index)
+        if let [only] = &self.users[..] {
+            return only.slot.posted_ticket().map(|_| 0);
+        }
+        let mut oldest: Option<(u64, usize)> = None;
+        for (index, user) in self.users.iter().enumerate() {
+            if let Some(ticket) = user.slot.posted_ticket()
+                && oldest.is_none_or(|(first, _)| ticket < first)
+            {
+                oldest = Some((ticket, index));
+            }
+        }
+        oldest.map(|(_, index)| index)
     }
 
     /// Tells whoever serves the posts of `poster` that something arrived.

@@ -149,7 +149,7 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
                 let request = this.request.take().expect("a request waits to be posted");
                 // SAFETY: the end is its slot's only poster (one end per slot, borrowed
                 // mutably by this future).
-                match unsafe { slot.post(request, core.ticket()) } {
+                match unsafe { slot.post(request, core.ticket(attachment.at)) } {
                     Ok(()) => {
                         *this.stage = Stage::Posted;
                         core.wake_servers_of(attachment.at);

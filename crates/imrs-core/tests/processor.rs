@@ -1,0 +1,162 @@
+//! Modules co-scheduled on one processor: they rendezvous, keep their order and timing on
+//! virtual time, survive a neighbour's panic, and leave the runtime its turn.
+
+mod common;
+
+use common::{at, paused_runtime, secs};
+
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::task::{Context, Poll};
+
+use imrs_core::prelude::*;
+use imrs_core::time::drive;
+
+/// A feeder that answers each request after a second of work, and a robot that asks
+/// `rounds` times, both on one processor. Returns the cell's event log.
+fn feeder_and_robot(rounds: u32) -> Vec<Event> {
+    paused_runtime().block_on(async move {
+        let (cell, clock) = Cell::virtual_clock();
+        let processor = Processor::new("CPU1");
+        let port = Port::<u32, u32, usage::Receive>::declare(
+            PortSpec::new("FEED", "FEEDER").clock(cell.clock().clone()),
+        );
+        let serving = port.clone();
+        let feeder = ModuleSpec::new("FEEDER", ()).task("FEEDER", move |ctx| {
+            let port = serving.clone();
+            async move {
+                let mut feed = port.owner()?;
+                for _ in 0..rounds {
+                    let (chip, reply) = ctx.receive(&mut feed).await?;
+                    ctx.delay(secs(1)).await;
+                    reply.reply(chip + 1);
+                }
+                Ok(())
+            }
+        });
+        let robot = ModuleSpec::new("ROBOT", ()).task("ROBOT", move |ctx| {
+            let port = port.clone();
+            async move {
+                let mut feed = port.user_named("ROBOT")?;
+                for chip in 0..rounds {
+                    let next = ctx.send(&mut feed, chip).await?;
+                    assert_eq!(next, chip + 1, "the feeder answers this robot's request");
+                }
+                Ok(())
+            }
+        });
+        let mut feeder = cell.start_on(&processor, feeder);
+        let mut robot = cell.start_on(&processor, robot);
+        drive(&clock, at(u64::from(rounds) + 1)).await;
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+        assert_eq!(feeder.finished().await, ModuleOutcome::Finished);
+        cell.events().snapshot()
+    })
+}
+
+#[test]
+fn modules_on_one_processor_rendezvous_on_virtual_time() {
+    let events = feeder_and_robot(5);
+    let finished = |module: &str| {
+        events
+            .iter()
+            .find(|event| {
+                event.module.as_str() == module && event.kind == EventKind::ModuleFinished
+            })
+            .map(|event| event.at)
+    };
+    // Five requests, one second of feeder work each: both finish at 5 s.
+    assert_eq!(finished("ROBOT"), Some(at(5)), "{events:#?}");
+    assert_eq!(finished("FEEDER"), Some(at(5)), "{events:#?}");
+}
+
+#[test]
+fn modules_on_one_processor_run_the_same_way_every_time() {
+    assert_eq!(feeder_and_robot(20), feeder_and_robot(20));
+}
+
+#[test]
+fn a_job_that_panics_leaves_the_others_running() {
+    paused_runtime().block_on(async {
+        let processor = Processor::new("CPU1");
+        let (done, finished) = tokio::sync::oneshot::channel();
+        processor.spawn(async { panic!("a job fails") });
+        processor.spawn(async move {
+            tokio::time::sleep(secs(1)).await;
+            done.send(()).unwrap();
+        });
+        finished
+            .await
+            .expect("the second job finishes after the first panicked");
+    });
+}
+
+/// A job that wakes itself at every poll and never finishes: a busy loop without `.await`s
+/// that suspend.
+struct Busy(Arc<AtomicU64>);
+
+impl Future for Busy {
+    type Output = ();
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<()> {
+        self.0.fetch_add(1, Ordering::Relaxed);
+        cx.waker().wake_by_ref();
+        Poll::Pending
+    }
+}
+
+#[test]
+fn a_job_that_keeps_waking_itself_does_not_starve_the_runtime() {
+    let polls = Arc::new(AtomicU64::new(0));
+    let counted = Arc::clone(&polls);
+    paused_runtime().block_on(async move {
+        let processor = Processor::new("CPU1");
+        processor.spawn(Busy(counted));
+        // Another task on the same thread still gets its turns. (Not a timer: paused time
+        // only moves while every task is idle, and the busy job never is.)
+        let other = tokio::spawn(async {
+            for _ in 0..10 {
+                tokio::task::yield_now().await;
+            }
+        });
+        other.await.unwrap();
+    });
+    assert!(
+        polls.load(Ordering::Relaxed) > 1,
+        "the busy job ran more than once"
+    );
+}
+
+#[test]
+fn jobs_woken_from_other_threads_are_not_lost() {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let processor = Processor::new("CPU1");
+        let (to_job, mut job_inbox) = tokio::sync::mpsc::channel::<u64>(1);
+        let (to_thread, thread_inbox) = std::sync::mpsc::channel::<u64>();
+        let (done, finished) = tokio::sync::oneshot::channel();
+        processor.spawn(async move {
+            let mut sum = 0;
+            while let Some(n) = job_inbox.recv().await {
+                sum += n;
+                to_thread.send(n).unwrap();
+            }
+            done.send(sum).unwrap();
+        });
+        // An OS thread that answers each message with the next: every wake of the job
+        // comes from outside the processor's task, racing its parking.
+        let echo = std::thread::spawn(move || {
+            for n in 1..=2_000 {
+                to_job.blocking_send(n).unwrap();
+                assert_eq!(thread_inbox.recv().unwrap(), n);
+            }
+        });
+        assert_eq!(finished.await.unwrap(), (1..=2_000).sum::<u64>());
+        echo.join().unwrap();
+    });
+}
