@@ -1,6 +1,6 @@
 //! A query into a response handler through the order scheduler, with the responder idle and
 //! with the responder in a lower-ranked section at a suspension point; the same-thread
-//! send/receive/reply round trip as baseline.
+//! send/receive/reply round trip as baseline. Both ends of each run on one processor.
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -38,13 +38,19 @@ fn query(iters: u64, busy: bool) -> Duration {
                 std::future::pending::<()>().await;
                 Ok(())
             });
-        let robot = cell.start(responder);
+        // Asker and responder on one processor, as the same-thread rendezvous below.
+        let processor = Processor::new("CPU1");
+        let robot = cell.start_on(&processor, responder);
         let mut asker = port.owner().unwrap();
-        let start = Instant::now();
-        for n in 0..iters {
-            black_box(asker.query(black_box(n)).await.unwrap());
-        }
-        let timed = start.elapsed();
+        let (done, timed) = tokio::sync::oneshot::channel();
+        processor.spawn(async move {
+            let start = Instant::now();
+            for n in 0..iters {
+                black_box(asker.query(black_box(n)).await.unwrap());
+            }
+            let _ = done.send(start.elapsed());
+        });
+        let timed = timed.await.unwrap();
         robot.stop();
         timed
     })
@@ -56,16 +62,21 @@ fn rendezvous(iters: u64) -> Duration {
         let port = Port::<u64, u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
-        tokio::spawn(async move {
+        let processor = Processor::new("CPU1");
+        processor.spawn(async move {
             while let Ok((n, reply)) = server.receive().await {
                 reply.reply(n + 7);
             }
         });
-        let start = Instant::now();
-        for n in 0..iters {
-            black_box(client.send(black_box(n)).await.unwrap());
-        }
-        start.elapsed()
+        let (done, timed) = tokio::sync::oneshot::channel();
+        processor.spawn(async move {
+            let start = Instant::now();
+            for n in 0..iters {
+                black_box(client.send(black_box(n)).await.unwrap());
+            }
+            let _ = done.send(start.elapsed());
+        });
+        timed.await.unwrap()
     })
 }
 

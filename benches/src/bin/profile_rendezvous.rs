@@ -1,23 +1,59 @@
 //! Same-thread round trips in a loop, for a profiler (`valgrind --tool=callgrind`), so that
 //! the ratio table's figures can be traced to where the time goes. Both ends run on one
-//! processor, as in `rendezvous_same_thread/imrs`.
+//! processor, as in `rendezvous_same_thread/imrs`; with `query`, the round trips are
+//! queries into a response handler of an idle module, as in `query/responder_idle`.
 //!
 //! ```text
 //! cargo build --release -p imrs-benches --bin profile_rendezvous
-//! valgrind --tool=callgrind target/release/profile_rendezvous 100000
+//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query]
 //! ```
 
 use std::hint::black_box;
 
 use imrs_benches::current_thread;
-use imrs_core::Processor;
-use imrs_ports::{Port, PortSpec, usage};
+use imrs_core::prelude::*;
+use imrs_ports::RealClock;
 
 fn main() {
     let round_trips: u64 = std::env::args()
         .nth(1)
         .and_then(|n| n.parse().ok())
         .unwrap_or(100_000);
+    if std::env::args().nth(2).is_some_and(|mode| mode == "query") {
+        queries(round_trips);
+    } else {
+        rendezvous(round_trips);
+    }
+}
+
+fn queries(round_trips: u64) {
+    current_thread().block_on(async move {
+        let cell = Cell::new(std::sync::Arc::new(RealClock::new()));
+        let processor = Processor::new("CPU1");
+        let port = Port::<u64, u64, usage::Query>::declare(PortSpec::new("STATUS", "ASKER"));
+        let responder = ModuleSpec::new("ROBOT", 7u64)
+            .order(["STATUS.STATE", "ROBOT"])
+            .response(
+                "STATUS.STATE",
+                port.responder_named("ROBOT", |s: &u64, q: u64| s + q)
+                    .expect("a new port has room for a responder"),
+            )
+            .task("ROBOT", |_ctx| std::future::pending());
+        let robot = cell.start_on(&processor, responder);
+        let mut asker = port.owner().expect("a new port has no owner yet");
+        let (done, finished) = tokio::sync::oneshot::channel();
+        processor.spawn(async move {
+            for n in 0..round_trips {
+                black_box(asker.query(black_box(n)).await.expect("the robot answers"));
+            }
+            let _ = done.send(());
+        });
+        finished.await.expect("the asker finishes");
+        robot.stop();
+    });
+}
+
+fn rendezvous(round_trips: u64) {
     current_thread().block_on(async move {
         let processor = Processor::new("CPU1");
         let port = Port::<[u8; 8], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));

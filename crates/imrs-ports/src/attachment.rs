@@ -66,7 +66,13 @@ impl<Req, Rep> Attachment<Req, Rep> {
 
     /// Whether a request is waiting for this end to serve it.
     pub(crate) fn has_waiting(&self) -> bool {
-        self.waiting() > 0
+        match self.at {
+            SlotId::Owner => self.core.oldest_posted_user().is_some(),
+            SlotId::User(index) => {
+                self.core.users[index].slot.posted_ticket().is_some()
+                    || self.core.owner_slot.posted_ticket().is_some()
+            }
+        }
     }
 
     /// Registers the task to be woken when a request arrives for this end to serve.

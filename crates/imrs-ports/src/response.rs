@@ -138,6 +138,9 @@ impl<Req, Rep, S> fmt::Debug for ResponseEnd<Req, Rep, S> {
 
 /// A response end as seen by whatever decides when handlers run.
 pub trait Respond<S> {
+    /// Whether a query waits, without registering for a wake; see
+    /// [`ResponseEnd::is_pending`].
+    fn is_pending(&self) -> bool;
     /// Ready when a query waits; see [`ResponseEnd::poll_pending`].
     fn poll_pending(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), ReceiveError>>;
     /// Answers one waiting query; see [`ResponseEnd::respond`].
@@ -145,6 +148,10 @@ pub trait Respond<S> {
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req, Rep, S> {
+    fn is_pending(&self) -> bool {
+        ResponseEnd::is_pending(self)
+    }
+
     fn poll_pending(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), ReceiveError>> {
         ResponseEnd::poll_pending(self, cx)
     }

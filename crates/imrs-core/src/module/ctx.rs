@@ -119,7 +119,9 @@ impl<S> ModuleShared<S> {
     /// The tasks that were asked to restart since the last call. Also clears the `pending`
     /// flag, unless exceptions still wait (whoever pushes sets it again after pushing).
     pub(crate) fn take_restart_requests(&self) -> Vec<Name> {
-        if !self.pending.swap(false, Ordering::AcqRel) {
+        // Looked at after every poll of every thread: a load, not a swap, in the usual case
+        // of nothing pending, so that it costs no read-modify-write.
+        if !self.pending.load(Ordering::Acquire) || !self.pending.swap(false, Ordering::AcqRel) {
             return Vec::new();
         }
         let requests = std::mem::take(&mut *lock(&self.restarts));

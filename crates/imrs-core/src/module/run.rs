@@ -82,11 +82,19 @@ impl KillSwitch {
         self.killed.store(false, Ordering::Release);
     }
 
-    fn poll_killed(&self, cx: &mut Context<'_>) -> bool {
+    /// Whether the copy was killed; registers `cx`'s waker unless `registered` already is
+    /// it (a module's task keeps its waker, and the registration takes a lock).
+    fn poll_killed(&self, cx: &mut Context<'_>, registered: &mut Option<Waker>) -> bool {
         if self.killed.load(Ordering::Acquire) {
             return true;
         }
-        self.waker.register(cx.waker());
+        if !registered
+            .as_ref()
+            .is_some_and(|waker| waker.will_wake(cx.waker()))
+        {
+            self.waker.register(cx.waker());
+            *registered = Some(cx.waker().clone());
+        }
         self.killed.load(Ordering::Acquire)
     }
 }
@@ -139,6 +147,9 @@ pub(crate) struct ModuleRun<S> {
     responses: Vec<ResponseRun<S>>,
     exception_handlers: Vec<(Name, Rank, ExceptionHandler<S>)>,
     kill: Arc<KillSwitch>,
+    /// The waker last registered with the kill switch: only a kill takes it back out, and
+    /// a kill ends this copy.
+    kill_waker: Option<Waker>,
     span: tracing::Span,
 }
 
@@ -203,6 +214,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             responses,
             exception_handlers,
             kill,
+            kill_waker: None,
             span,
         }
     }
@@ -218,10 +230,15 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         tasks.chain(handlers).max()
     }
 
-    /// Starts every pending handler whose rank allows it now. Returns whether any started.
-    fn admit(&mut self, cx: &mut Context<'_>) -> bool {
-        let mut started = false;
-        self.restart_requested();
+    /// Starts every pending handler whose rank allows it now. Returns whether a thread
+    /// started (an exception handler, or a restarted task) that must be polled. A response
+    /// handler runs to completion right here, so answering queries starts none.
+    ///
+    /// It registers for no wake (it runs after every poll of every thread, and a waker
+    /// registration costs atomic read-modify-writes): [`ModuleRun::park`] does, once, before
+    /// the module's future returns `Pending`.
+    fn admit(&mut self) -> bool {
+        let mut started = self.restart_requested();
         loop {
             let host = self.host_rank();
             let admissible = |rank: Rank| host.is_none_or(|host| rank.outranks(host));
@@ -240,7 +257,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 // Sorted by rank: no later handler outranks the host either.
                 break;
             }
-            while let Poll::Ready(Ok(())) = response.end.poll_pending(cx) {
+            while response.end.is_pending() {
                 let end = &mut response.end;
                 let answered = self.shared.state.read(|state| end.respond(state));
                 if answered {
@@ -250,11 +267,23 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                             handler: response.name.clone(),
                         },
                     );
-                    started = true;
                 }
             }
         }
         started
+    }
+
+    /// Before the module's future returns `Pending`: registers every response handler for a
+    /// wake when a query comes. Returns whether one that may start now came meanwhile.
+    fn park(&mut self, cx: &mut Context<'_>) -> bool {
+        let host = self.host_rank();
+        let mut ready = false;
+        for response in &mut self.responses {
+            let admissible = host.is_none_or(|host| response.rank.outranks(host));
+            let waiting = matches!(response.end.poll_pending(cx), Poll::Ready(Ok(())));
+            ready |= waiting && admissible;
+        }
+        ready
     }
 
     fn handler_for(&self, exception: &Name) -> Option<(Rank, &ExceptionHandler<S>)> {
@@ -299,7 +328,10 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         );
     }
 
-    fn restart_requested(&mut self) {
+    /// Starts a new copy of each task whose restart was asked for. Returns whether any
+    /// started.
+    fn restart_requested(&mut self) -> bool {
+        let mut started = false;
         for name in self.shared.take_restart_requests() {
             let Some(index) = self.tasks.iter().position(|task| task.name == name) else {
                 self.shared.event(
@@ -314,7 +346,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 continue;
             };
             self.start_copy(index);
+            started = true;
         }
+        started
     }
 
     /// Drops whatever copy of task `index` there is and starts a new one.
@@ -441,11 +475,11 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
         let this = self.get_mut();
         let span = this.span.clone();
         let _entered = span.enter();
-        if this.kill.poll_killed(cx) {
+        if this.kill.poll_killed(cx, &mut this.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
         loop {
-            let mut progress = this.admit(cx);
+            let mut progress = this.admit();
             // Running handlers are kept in rank order, most urgent first.
             let mut index = 0;
             while index < this.handlers.len() {
@@ -454,16 +488,16 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
                 } else {
                     index += 1;
                 }
-                progress |= this.admit(cx);
+                progress |= this.admit();
             }
             for index in 0..this.tasks.len() {
                 progress |= this.poll_task(index, cx);
-                progress |= this.admit(cx);
+                progress |= this.admit();
             }
             if let Some(exit) = this.exit() {
                 return Poll::Ready(exit);
             }
-            if !progress {
+            if !progress && !this.park(cx) {
                 return Poll::Pending;
             }
         }
