@@ -55,7 +55,8 @@ fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 ///
 /// Modules run as tokio tasks, in parallel on a multi-thread runtime, or one at a time on a
 /// current-thread runtime — which, on a [`VirtualClock`](imrs_ports::VirtualClock), makes
-/// a run reproducible event for event.
+/// a run reproducible event for event. Modules that talk at every turn may share one task
+/// instead: [`Cell::start_on`] a [`Processor`].
 #[derive(Clone)]
 pub struct Cell {
     shared: Arc<CellShared>,

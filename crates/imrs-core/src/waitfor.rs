@@ -5,6 +5,7 @@
 //! read-only, and goes on with the result. Inside the function, [`Pool::getmess`] reads one
 //! task's message. The same rendezvous can be used again for the next round.
 
+use std::collections::HashMap;
 use std::fmt;
 use std::future::poll_fn;
 use std::pin::pin;
@@ -14,23 +15,45 @@ use std::time::Duration;
 
 use imrs_ports::{Name, SharedClock};
 
+/// The named tasks of a rendezvous, and each one's place, found by name in O(1): every
+/// arrival and every `getmess` looks one up, so a scan would make a round of n tasks O(n²).
+#[derive(Debug)]
+struct Members {
+    names: Vec<Name>,
+    places: HashMap<Box<str>, usize>,
+}
+
+impl Members {
+    fn new(names: Vec<Name>) -> Self {
+        let mut places = HashMap::with_capacity(names.len());
+        for (place, name) in names.iter().enumerate() {
+            // A name listed twice keeps its first place, as a scan would find it.
+            places.entry(name.as_str().into()).or_insert(place);
+        }
+        Self { names, places }
+    }
+
+    fn place(&self, task: &str) -> Option<usize> {
+        self.places.get(task).copied()
+    }
+}
+
 /// The pooled messages of one round of a `waitfor`, one per named task.
 #[derive(Debug)]
 pub struct Pool<M> {
-    members: Arc<[Name]>,
+    members: Arc<Members>,
     messages: Vec<M>,
 }
 
 impl<M> Pool<M> {
     /// `GETMESS(task)`: the message `task` pooled, if it is a member.
     pub fn getmess(&self, task: &str) -> Option<&M> {
-        let index = self.members.iter().position(|m| m.as_str() == task)?;
-        self.messages.get(index)
+        self.messages.get(self.members.place(task)?)
     }
 
     /// Every member with its message, in the order the rendezvous names them.
     pub fn iter(&self) -> impl Iterator<Item = (&Name, &M)> {
-        self.members.iter().zip(&self.messages)
+        self.members.names.iter().zip(&self.messages)
     }
 
     /// How many messages were pooled.
@@ -107,7 +130,7 @@ pub struct WaitFor<M> {
 
 struct Shared<M> {
     name: Name,
-    members: Arc<[Name]>,
+    members: Arc<Members>,
     clock: SharedClock,
     round: Mutex<Round<M>>,
 }
@@ -148,8 +171,8 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
         I: IntoIterator<Item = N>,
         N: Into<Name>,
     {
-        let members: Arc<[Name]> = members.into_iter().map(Into::into).collect();
-        let count = members.len();
+        let members = Arc::new(Members::new(members.into_iter().map(Into::into).collect()));
+        let count = members.names.len();
         Self {
             shared: Arc::new(Shared {
                 name: name.into(),
@@ -173,7 +196,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
 
     /// The named tasks.
     pub fn members(&self) -> &[Name] {
-        &self.shared.members
+        &self.shared.members.names
     }
 
     /// `waitfor`: `task` pools `message`, waits (at most `timeout`) until every member has,
@@ -186,7 +209,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
         timeout: Option<Duration>,
     ) -> Result<R, WaitForError<M>> {
         let shared = &self.shared;
-        let Some(index) = shared.members.iter().position(|m| m.as_str() == task) else {
+        let Some(index) = shared.members.place(task) else {
             return Err(WaitForError::NotAMember {
                 barrier: shared.name.clone(),
                 task: task.into(),
@@ -237,6 +260,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             round.count -= 1;
             let missing = shared
                 .members
+                .names
                 .iter()
                 .zip(&round.arrived)
                 .filter(|(_, arrived)| arrived.is_none())
@@ -283,7 +307,7 @@ impl<M> fmt::Debug for WaitFor<M> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("WaitFor")
             .field("name", &self.shared.name)
-            .field("members", &self.shared.members)
+            .field("members", &self.shared.members.names)
             .finish_non_exhaustive()
     }
 }
