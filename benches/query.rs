@@ -42,15 +42,14 @@ fn query(iters: u64, busy: bool) -> Duration {
         let processor = Processor::new("CPU1");
         let robot = cell.start_on(&processor, responder);
         let mut asker = port.owner().unwrap();
-        let (done, timed) = tokio::sync::oneshot::channel();
-        processor.spawn(async move {
+        let asking = processor.spawn(async move {
             let start = Instant::now();
             for n in 0..iters {
                 black_box(asker.query(black_box(n)).await.unwrap());
             }
-            let _ = done.send(start.elapsed());
+            start.elapsed()
         });
-        let timed = timed.await.unwrap();
+        let timed = asking.await.unwrap();
         robot.stop();
         timed
     })
@@ -63,20 +62,22 @@ fn rendezvous(iters: u64) -> Duration {
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
         let processor = Processor::new("CPU1");
-        processor.spawn(async move {
-            while let Ok((n, reply)) = server.receive().await {
+        let serving = processor.spawn(async move {
+            for _ in 0..iters {
+                let (n, reply) = server.receive().await.unwrap();
                 reply.reply(n + 7);
             }
         });
-        let (done, timed) = tokio::sync::oneshot::channel();
-        processor.spawn(async move {
+        let sending = processor.spawn(async move {
             let start = Instant::now();
             for n in 0..iters {
                 black_box(client.send(black_box(n)).await.unwrap());
             }
-            let _ = done.send(start.elapsed());
+            start.elapsed()
         });
-        timed.await.unwrap()
+        let timed = sending.await.unwrap();
+        serving.await.unwrap();
+        timed
     })
 }
 

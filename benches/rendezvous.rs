@@ -44,23 +44,24 @@ fn imrs_same_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Dura
         let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
-        processor.spawn(async move {
+        let serving = processor.spawn(async move {
             for _ in 0..iters {
                 let (message, reply) = server.receive().await.unwrap();
                 reply.reply(u64::from(message[0]));
             }
         });
-        let (done, timed) = oneshot::channel();
-        processor.spawn(async move {
+        let sending = processor.spawn(async move {
             let mut samples = Tail::with_capacity(if keep { iters as usize } else { 0 });
             let timed = round_trips!(
                 iters,
                 keep.then_some(&mut samples),
                 client.send(black_box([1u8; N]))
             );
-            let _ = done.send((timed, samples));
+            (timed, samples)
         });
-        timed.await.unwrap()
+        let timed = sending.await.unwrap();
+        serving.await.unwrap();
+        timed
     });
     if let Some(tail) = tail {
         tail.absorb(samples);

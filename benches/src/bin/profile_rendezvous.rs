@@ -41,14 +41,14 @@ fn queries(round_trips: u64) {
             .task("ROBOT", |_ctx| std::future::pending());
         let robot = cell.start_on(&processor, responder);
         let mut asker = port.owner().expect("a new port has no owner yet");
-        let (done, finished) = tokio::sync::oneshot::channel();
-        processor.spawn(async move {
-            for n in 0..round_trips {
-                black_box(asker.query(black_box(n)).await.expect("the robot answers"));
-            }
-            let _ = done.send(());
-        });
-        finished.await.expect("the asker finishes");
+        processor
+            .spawn(async move {
+                for n in 0..round_trips {
+                    black_box(asker.query(black_box(n)).await.expect("the robot answers"));
+                }
+            })
+            .await
+            .expect("the asker finishes");
         robot.stop();
     });
 }
@@ -61,14 +61,13 @@ fn rendezvous(round_trips: u64) {
         let mut client = port
             .user_named("CLIENT")
             .expect("a new port has room for a user");
-        processor.spawn(async move {
+        let serving = processor.spawn(async move {
             for _ in 0..round_trips {
                 let (message, reply) = server.receive().await.expect("the client sends");
                 reply.reply(u64::from(message[0]));
             }
         });
-        let (done, finished) = tokio::sync::oneshot::channel();
-        processor.spawn(async move {
+        let sending = processor.spawn(async move {
             for _ in 0..round_trips {
                 black_box(
                     client
@@ -77,8 +76,8 @@ fn rendezvous(round_trips: u64) {
                         .expect("the server replies"),
                 );
             }
-            let _ = done.send(());
         });
-        finished.await.expect("the client finishes");
+        sending.await.expect("the client finishes");
+        serving.await.expect("the server finishes");
     });
 }

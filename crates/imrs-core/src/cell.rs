@@ -155,13 +155,7 @@ impl Cell {
 
     /// Starts `spec` as a top-level module. If it fails, it stays failed.
     pub fn start<S: Send + Sync + 'static>(&self, spec: ModuleSpec<S>) -> ModuleHandle {
-        spawn_module(
-            Arc::clone(&self.shared),
-            None,
-            RestartPolicy::NEVER,
-            spec,
-            None,
-        )
+        self.launch(None, RestartPolicy::NEVER, spec, None)
     }
 
     /// Starts a top-level module made by `factory`, and makes a new copy of it with
@@ -172,13 +166,7 @@ impl Cell {
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
     {
         let first = factory();
-        spawn_module(
-            Arc::clone(&self.shared),
-            None,
-            policy,
-            first,
-            Some(Box::new(factory)),
-        )
+        self.launch(None, policy, first, Some(Box::new(factory)))
     }
 
     /// Starts `spec` as a top-level module on `processor`, co-scheduled with the other
@@ -188,15 +176,7 @@ impl Cell {
         processor: &Processor,
         spec: ModuleSpec<S>,
     ) -> ModuleHandle {
-        let (handle, supervisor) = supervisor(
-            Arc::clone(&self.shared),
-            None,
-            RestartPolicy::NEVER,
-            spec,
-            None,
-        );
-        processor.spawn(supervisor);
-        handle
+        self.launch(Some(processor), RestartPolicy::NEVER, spec, None)
     }
 
     /// [`Cell::supervise`], on `processor`: every copy of the module runs there.
@@ -211,14 +191,25 @@ impl Cell {
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
     {
         let first = factory();
-        let (handle, supervisor) = supervisor(
-            Arc::clone(&self.shared),
-            None,
-            policy,
-            first,
-            Some(Box::new(factory)),
-        );
-        processor.spawn(supervisor);
+        self.launch(Some(processor), policy, first, Some(Box::new(factory)))
+    }
+
+    /// Starts the supervisor of a top-level module on `processor`, or as a tokio task of
+    /// its own.
+    fn launch<S: Send + Sync + 'static>(
+        &self,
+        processor: Option<&Processor>,
+        policy: RestartPolicy,
+        first: ModuleSpec<S>,
+        factory: Option<Factory<S>>,
+    ) -> ModuleHandle {
+        let Some(processor) = processor else {
+            return spawn_module(Arc::clone(&self.shared), None, policy, first, factory);
+        };
+        let (handle, supervisor) =
+            supervisor(Arc::clone(&self.shared), None, policy, first, factory);
+        // The module handle reports how the module ends: no job handle is needed.
+        processor.place(supervisor);
         handle
     }
 

@@ -79,7 +79,7 @@ pub use log::{Log, Record};
 pub use module::ctx::Ctx;
 pub use module::spec::{ModuleDecl, ModuleSpec, TaskError, TaskResult};
 pub use order::{Order, Rank};
-pub use processor::Processor;
+pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;
 pub use waitfor::{Pool, WaitFor, WaitForError};
 pub use work::{Performed, WorkSchedule};

@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::task::{Context, Poll, Wake, Waker};
 
 use imrs_ports::Name;
-use tokio::sync::Notify;
+use tokio::sync::{Notify, oneshot};
 
 type Job = Pin<Box<dyn Future<Output = ()> + Send>>;
 
@@ -144,19 +144,82 @@ impl Processor {
         &self.owner.shared.name
     }
 
-    /// Runs `future` on the processor, beside whatever else runs there.
+    /// Runs `future` on the processor, beside whatever else runs there; the handle yields
+    /// its output. Dropping the handle leaves the job running.
     ///
-    /// A job that panics is dropped; the others go on.
-    pub fn spawn(&self, future: impl Future<Output = ()> + Send + 'static) {
+    /// A job that panics is dropped, and its handle yields [`JobLost`]; the others go on.
+    pub fn spawn<F>(&self, future: F) -> JobHandle<F::Output>
+    where
+        F: Future + Send + 'static,
+        F::Output: Send + 'static,
+    {
+        let (output, handle) = oneshot::channel();
+        self.place(async move {
+            // The handle may be gone: then nobody wants the output.
+            let _ = output.send(future.await);
+        });
+        JobHandle {
+            processor: self.name().clone(),
+            output: handle,
+        }
+    }
+
+    /// Puts `job` on the processor's list and wakes its task.
+    pub(crate) fn place(&self, job: impl Future<Output = ()> + Send + 'static) {
         let shared = &self.owner.shared;
         shared
             .arrivals
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
-            .push(Box::pin(future));
+            .push(Box::pin(job));
         shared.arrived.store(true, Ordering::SeqCst);
         shared.wake_task();
     }
+}
+
+/// The output of a job placed with [`Processor::spawn`], once it has finished.
+#[derive(Debug)]
+#[must_use = "a job handle does nothing unless awaited; drop it to leave the job running"]
+pub struct JobHandle<T> {
+    processor: Name,
+    output: oneshot::Receiver<T>,
+}
+
+impl<T> Future for JobHandle<T> {
+    type Output = Result<T, JobLost>;
+
+    fn poll(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
+        Pin::new(&mut self.output).poll(cx).map_err(|_| JobLost {
+            processor: self.processor.clone(),
+        })
+    }
+}
+
+/// A job ended without an output: it panicked, or its processor's task was dropped (its
+/// runtime shut down) before the job finished.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct JobLost {
+    /// The processor the job ran on.
+    pub processor: Name,
+}
+
+impl fmt::Display for JobLost {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "a job on processor {} ended without an output: it panicked, or the processor's \
+             runtime shut down",
+            self.processor
+        )
+    }
+}
+
+impl std::error::Error for JobLost {}
+
+/// Whether `flag` was set, clearing it. A plain load first: the scheduler looks at flags far
+/// more often than it finds them set, and a load costs no read-modify-write.
+fn take(flag: &AtomicBool) -> bool {
+    flag.load(Ordering::Relaxed) && flag.swap(false, Ordering::SeqCst)
 }
 
 impl Drop for Owner {
@@ -206,7 +269,7 @@ fn turn(shared: &Arc<Shared>, slots: &mut Vec<Slot>) -> Turn {
     let _running = Running::enter(shared);
     let mut budget = TURN_BUDGET;
     loop {
-        if shared.arrived.swap(false, Ordering::SeqCst) {
+        if take(&shared.arrived) {
             let arrivals = std::mem::take(
                 &mut *shared
                     .arrivals
@@ -226,7 +289,7 @@ fn turn(shared: &Arc<Shared>, slots: &mut Vec<Slot>) -> Turn {
         let mut index = 0;
         while index < slots.len() {
             let slot = &mut slots[index];
-            if !slot.wake.ready.swap(false, Ordering::SeqCst) {
+            if !take(&slot.wake.ready) {
                 index += 1;
                 continue;
             }

@@ -6,6 +6,7 @@ use std::time::Duration;
 
 use crate::core::{Core, SlotId};
 use crate::meta::Name;
+use crate::slot::Slot;
 
 pub(crate) struct Attachment<Req, Rep> {
     pub(crate) core: Arc<Core<Req, Rep>>,
@@ -47,32 +48,30 @@ impl<Req, Rep> Attachment<Req, Rep> {
         }
     }
 
+    /// The slots this end serves: every user's, for the owner; a user's own slot (where a
+    /// broadcast lands) and the owner's (which any user may take from), for a user.
+    fn served_slots(&self) -> impl Iterator<Item = &Slot<Req, Rep>> {
+        let (users, owner_slot) = match self.at {
+            SlotId::Owner => (&self.core.users[..], None),
+            SlotId::User(index) => (
+                std::slice::from_ref(&self.core.users[index]),
+                Some(&*self.core.owner_slot),
+            ),
+        };
+        users.iter().map(|user| &*user.slot).chain(owner_slot)
+    }
+
     /// How many requests are waiting for this end to serve them.
     pub(crate) fn waiting(&self) -> usize {
-        let posted = |slot: &crate::slot::Slot<Req, Rep>| slot.posted_ticket().is_some();
-        match self.at {
-            SlotId::Owner => self
-                .core
-                .users
-                .iter()
-                .filter(|user| posted(&user.slot))
-                .count(),
-            SlotId::User(index) => {
-                usize::from(posted(&self.core.users[index].slot))
-                    + usize::from(posted(&self.core.owner_slot))
-            }
-        }
+        self.served_slots()
+            .filter(|slot| slot.posted_ticket().is_some())
+            .count()
     }
 
     /// Whether a request is waiting for this end to serve it.
     pub(crate) fn has_waiting(&self) -> bool {
-        match self.at {
-            SlotId::Owner => self.core.oldest_posted_user().is_some(),
-            SlotId::User(index) => {
-                self.core.users[index].slot.posted_ticket().is_some()
-                    || self.core.owner_slot.posted_ticket().is_some()
-            }
-        }
+        self.served_slots()
+            .any(|slot| slot.posted_ticket().is_some())
     }
 
     /// Registers the task to be woken when a request arrives for this end to serve.

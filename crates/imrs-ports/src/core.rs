@@ -22,7 +22,6 @@ pub(crate) enum SlotId {
 /// Keeps a value on cache lines of its own (128 bytes: adjacent-line prefetchers fetch lines
 /// in pairs), so that threads writing their own fields do not steal each other's lines.
 /// On a TIGHT port both ends spin, and every stolen line is a cross-core round trip.
-#[derive(Default)]
 #[repr(align(128))]
 pub(crate) struct Padded<T>(T);
 
@@ -113,9 +112,6 @@ impl<Req, Rep> Core<Req, Rep> {
 
     /// The user slot holding the oldest waiting request, if any.
     pub(crate) fn oldest_posted_user(&self) -> Option<usize> {
-        if let [only] = &self.users[..] {
-            return only.slot.posted_ticket().map(|_| 0);
-        }
         let mut oldest: Option<(u64, usize)> = None;
         for (index, user) in self.users.iter().enumerate() {
             if let Some(ticket) = user.slot.posted_ticket()

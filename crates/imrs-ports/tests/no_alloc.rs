@@ -1,43 +1,14 @@
 //! In steady state a rendezvous allocates nothing: counted by a global allocator.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::time::Duration;
 
 use imrs_ports::{Port, PortSpec, usage};
 
-struct Counting;
+// Shared with imrs-core's processor test, which counts the same way.
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
 
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls on this thread.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|count| count.set(count.get() + 1));
-        // SAFETY: the caller's contract for `alloc` is passed on as is.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: the caller's contract for `dealloc` is passed on as is.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|count| count.set(count.get() + 1));
-        // SAFETY: the caller's contract for `realloc` is passed on as is.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(Cell::get)
-}
+use counting_alloc::allocations;
 
 /// Round trips between two tasks on one thread: `warm_up` first, then `measured`, counting
 /// the allocations of the measured ones alone.
@@ -92,13 +63,4 @@ fn a_timed_rendezvous_on_the_real_clock_allocates_nothing() {
     let spec = PortSpec::new("P", "OWNER").timeout(hour);
     let allocated = allocations_per_round_trips(spec, Some(hour), 100, 1_000);
     assert_eq!(allocated, 0, "allocations in 1000 timed round trips");
-}
-
-#[test]
-fn the_counter_sees_allocations() {
-    // Guards the two tests above against a counter that never counts.
-    let before = allocations();
-    let boxed = std::hint::black_box(Box::new(7u64));
-    assert!(allocations() > before);
-    drop(boxed);
 }

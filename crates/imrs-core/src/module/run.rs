@@ -19,10 +19,11 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::pin::Pin;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
-use std::task::{Context, Poll, Waker};
+use std::task::{Context, Poll};
 
+use atomic_waker::AtomicWaker;
 use imrs_ports::clock::Sleep;
 use imrs_ports::{Name, Respond};
 
@@ -33,32 +34,14 @@ use crate::exception::Exception;
 use crate::order::{Order, Rank};
 use crate::supervision::RestartPolicy;
 
-/// One waker slot, for the kill switch (rarely used, so a mutex is plenty).
-#[derive(Debug, Default)]
-struct WakerSlot(Mutex<Option<Waker>>);
-
-impl WakerSlot {
-    fn register(&self, waker: &Waker) {
-        let mut slot = self.0.lock().unwrap_or_else(PoisonError::into_inner);
-        if !slot.as_ref().is_some_and(|held| held.will_wake(waker)) {
-            *slot = Some(waker.clone());
-        }
-    }
-
-    fn wake(&self) {
-        let waker = self.0.lock().unwrap_or_else(PoisonError::into_inner).take();
-        if let Some(waker) = waker {
-            waker.wake();
-        }
-    }
-}
-
 /// Kills a running module from outside: its future ends at its next poll.
 #[derive(Debug, Default)]
 pub(crate) struct KillSwitch {
     killed: AtomicBool,
     stopped: AtomicBool,
-    waker: WakerSlot,
+    /// Polled at every poll of the module: registering the same waker again is two
+    /// compare-and-swaps, no lock and no clone.
+    waker: AtomicWaker,
 }
 
 impl KillSwitch {
@@ -82,19 +65,11 @@ impl KillSwitch {
         self.killed.store(false, Ordering::Release);
     }
 
-    /// Whether the copy was killed; registers `cx`'s waker unless `registered` already is
-    /// it (a module's task keeps its waker, and the registration takes a lock).
-    fn poll_killed(&self, cx: &mut Context<'_>, registered: &mut Option<Waker>) -> bool {
+    fn poll_killed(&self, cx: &mut Context<'_>) -> bool {
         if self.killed.load(Ordering::Acquire) {
             return true;
         }
-        if !registered
-            .as_ref()
-            .is_some_and(|waker| waker.will_wake(cx.waker()))
-        {
-            self.waker.register(cx.waker());
-            *registered = Some(cx.waker().clone());
-        }
+        self.waker.register(cx.waker());
         self.killed.load(Ordering::Acquire)
     }
 }
@@ -147,9 +122,6 @@ pub(crate) struct ModuleRun<S> {
     responses: Vec<ResponseRun<S>>,
     exception_handlers: Vec<(Name, Rank, ExceptionHandler<S>)>,
     kill: Arc<KillSwitch>,
-    /// The waker last registered with the kill switch: only a kill takes it back out, and
-    /// a kill ends this copy.
-    kill_waker: Option<Waker>,
     span: tracing::Span,
 }
 
@@ -214,7 +186,6 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             responses,
             exception_handlers,
             kill,
-            kill_waker: None,
             span,
         }
     }
@@ -475,7 +446,7 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
         let this = self.get_mut();
         let span = this.span.clone();
         let _entered = span.enter();
-        if this.kill.poll_killed(cx, &mut this.kill_waker) {
+        if this.kill.poll_killed(cx) {
             return Poll::Ready(ModuleExit::Killed);
         }
         loop {
