@@ -16,7 +16,8 @@ use imrs_ports::RealClock;
 fn rounds(n: usize, rounds: u64) -> Duration {
     current_thread().block_on(async move {
         let names: Vec<String> = (0..n).map(|i| format!("T{i}")).collect();
-        let barrier = WaitFor::<u64>::new("MEET", names.clone(), Arc::new(RealClock::new()));
+        let barrier = WaitFor::<u64>::new("MEET", names.clone(), Arc::new(RealClock::new()))
+            .expect("distinct members");
         let start = Instant::now();
         let tasks: Vec<_> = names
             .into_iter()

@@ -4,9 +4,34 @@
 //! A **module** controls one indivisible subprocess — a robot, a gate, a feeder. It owns its
 //! state, runs its tasks, answers queries with response handlers that read (never write)
 //! its state, and reacts to exceptions such as a port's timeout. Its **order** ranks its
-//! background code, handlers and named sections; a pending handler runs only when it
-//! outranks the section a thread of the module is in, at that thread's next suspension
-//! point. Modules talk only through the ports of [`imrs_ports`].
+//! background code, handlers and named sections. Modules talk only through the ports of
+//! [`imrs_ports`].
+//!
+//! # The order rule
+//!
+//! **A pending handler — response or exception alike — starts at the next suspension point
+//! at which its rank outranks both the section of the thread it interrupts (the least urgent
+//! live thread of the module) and every named section that any live thread of the module is
+//! in.** A named section ranked above a handler is thus a promise that the handler never sees
+//! the module inside it, whatever the module's other threads are doing; and CHIP_IT of the
+//! seed's Appendix still answers `SHARE_FEEDER1.CRIT_SECTION` while it is in `INSERT`, even
+//! with its FREEZE_CARD task in background code.
+//!
+//! Why this cannot deadlock a module by itself (priority inversion): the rule decides only
+//! when a handler *starts*; a thread that runs — a task, or an exception handler already
+//! started — is never held back by the order, whatever its rank. So the only waits the order
+//! adds are pending handlers waiting for threads to leave sections. A thread leaves its
+//! section as soon as its own code does; it is held back only by what it awaits (a port, a
+//! delay, a barrier), never by the scheduler. A deadlock inside one module therefore needs a
+//! thread that, inside a section some handler H must outrank, waits — directly or through
+//! other threads — for H itself: it queries its own module, or waits for what an exception
+//! handler it raised would do. For a named section that is a contradiction in the author's
+//! order (the section promises H never runs inside it); for the background it is the seed's
+//! own rule. Either way the wait goes through a port or barrier, so its `TIMEOUT` bounds it,
+//! and a `PORT.TIMEOUT` handler ranked above the section runs. Across modules there is no
+//! rank inheritance: the serving module's order decides when its handler runs, and the
+//! waiter's port timeout bounds the wait, which is how the seed breaks the CHIP_IT/CHIP_IT2
+//! deadlock.
 //!
 //! Two modules: LOAD_IT queries its child LOAD_CARD for its status.
 //!
@@ -81,7 +106,7 @@ pub use module::spec::{ModuleDecl, ModuleSpec, TaskError, TaskResult};
 pub use order::{Order, Rank};
 pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;
-pub use waitfor::{Pool, WaitFor, WaitForError};
+pub use waitfor::{DuplicateMember, Pool, WaitFor, WaitForError};
 pub use work::{Performed, WorkSchedule};
 
 /// Everything a cell author imports.

@@ -24,19 +24,43 @@ struct Members {
 }
 
 impl Members {
-    fn new(names: Vec<Name>) -> Self {
+    /// The members, or the first name listed twice: two members under one name could never
+    /// both arrive, so such a rendezvous could never complete.
+    fn new(names: Vec<Name>) -> Result<Self, Name> {
         let mut places = HashMap::with_capacity(names.len());
         for (place, name) in names.iter().enumerate() {
-            // A name listed twice keeps its first place, as a scan would find it.
-            places.entry(name.as_str().into()).or_insert(place);
+            if places.insert(name.as_str().into(), place).is_some() {
+                return Err(name.clone());
+            }
         }
-        Self { names, places }
+        Ok(Self { names, places })
     }
 
     fn place(&self, task: &str) -> Option<usize> {
         self.places.get(task).copied()
     }
 }
+
+/// A rendezvous that names one task twice, refused by [`WaitFor::new`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DuplicateMember {
+    /// The rendezvous.
+    pub barrier: Name,
+    /// The task named twice.
+    pub task: Name,
+}
+
+impl fmt::Display for DuplicateMember {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "waitfor {} names task {} twice: it could never complete",
+            self.barrier, self.task
+        )
+    }
+}
+
+impl std::error::Error for DuplicateMember {}
 
 /// The pooled messages of one round of a `waitfor`, one per named task.
 #[derive(Debug)]
@@ -156,6 +180,48 @@ impl<M> Round<M> {
     }
 }
 
+impl<M> Round<M> {
+    /// Takes back the message of member `index`, which waits in this round.
+    fn withdraw(&mut self, index: usize) -> M {
+        self.wakers[index] = None;
+        self.count -= 1;
+        self.arrived[index]
+            .take()
+            .expect("the member's message waits")
+    }
+}
+
+/// One member's arrival in a round, withdrawn if its waiter is dropped before the round is
+/// released.
+struct Arrival<'a, M> {
+    barrier: &'a WaitFor<M>,
+    index: usize,
+    generation: u64,
+    armed: bool,
+}
+
+impl<M> Drop for Arrival<'_, M> {
+    fn drop(&mut self) {
+        if !self.armed {
+            return;
+        }
+        let mut round = self.barrier.lock();
+        if round.generation == self.generation && round.arrived[self.index].is_some() {
+            drop(round.withdraw(self.index));
+        }
+    }
+}
+
+impl<M> WaitFor<M> {
+    fn lock(&self) -> MutexGuard<'_, Round<M>> {
+        // Every critical section leaves the round consistent before anything can panic.
+        self.shared
+            .round
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
 impl<M> Clone for WaitFor<M> {
     fn clone(&self) -> Self {
         Self {
@@ -165,18 +231,30 @@ impl<M> Clone for WaitFor<M> {
 }
 
 impl<M: Send + Sync + 'static> WaitFor<M> {
-    /// The rendezvous `name` of the tasks `members`, timed on `clock`.
-    pub fn new<I, N>(name: impl Into<Name>, members: I, clock: SharedClock) -> Self
+    /// The rendezvous `name` of the tasks `members`, timed on `clock`. Refuses a task named
+    /// twice.
+    pub fn new<I, N>(
+        name: impl Into<Name>,
+        members: I,
+        clock: SharedClock,
+    ) -> Result<Self, DuplicateMember>
     where
         I: IntoIterator<Item = N>,
         N: Into<Name>,
     {
-        let members = Arc::new(Members::new(members.into_iter().map(Into::into).collect()));
+        let name = name.into();
+        let members =
+            Members::new(members.into_iter().map(Into::into).collect()).map_err(|task| {
+                DuplicateMember {
+                    barrier: name.clone(),
+                    task,
+                }
+            })?;
         let count = members.names.len();
-        Self {
+        Ok(Self {
             shared: Arc::new(Shared {
-                name: name.into(),
-                members,
+                name,
+                members: Arc::new(members),
                 clock,
                 round: Mutex::new(Round {
                     generation: 0,
@@ -186,7 +264,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                     released: None,
                 }),
             }),
-        }
+        })
     }
 
     /// The rendezvous' name.
@@ -233,6 +311,14 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             }
             generation
         };
+        // A waiter dropped before the round is released (an outer timeout, its module
+        // killed) takes its message back, so the round does not complete without it.
+        let mut arrival = Arrival {
+            barrier: self,
+            index,
+            generation,
+            armed: true,
+        };
         let mut deadline = pin!(timeout.map(|timeout| shared.clock.sleep(timeout)));
         let pool = poll_fn(|cx| {
             let mut round = self.lock();
@@ -253,11 +339,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             if let Some(pool) = round.pool_after(generation) {
                 return Poll::Ready(Ok(pool));
             }
-            round.wakers[index] = None;
-            let message = round.arrived[index]
-                .take()
-                .expect("the caller's message waits");
-            round.count -= 1;
+            let message = round.withdraw(index);
             let missing = shared
                 .members
                 .names
@@ -273,7 +355,9 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 message,
             }))
         })
-        .await?;
+        .await;
+        arrival.armed = false;
+        let pool = pool?;
         Ok(combine(&pool))
     }
 
@@ -292,14 +376,6 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
         for waker in round.wakers.iter_mut().filter_map(Option::take) {
             waker.wake();
         }
-    }
-
-    fn lock(&self) -> MutexGuard<'_, Round<M>> {
-        // Every critical section leaves the round consistent before anything can panic.
-        self.shared
-            .round
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
     }
 }
 

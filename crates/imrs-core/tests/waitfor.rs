@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::paused_runtime;
+use common::{at, paused_runtime, secs};
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -18,7 +18,7 @@ fn rendezvous_of(n: usize) -> Vec<(u64, u64)> {
     paused_runtime().block_on(async move {
         let (cell, clock) = Cell::virtual_clock();
         let names: Vec<String> = (0..n).map(|i| format!("T{i}")).collect();
-        let barrier = WaitFor::<u64>::new("MEET", names.clone(), cell.clock().clone());
+        let barrier = WaitFor::<u64>::new("MEET", names.clone(), cell.clock().clone()).unwrap();
         let results = Arc::new(Mutex::new(vec![(0, 0); n]));
         let mut spec = ModuleSpec::new("TEAM", ());
         for (i, name) in names.iter().enumerate() {
@@ -65,7 +65,7 @@ fn everyone_waits_for_the_last_and_then_each_combines_the_pool() {
 fn each_task_gets_its_own_combination_of_the_same_pool() {
     paused_runtime().block_on(async {
         let clock: SharedClock = Arc::new(VirtualClock::new());
-        let barrier = WaitFor::<&'static str>::new("TRIO", ["A", "B", "C"], clock);
+        let barrier = WaitFor::<&'static str>::new("TRIO", ["A", "B", "C"], clock).unwrap();
         let mut joins = Vec::new();
         for (task, message) in [("A", "a"), ("B", "b"), ("C", "c")] {
             let barrier = barrier.clone();
@@ -115,7 +115,7 @@ fn a_late_task_makes_the_others_time_out_and_they_get_their_messages_back() {
     paused_runtime().block_on(async {
         let clock = VirtualClock::new();
         let shared: SharedClock = Arc::new(clock.clone());
-        let barrier = WaitFor::<u32>::new("SYNC", ["EARLY", "LATE"], shared);
+        let barrier = WaitFor::<u32>::new("SYNC", ["EARLY", "LATE"], shared).unwrap();
         let early = {
             let barrier = barrier.clone();
             tokio::spawn(async move {
@@ -158,7 +158,7 @@ fn a_late_task_makes_the_others_time_out_and_they_get_their_messages_back() {
 fn a_stranger_is_refused_with_its_message() {
     paused_runtime().block_on(async {
         let clock: SharedClock = Arc::new(VirtualClock::new());
-        let barrier = WaitFor::<u8>::new("PAIR", ["A", "B"], clock);
+        let barrier = WaitFor::<u8>::new("PAIR", ["A", "B"], clock).unwrap();
         let refused = barrier.waitfor("Z", 9, |_| (), None).await;
         assert_eq!(
             refused,
@@ -172,5 +172,56 @@ fn a_stranger_is_refused_with_its_message() {
             refused.unwrap_err().to_string(),
             "task Z is not named in waitfor PAIR"
         );
+    });
+}
+
+#[test]
+fn a_task_named_twice_is_refused_when_the_rendezvous_is_made() {
+    let clock: SharedClock = Arc::new(VirtualClock::new());
+    let refused = WaitFor::<u8>::new("PAIR", ["A", "B", "A"], clock).unwrap_err();
+    assert_eq!(refused.barrier, "PAIR");
+    assert_eq!(refused.task, "A");
+    assert_eq!(
+        refused.to_string(),
+        "waitfor PAIR names task A twice: it could never complete"
+    );
+}
+
+#[test]
+fn a_dropped_waiter_withdraws_its_message_and_may_wait_again() {
+    paused_runtime().block_on(async {
+        let clock = VirtualClock::new();
+        let shared: SharedClock = Arc::new(clock.clone());
+        let barrier = WaitFor::<&'static str>::new("PAIR", ["A", "B"], shared.clone()).unwrap();
+        // A waits, but an outer timeout drops its wait before B comes.
+        let a = {
+            let barrier = barrier.clone();
+            let clock = shared.clone();
+            tokio::spawn(async move {
+                let first = tokio::select! {
+                    met = barrier.waitfor("A", "stale", |_| (), None) => Some(met),
+                    () = clock.sleep(secs(1)) => None,
+                };
+                assert!(first.is_none(), "B never came in the first second");
+                clock.sleep(secs(4)).await;
+                barrier
+                    .waitfor("A", "fresh", |pool| *pool.getmess("B").unwrap(), None)
+                    .await
+            })
+        };
+        let b = {
+            let barrier = barrier.clone();
+            let clock = shared.clone();
+            tokio::spawn(async move {
+                clock.sleep(secs(2)).await;
+                barrier
+                    .waitfor("B", "b", |pool| *pool.getmess("A").unwrap(), None)
+                    .await
+            })
+        };
+        imrs_core::time::drive(&clock, at(10)).await;
+        // B met A's second call, not the message of the dropped one.
+        assert_eq!(b.await.unwrap().unwrap(), "fresh");
+        assert_eq!(a.await.unwrap().unwrap(), "b");
     });
 }

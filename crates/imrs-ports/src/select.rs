@@ -35,6 +35,11 @@ pub trait Alternative {
     fn priority(&self) -> Option<Priority>;
     /// Takes its message if one is ready, or registers the task to be woken.
     fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<Self::Output>;
+    /// Whether nothing can ever be ready again (its port is closed for good). Asked after a
+    /// [`poll_ready`](Alternative::poll_ready) that found nothing.
+    fn is_closed(&self) -> bool {
+        false
+    }
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, U: Receives> Alternative for &mut End<Req, Rep, U> {
@@ -47,6 +52,10 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Receives> Alternative for &mut
     fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<Self::Output> {
         poll_take(&self.attachment, cx)
             .map(|(message, from)| (message, ReplyHandle::new(&self.attachment, from)))
+    }
+
+    fn is_closed(&self) -> bool {
+        self.attachment.peer_gone() && !self.attachment.has_waiting()
     }
 }
 
@@ -72,15 +81,20 @@ impl<A: Alternative> Alternative for Guarded<A> {
     fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<A::Output> {
         self.alternative.poll_ready(cx)
     }
+
+    fn is_closed(&self) -> bool {
+        self.alternative.is_closed()
+    }
 }
 
-/// Every alternative of a `select` was closed by its guard: nothing could ever be chosen.
+/// Every alternative of a `select` was closed, by its guard or because its port is closed
+/// for good (no peer can ever come back to it): nothing could ever be chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AllClosed;
 
 impl fmt::Display for AllClosed {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("every alternative of the select is closed by its guard")
+        f.write_str("every alternative of the select is closed, by its guard or for good")
     }
 }
 
@@ -95,6 +109,8 @@ pub trait Arms<Out> {
     fn priority(&self, index: usize) -> Option<Priority>;
     /// Polls arm `index`.
     fn poll_arm(&mut self, index: usize, cx: &mut Context<'_>) -> Poll<Out>;
+    /// Whether arm `index` can never be ready again.
+    fn is_closed(&self, index: usize) -> bool;
 }
 
 impl<Out> Arms<Out> for () {
@@ -106,6 +122,10 @@ impl<Out> Arms<Out> for () {
 
     fn poll_arm(&mut self, _: usize, _: &mut Context<'_>) -> Poll<Out> {
         Poll::Pending
+    }
+
+    fn is_closed(&self, _: usize) -> bool {
+        true
     }
 }
 
@@ -138,6 +158,14 @@ where
             arm.alternative.poll_ready(cx).map(&mut arm.then)
         } else {
             self.0.poll_arm(index, cx)
+        }
+    }
+
+    fn is_closed(&self, index: usize) -> bool {
+        if index == Rest::LEN {
+            self.1.alternative.is_closed()
+        } else {
+            self.0.is_closed(index)
         }
     }
 }
@@ -192,13 +220,19 @@ impl<Out, A: Arms<Out> + Unpin> Future for Select<Out, A> {
         if cursor.is_none() {
             return Poll::Ready(Err(AllClosed));
         }
+        let mut all_closed = true;
         while let Some((priority, index)) = cursor {
             if let Poll::Ready(out) = this.arms.poll_arm(index, cx) {
                 return Poll::Ready(Ok(out));
             }
+            all_closed &= this.arms.is_closed(index);
             cursor = this.next_in_order(Some((priority, index)));
         }
-        Poll::Pending
+        if all_closed {
+            Poll::Ready(Err(AllClosed))
+        } else {
+            Poll::Pending
+        }
     }
 }
 

@@ -206,6 +206,24 @@ impl<Req, Rep> Slot<Req, Rep> {
         }
     }
 
+    /// Poster: takes its request back if no server has taken it; a request already taken
+    /// stays with its server.
+    ///
+    /// # Safety
+    ///
+    /// As for [`Slot::poll_answer`].
+    pub(crate) unsafe fn withdraw_unsent(&self) -> Option<Req> {
+        self.state
+            .compare_exchange(POSTED, EMPTY, Ordering::AcqRel, Ordering::Acquire)
+            .ok()?;
+        // SAFETY: POSTED -> EMPTY by the poster: no server took the request, and none can
+        // now; the cell is the poster's again.
+        Some(
+            self.request
+                .with_mut(|cell| unsafe { (*cell).assume_init_read() }),
+        )
+    }
+
     /// Poster: gives up on its request (a timeout, a closed port, a dropped future).
     ///
     /// # Safety

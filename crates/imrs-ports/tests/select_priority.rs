@@ -127,3 +127,51 @@ fn select_waits_until_a_message_arrives() {
         late.await.unwrap();
     });
 }
+
+#[test]
+fn a_select_over_ports_closed_for_good_ends_as_receive_does() {
+    on_both_runtimes(|| async {
+        let [urgent, normal, _] = three_ports();
+        let mut urgent_owner = urgent.owner().unwrap();
+        let mut normal_owner = normal.owner().unwrap();
+        let late_sender = normal.user_named("LATE").unwrap();
+        // Both declarations go, and then the last user: nobody can ever send on either.
+        drop((urgent, normal));
+        let selecting = tokio::spawn(async move {
+            let result = select()
+                .or(&mut urgent_owner, |_| "urgent")
+                .or(&mut normal_owner, |_| "normal")
+                .await;
+            let receive = urgent_owner.receive().await.map(|_| ());
+            (result, receive.is_err())
+        });
+        tokio::task::yield_now().await;
+        drop(late_sender);
+        let (result, receive_closed) = selecting.await.unwrap();
+        assert!(receive_closed, "receive on the same port says Closed");
+        assert_eq!(result, Err(AllClosed));
+    });
+}
+
+#[test]
+fn a_message_sent_before_the_port_closed_is_still_selected() {
+    on_both_runtimes(|| async {
+        let [urgent, _, _] = three_ports();
+        let mut owner = urgent.owner().unwrap();
+        let mut sender = urgent.user_named("LAST").unwrap();
+        drop(urgent);
+        let sending = tokio::spawn(async move { sender.send(7).await });
+        let chosen = select()
+            .or(
+                &mut owner,
+                |(message, reply): (u32, imrs_ports::ReplyHandle<()>)| {
+                    reply.reply(());
+                    message
+                },
+            )
+            .await;
+        assert_eq!(chosen, Ok(7));
+        sending.await.unwrap().unwrap();
+        assert_eq!(select().or(&mut owner, |_| 0).await, Err(AllClosed));
+    });
+}

@@ -88,3 +88,25 @@ fn send_all_times_out_when_nobody_answers() {
         assert!(robot.try_receive().is_none());
     });
 }
+
+#[test]
+fn send_all_does_not_wait_for_a_user_that_detached_before_taking_the_message() {
+    on_both_runtimes(|| async {
+        let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+        let mut supervisor = port.owner().unwrap();
+        let mut answering = port.user_named("ROBOT1").unwrap();
+        let leaving = port.user_named("ROBOT2").unwrap();
+        let sending = tokio::spawn(async move {
+            let mut broadcast = supervisor.send_all("halt").await.unwrap();
+            let later = broadcast.next_reply().await;
+            (broadcast.from.to_string(), broadcast.first, later)
+        });
+        let (_, reply) = answering.receive().await.unwrap();
+        reply.reply(1);
+        // ROBOT2 goes without taking "halt": the broadcast must end without its answer.
+        drop(leaving);
+        let (from, first, later) = sending.await.unwrap();
+        assert_eq!((from.as_str(), first), ("ROBOT1", 1));
+        assert_eq!(later, None);
+    });
+}

@@ -24,24 +24,45 @@ use crate::supervision::RestartPolicy;
 use crate::waitfor::{Pool, WaitFor, WaitForError};
 use crate::work::{Performed, WorkSchedule};
 
-/// The section a thread of a module is in, as a rank: read by the module's scheduler at
-/// every suspension point.
+/// The section a thread of a module is in, as a rank, and whether it is a *named* section
+/// (one the order ranks, such as `GRASP`): read by the module's scheduler at every
+/// suspension point.
 #[derive(Debug)]
 pub(crate) struct SectionCell(AtomicU32);
 
+/// The bit of a [`SectionCell`] that marks a named section; ranks use the bits below it.
+const NAMED: u32 = 1 << 31;
+
 impl SectionCell {
+    /// A thread in background code or a handler at `rank`: no named section.
     pub(crate) fn new(rank: Rank) -> Self {
         Self(AtomicU32::new(rank.position()))
     }
 
     pub(crate) fn get(&self) -> Rank {
-        Rank::from_raw(self.0.load(Ordering::Relaxed))
+        Rank::from_raw(self.0.load(Ordering::Relaxed) & !NAMED)
     }
 
-    fn replace(&self, rank: Rank) -> Rank {
-        Rank::from_raw(self.0.swap(rank.position(), Ordering::Relaxed))
+    /// The rank of the named section the thread is in, if it is in one.
+    pub(crate) fn named(&self) -> Option<Rank> {
+        let raw = self.0.load(Ordering::Relaxed);
+        (raw & NAMED != 0).then(|| Rank::from_raw(raw & !NAMED))
     }
 
+    /// Enters a section: a named one at `rank`, or (`None`) one the order does not name,
+    /// which keeps the rank of the code around it. Returns what to restore on leaving.
+    fn enter(&self, rank: Option<Rank>) -> u32 {
+        match rank {
+            Some(rank) => self.0.swap(rank.position() | NAMED, Ordering::Relaxed),
+            None => self.0.load(Ordering::Relaxed),
+        }
+    }
+
+    fn restore(&self, raw: u32) {
+        self.0.store(raw, Ordering::Relaxed);
+    }
+
+    /// Back to background code (or a handler) at `rank`.
     pub(crate) fn set(&self, rank: Rank) {
         self.0.store(rank.position(), Ordering::Relaxed);
     }
@@ -202,11 +223,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// thread at the section's rank. A section the order does not name keeps the rank of the
     /// code around it.
     pub async fn section<F: Future>(&self, name: &str, body: F) -> F::Output {
-        let rank = self
-            .module
-            .order
-            .rank_of(name)
-            .unwrap_or_else(|| self.section.get());
+        let rank = self.module.order.rank_of(name);
         let name: Name = name.into();
         let _inside = SectionGuard::enter(self, name.clone(), rank);
         let span = tracing::debug_span!("section", module = %self.module.name, section = %name);
@@ -443,12 +460,12 @@ impl<S> fmt::Debug for Ctx<S> {
 struct SectionGuard<'a, S: Send + Sync + 'static> {
     ctx: &'a Ctx<S>,
     name: Name,
-    outer: Rank,
+    outer: u32,
 }
 
 impl<'a, S: Send + Sync + 'static> SectionGuard<'a, S> {
-    fn enter(ctx: &'a Ctx<S>, name: Name, rank: Rank) -> Self {
-        let outer = ctx.section.replace(rank);
+    fn enter(ctx: &'a Ctx<S>, name: Name, rank: Option<Rank>) -> Self {
+        let outer = ctx.section.enter(rank);
         ctx.event(EventKind::SectionEntered {
             section: name.clone(),
         });
@@ -458,7 +475,7 @@ impl<'a, S: Send + Sync + 'static> SectionGuard<'a, S> {
 
 impl<S: Send + Sync + 'static> Drop for SectionGuard<'_, S> {
     fn drop(&mut self) {
-        self.ctx.section.set(self.outer);
+        self.ctx.section.restore(self.outer);
         self.ctx.event(EventKind::SectionLeft {
             section: self.name.clone(),
         });

@@ -5,17 +5,16 @@
 //! when pending handlers may start. The rule (seed 000, §4.2 and §5.1):
 //!
 //! - A pending handler (a query for a response handler, a raised exception) starts when its
-//!   rank outranks the section that some live thread of the module is in, at that thread's
-//!   suspension point: that is, at the end of a poll. Ranks are re-checked after every poll
-//!   of every thread. Wakers only wake the module's task; nothing is polled inside a waker.
+//!   rank outranks the section of the thread it interrupts (the least urgent live thread)
+//!   and every named section that any live thread of the module is in, at the end of a
+//!   poll. Ranks are re-checked after every poll of every thread. Wakers only wake the
+//!   module's task; nothing is polled inside a waker.
 //! - A response handler is synchronous: it runs to completion right there, reading `&S`.
 //!   An exception handler is asynchronous and becomes a thread of its own, at its rank.
 //! - The order decides only when handlers *start*; it never stops a running thread from
-//!   making progress. So a high-rank thread waiting on a port served by a lower-ranked thread
-//!   of the same module cannot deadlock: the lower-ranked thread keeps running (this is the
-//!   rule for priority inversion). Across modules there is no rank inheritance: the serving
-//!   module's order decides when its handler runs, and the waiter's port timeout bounds the
-//!   wait — which is how the seed breaks the CHIP_IT/CHIP_IT2 deadlock.
+//!   making progress, so a high-rank thread waiting on a port served by a lower-ranked thread
+//!   of the same module cannot deadlock. The crate docs ("The order rule") give the whole
+//!   argument.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::pin::Pin;
@@ -190,15 +189,28 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         }
     }
 
-    /// The least urgent section any live thread is in: a handler must outrank it to start.
-    /// `None` when no thread lives, and any handler may start.
+    /// The rank a pending handler must outrank to start: the most urgent *named* section a
+    /// live thread is in, or, when no thread is in one, the least urgent section of any live
+    /// thread (the one a handler interrupts). `None` when no thread lives, and any handler
+    /// may start.
+    ///
+    /// A named section always ranks at least as urgent as the least urgent live thread, so
+    /// this is the rule "outrank the thread you interrupt and every named section occupied".
     fn host_rank(&self) -> Option<Rank> {
         let tasks = self.tasks.iter().filter_map(|task| match task.stage {
-            Stage::Running(_) => Some(task.section.get()),
+            Stage::Running(_) => Some(&*task.section),
             _ => None,
         });
-        let handlers = self.handlers.iter().map(|handler| handler.section.get());
-        tasks.chain(handlers).max()
+        let handlers = self.handlers.iter().map(|handler| &*handler.section);
+        let mut least_urgent = None;
+        let mut named: Option<Rank> = None;
+        for section in tasks.chain(handlers) {
+            least_urgent = least_urgent.max(Some(section.get()));
+            if let Some(rank) = section.named() {
+                named = Some(named.map_or(rank, |most_urgent| most_urgent.min(rank)));
+            }
+        }
+        named.or(least_urgent)
     }
 
     /// Starts every pending handler whose rank allows it now. Returns whether a thread
