@@ -40,7 +40,7 @@ fn query(iters: u64, busy: bool) -> Duration {
             });
         // Asker and responder on one processor, as the same-thread rendezvous below.
         let processor = Processor::new("CPU1");
-        let robot = cell.start_on(&processor, responder);
+        let robot = cell.start_on(&processor, responder).unwrap();
         let mut asker = port.owner().unwrap();
         let asking = processor.spawn(async move {
             let start = Instant::now();

@@ -39,7 +39,7 @@ fn queries(round_trips: u64) {
                     .expect("a new port has room for a responder"),
             )
             .task("ROBOT", |_ctx| std::future::pending());
-        let robot = cell.start_on(&processor, responder);
+        let robot = cell.start_on(&processor, responder).unwrap();
         let mut asker = port.owner().expect("a new port has no owner yet");
         processor
             .spawn(async move {

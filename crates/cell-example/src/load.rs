@@ -52,11 +52,11 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
                 let (child_ports, child_sim) = (ports.clone(), sim.clone());
                 ctx.costart_supervised(CHILD_RESTARTS, move || {
                     load_card(line, &child_ports, &child_sim)
-                });
+                })?;
                 let (child_ports, child_sim) = (ports.clone(), sim.clone());
                 ctx.costart_supervised(CHILD_RESTARTS, move || {
                     screw_in_card(line, &child_ports, &child_sim)
-                });
+                })?;
                 let mut ask_child1 = ports.ask_child1.owner()?;
                 let mut ask_child2 = ports.ask_child2.owner()?;
                 let mut frequency = ports.frequency.user_named(n.load_it.clone())?;

@@ -155,7 +155,7 @@ async fn simulate(
     sim.spawn();
     let policy = RestartPolicy::restart(3, Duration::from_secs(5));
     if config.feeder == FeederPolicy::Arbiter {
-        cell.start(feeder_monitor(&ports));
+        cell.start(feeder_monitor(&ports))?;
     }
     for line in Line::ALL {
         let (lines, sim) = (ports.lines[line.index()].clone(), sim.clone());
@@ -163,8 +163,8 @@ async fn simulate(
         let (gate_lines, gate_sim) = (lines.clone(), sim.clone());
         cell.supervise(policy, move || {
             gate(line, &gate_lines, &gate_sim, Arc::clone(&death))
-        });
-        cell.start(load_it(line, &lines, &sim));
+        })?;
+        cell.start(load_it(line, &lines, &sim))?;
         let (all_ports, chip_sim, chip_waits, feeder) = (
             ports.clone(),
             sim.clone(),
@@ -173,7 +173,7 @@ async fn simulate(
         );
         cell.supervise(policy, move || {
             chip_it(line, feeder, &all_ports, &chip_sim, Arc::clone(&chip_waits))
-        });
+        })?;
     }
 
     let total = Duration::from_secs_f64(config.hours * 3600.0);

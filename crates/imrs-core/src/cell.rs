@@ -1,6 +1,7 @@
 //! A cell: the clock, the event log, the wiring, and the modules running in it.
 
 use std::collections::BTreeMap;
+use std::collections::btree_map::Entry;
 use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
@@ -10,7 +11,7 @@ use imrs_ports::{
 };
 use tokio::sync::watch;
 
-use crate::check::{CellErrors, check};
+use crate::check::{CellError, CellErrors, check};
 use crate::deadlock::WaitGraph;
 use crate::event::{Event, EventKind, EventLog};
 use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
@@ -153,14 +154,23 @@ impl Cell {
         check(&lock(&self.shared.wiring), modules)
     }
 
-    /// Starts `spec` as a top-level module. If it fails, it stays failed.
-    pub fn start<S: Send + Sync + 'static>(&self, spec: ModuleSpec<S>) -> ModuleHandle {
+    /// Starts `spec` as a top-level module. If it fails, it stays failed. Refused if a
+    /// module of the same name runs in the cell.
+    pub fn start<S: Send + Sync + 'static>(
+        &self,
+        spec: ModuleSpec<S>,
+    ) -> Result<ModuleHandle, CellError> {
         self.launch(None, RestartPolicy::NEVER, spec, None)
     }
 
     /// Starts a top-level module made by `factory`, and makes a new copy of it with
-    /// `factory` when it fails or is killed, as `policy` allows.
-    pub fn supervise<S, F>(&self, policy: RestartPolicy, mut factory: F) -> ModuleHandle
+    /// `factory` when it fails or is killed, as `policy` allows. Refused if a module of the
+    /// same name runs in the cell.
+    pub fn supervise<S, F>(
+        &self,
+        policy: RestartPolicy,
+        mut factory: F,
+    ) -> Result<ModuleHandle, CellError>
     where
         S: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
@@ -175,7 +185,7 @@ impl Cell {
         &self,
         processor: &Processor,
         spec: ModuleSpec<S>,
-    ) -> ModuleHandle {
+    ) -> Result<ModuleHandle, CellError> {
         self.launch(Some(processor), RestartPolicy::NEVER, spec, None)
     }
 
@@ -185,7 +195,7 @@ impl Cell {
         processor: &Processor,
         policy: RestartPolicy,
         mut factory: F,
-    ) -> ModuleHandle
+    ) -> Result<ModuleHandle, CellError>
     where
         S: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
@@ -202,15 +212,15 @@ impl Cell {
         policy: RestartPolicy,
         first: ModuleSpec<S>,
         factory: Option<Factory<S>>,
-    ) -> ModuleHandle {
+    ) -> Result<ModuleHandle, CellError> {
         let Some(processor) = processor else {
             return spawn_module(Arc::clone(&self.shared), None, policy, first, factory);
         };
         let (handle, supervisor) =
-            supervisor(Arc::clone(&self.shared), None, policy, first, factory);
+            supervisor(Arc::clone(&self.shared), None, policy, first, factory)?;
         // The module handle reports how the module ends: no job handle is needed.
         processor.place(supervisor);
-        handle
+        Ok(handle)
     }
 
     /// Kills the running copy of `module`; a supervised module gets a new copy. Returns
@@ -297,24 +307,29 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
     policy: RestartPolicy,
     first: ModuleSpec<S>,
     factory: Option<Factory<S>>,
-) -> ModuleHandle {
-    let (handle, supervisor) = supervisor(cell, parent, policy, first, factory);
+) -> Result<ModuleHandle, CellError> {
+    let (handle, supervisor) = supervisor(cell, parent, policy, first, factory)?;
     tokio::spawn(supervisor);
-    handle
+    Ok(handle)
 }
 
 /// The supervisor of one module: it runs copies of the module until one finishes, or the
-/// policy is spent, or the module is stopped. The caller places it on a task.
+/// policy is spent, or the module is stopped. The caller places it on a task. Each copy's
+/// costarted children are stopped, and waited for, when the copy ends: a child belongs to
+/// the copy of its parent that started it.
 fn supervisor<S: Send + Sync + 'static>(
     cell: Arc<CellShared>,
     parent: Option<Name>,
     policy: RestartPolicy,
     first: ModuleSpec<S>,
     mut factory: Option<Factory<S>>,
-) -> (ModuleHandle, impl Future<Output = ()> + Send + 'static) {
+) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellError> {
     let name = first.name.clone();
     let kill = Arc::new(KillSwitch::default());
-    lock(&cell.modules).insert(name.clone(), Arc::clone(&kill));
+    match lock(&cell.modules).entry(name.clone()) {
+        Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }),
+        Entry::Vacant(vacant) => vacant.insert(Arc::clone(&kill)),
+    };
     let (report, done) = watch::channel(None);
     let handle = ModuleHandle {
         name: name.clone(),
@@ -335,8 +350,16 @@ fn supervisor<S: Send + Sync + 'static>(
                 unreachable!("a copy is made before every run");
             };
             kill.rearm();
-            let exit =
-                ModuleRun::new(spec, Arc::clone(&cell), parent.clone(), Arc::clone(&kill)).await;
+            let children = Children::default();
+            let copy = ModuleRun::new(
+                spec,
+                Arc::clone(&cell),
+                parent.clone(),
+                Arc::clone(&kill),
+                children.clone(),
+            );
+            let exit = copy.await;
+            children.stop_all().await;
             let outcome = match exit {
                 ModuleExit::Finished => {
                     cell.record(&name, EventKind::ModuleFinished);
@@ -374,5 +397,27 @@ fn supervisor<S: Send + Sync + 'static>(
         lock(&cell.modules).remove(&name);
         report.send_replace(Some(outcome));
     };
-    (handle, supervisor)
+    Ok((handle, supervisor))
+}
+
+/// The modules one copy of a module costarted.
+#[derive(Clone, Default)]
+pub(crate) struct Children(Arc<Mutex<Vec<ModuleHandle>>>);
+
+impl Children {
+    pub(crate) fn adopt(&self, child: &ModuleHandle) {
+        lock(&self.0).push(child.clone());
+    }
+
+    /// Stops every child for good and waits until each has ended (and, in turn, its own
+    /// children), so that a new copy of the parent can start children of the same names.
+    async fn stop_all(&self) {
+        let children = std::mem::take(&mut *lock(&self.0));
+        for child in &children {
+            child.stop();
+        }
+        for mut child in children {
+            child.finished().await;
+        }
+    }
 }

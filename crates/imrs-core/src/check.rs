@@ -167,6 +167,8 @@ impl fmt::Display for CellError {
     }
 }
 
+impl std::error::Error for CellError {}
+
 /// Every wiring problem of a cell.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CellErrors(pub Vec<CellError>);
@@ -181,6 +183,12 @@ impl fmt::Display for CellErrors {
 }
 
 impl std::error::Error for CellErrors {}
+
+impl From<CellError> for CellErrors {
+    fn from(error: CellError) -> Self {
+        Self(vec![error])
+    }
+}
 
 impl From<WireError> for CellErrors {
     fn from(error: WireError) -> Self {

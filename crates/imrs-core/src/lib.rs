@@ -71,8 +71,8 @@
 //!         Ok(())
 //!     }
 //! });
-//! cell.start(load_card);
-//! let mut load_it = cell.start(load_it);
+//! cell.start(load_card)?;
+//! let mut load_it = cell.start(load_it)?;
 //! imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(30))).await;
 //! assert_eq!(load_it.finished().await, ModuleOutcome::Finished);
 //! # Ok::<_, Box<dyn std::error::Error>>(())

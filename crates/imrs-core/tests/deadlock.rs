@@ -87,7 +87,7 @@ fn the_chip_robots_deadlock_is_reported_and_broken_by_asymmetric_timeouts() {
         let log: Log = Arc::default();
         let chip_it = chip_robot("CHIP_IT", share_feeder.clone(), &share_feeder1, Arc::clone(&log));
         let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
-        let mut handles = [cell.start(chip_it), cell.start(chip_it2)];
+        let mut handles = [cell.start(chip_it).unwrap(), cell.start(chip_it2).unwrap()];
         drive(&clock, at(40)).await;
         for handle in &mut handles {
             assert_eq!(handle.finished().await, ModuleOutcome::Finished);

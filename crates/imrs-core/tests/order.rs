@@ -98,8 +98,11 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
                 });
             askers.push(asker);
         }
-        cell.start(chip_it);
-        let askers: Vec<_> = askers.into_iter().map(|asker| cell.start(asker)).collect();
+        cell.start(chip_it).unwrap();
+        let askers: Vec<_> = askers
+            .into_iter()
+            .map(|asker| cell.start(asker).unwrap())
+            .collect();
         drive(&clock, at(60)).await;
         for asker in &askers {
             assert_eq!(
@@ -201,7 +204,7 @@ fn a_let_1_go_timeout_interrupts_gates_background_which_restarts_release() {
                     }
                 }
             });
-        let gate = cell.start(gate);
+        let gate = cell.start(gate).unwrap();
         drive(&clock, at(40)).await;
         assert_eq!(gate.outcome(), None, "RELEASE loops forever, so GATE runs on");
 
@@ -271,7 +274,7 @@ fn a_high_rank_handler_waiting_on_a_low_rank_task_of_its_module_is_not_blocked()
                     Ok(())
                 }
             });
-        let mut gate = cell.start(gate);
+        let mut gate = cell.start(gate).unwrap();
         drive(&clock, at(10)).await;
         assert_eq!(gate.finished().await, ModuleOutcome::Finished);
     });

@@ -61,9 +61,9 @@ fn independent_a_proprietor_owns_the_shared_conveyor_state() {
                     }
                 })
         };
-        cell.start(proprietor);
-        cell.start(station("GATE", 1, 2, 10));
-        cell.start(station("CHIP_IT", -1, 3, 5));
+        cell.start(proprietor).unwrap();
+        cell.start(station("GATE", 1, 2, 10)).unwrap();
+        cell.start(station("CHIP_IT", -1, 3, 5)).unwrap();
         let mut reader = occupancy.user_named("REPORT").unwrap();
         drive(&clock, at(10)).await;
         assert_eq!(reader.query(()).await.unwrap(), 5 - 3);
@@ -120,10 +120,10 @@ fn loosely_coupled_two_robots_share_a_tool_through_a_monitor() {
                     }
                 })
         };
-        cell.start(crib);
+        cell.start(crib).unwrap();
         let mut robots = [
-            cell.start(robot("ROBOT_A", 2)),
-            cell.start(robot("ROBOT_B", 3)),
+            cell.start(robot("ROBOT_A", 2)).unwrap(),
+            cell.start(robot("ROBOT_B", 3)).unwrap(),
         ];
         drive(&clock, at(60)).await;
         for robot in &mut robots {
@@ -184,7 +184,7 @@ fn tightly_coupled_a_parent_directs_its_child_through_a_tight_port() {
                             }
                         }
                     });
-                    let gripper = ctx.costart(gripper);
+                    let gripper = ctx.costart(gripper).unwrap();
                     let mut direct = direct.owner()?;
                     for opening in 0..1000 {
                         assert_eq!(direct.send(opening).await?, opening * 2);
@@ -194,7 +194,7 @@ fn tightly_coupled_a_parent_directs_its_child_through_a_tight_port() {
                 }
             }
         });
-        let mut arm = cell.start(arm);
+        let mut arm = cell.start(arm).unwrap();
         assert_eq!(arm.finished().await, ModuleOutcome::Finished);
     });
 }
@@ -236,8 +236,8 @@ fn serialized_motion_a_send_releases_the_next_step() {
                     }
                 }
             });
-        cell.start(screw_in_card);
-        cell.start(load_card);
+        cell.start(screw_in_card).unwrap();
+        cell.start(load_card).unwrap();
         drive(&clock, at(20)).await;
         let sections: Vec<_> = cell
             .events()
@@ -332,8 +332,8 @@ fn work_coupled_a_mate_takes_over_and_nothing_is_applied_twice_or_lost() {
                 }
             }
         });
-        cell.start(load_b);
-        let mut load_a = cell.start(load_a);
+        cell.start(load_b).unwrap();
+        let mut load_a = cell.start(load_a).unwrap();
         drive(&clock, at(30)).await;
         assert!(matches!(load_a.finished().await, ModuleOutcome::Failed(_)));
         assert_eq!(*loaded.lock().unwrap(), (0..CARDS).collect::<Vec<_>>());

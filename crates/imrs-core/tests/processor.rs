@@ -48,8 +48,8 @@ fn feeder_and_robot(rounds: u32) -> Vec<Event> {
                 Ok(())
             }
         });
-        let mut feeder = cell.start_on(&processor, feeder);
-        let mut robot = cell.start_on(&processor, robot);
+        let mut feeder = cell.start_on(&processor, feeder).unwrap();
+        let mut robot = cell.start_on(&processor, robot).unwrap();
         drive(&clock, at(u64::from(rounds) + 1)).await;
         assert_eq!(robot.finished().await, ModuleOutcome::Finished);
         assert_eq!(feeder.finished().await, ModuleOutcome::Finished);

@@ -107,9 +107,9 @@ fn run_cell(seed: u64) -> Vec<Event> {
                 }
             });
 
-        cell.start(inspector);
-        cell.start(robot);
-        cell.start(feeder);
+        cell.start(inspector).unwrap();
+        cell.start(robot).unwrap();
+        cell.start(feeder).unwrap();
         drive(&clock, Instant::from_start(Duration::from_secs(60))).await;
         cell.events().snapshot()
     })

@@ -76,7 +76,7 @@ fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_backg
                     ctx.delay(secs(1)).await;
                 }
             });
-        cell.start(welder);
+        cell.start(welder).unwrap();
 
         let mut askers = Vec::new();
         for asked in [3, 8, 22, 33, 40] {
@@ -91,7 +91,7 @@ fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_backg
                     Ok(())
                 }
             });
-            askers.push(cell.start(asker));
+            askers.push(cell.start(asker).unwrap());
         }
         drive(&clock, at(60)).await;
         for asker in &askers {
@@ -151,7 +151,7 @@ fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_fre
                     ctx.delay(secs(2)).await;
                 }
             });
-        cell.start(chip_it);
+        cell.start(chip_it).unwrap();
 
         let mut askers = Vec::new();
         for asked in [5, 15, 25, 35, 45, 52] {
@@ -165,7 +165,7 @@ fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_fre
                     Ok(())
                 }
             });
-            askers.push(cell.start(asker));
+            askers.push(cell.start(asker).unwrap());
         }
         drive(&clock, at(59)).await;
         for asker in &askers {

@@ -33,23 +33,25 @@ fn a_module_killed_mid_rendezvous_fails_its_users_and_its_copy_serves_them_after
         let copies = Arc::new(AtomicU32::new(0));
         let screwer_port = card_in_place.clone();
         let screwer_copies = Arc::clone(&copies);
-        let screwer = cell.supervise(RestartPolicy::restart(3, secs(1)), move || {
-            let port = screwer_port.clone();
-            let copies = Arc::clone(&screwer_copies);
-            ModuleSpec::new("SCREW_IN_CARD", ()).task("SCREW_IN_CARD", move |ctx| {
-                let port = port.clone();
-                let copy = copies.fetch_add(1, Ordering::SeqCst);
-                async move {
-                    let mut card_in_place = port.user_named("SCREW_IN_CARD")?;
-                    loop {
-                        let (card, reply) = ctx.receive(&mut card_in_place).await?;
-                        // The first copy takes 10 s to screw (and is killed meanwhile).
-                        ctx.delay(secs(if copy == 0 { 10 } else { 1 })).await;
-                        reply.reply(card as i32);
+        let screwer = cell
+            .supervise(RestartPolicy::restart(3, secs(1)), move || {
+                let port = screwer_port.clone();
+                let copies = Arc::clone(&screwer_copies);
+                ModuleSpec::new("SCREW_IN_CARD", ()).task("SCREW_IN_CARD", move |ctx| {
+                    let port = port.clone();
+                    let copy = copies.fetch_add(1, Ordering::SeqCst);
+                    async move {
+                        let mut card_in_place = port.user_named("SCREW_IN_CARD")?;
+                        loop {
+                            let (card, reply) = ctx.receive(&mut card_in_place).await?;
+                            // The first copy takes 10 s to screw (and is killed meanwhile).
+                            ctx.delay(secs(if copy == 0 { 10 } else { 1 })).await;
+                            reply.reply(card as i32);
+                        }
                     }
-                }
+                })
             })
-        });
+            .unwrap();
         let outcomes = Arc::new(std::sync::Mutex::new(Vec::new()));
         let seen = Arc::clone(&outcomes);
         cell.start(
@@ -69,7 +71,8 @@ fn a_module_killed_mid_rendezvous_fails_its_users_and_its_copy_serves_them_after
                     Ok(())
                 }
             }),
-        );
+        )
+        .unwrap();
         // Kill the screwer while it holds card 1.
         drive(&clock, at(3)).await;
         assert!(cell.kill("SCREW_IN_CARD"));
@@ -104,7 +107,7 @@ fn a_failing_task_is_restarted_with_backoff_until_its_policy_is_spent() {
             RestartPolicy::restart(2, secs(1)),
             |_ctx| async move { Err::<(), TaskError>("jammed".into()) },
         );
-        let mut feeder = cell.start(spec);
+        let mut feeder = cell.start(spec).unwrap();
         drive(&clock, at(10)).await;
         assert_eq!(
             feeder.finished().await,
@@ -147,7 +150,7 @@ fn a_panicking_task_is_reported_with_module_and_task_names_and_raises_its_except
                 ctx.delay(secs(5)).await;
                 Ok(())
             });
-        let mut chip_it = cell.start(spec);
+        let mut chip_it = cell.start(spec).unwrap();
         drive(&clock, at(10)).await;
         assert_eq!(
             chip_it.finished().await,
@@ -193,7 +196,7 @@ fn costarted_children_run_under_their_parent_and_answer_its_queries() {
                         ctx.delay(secs(100)).await;
                         Ok(())
                     });
-                let child = ctx.costart(child);
+                let child = ctx.costart(child).unwrap();
                 let mut ask_child2 = port.owner()?;
                 ctx.delay(secs(4)).await;
                 let alive = ctx
@@ -208,7 +211,7 @@ fn costarted_children_run_under_their_parent_and_answer_its_queries() {
                 Ok(())
             }
         });
-        cell.start(load_it);
+        cell.start(load_it).unwrap();
         drive(&clock, at(20)).await;
         let results = results.lock().unwrap().clone();
         assert_eq!(results[0], Ok(0));

@@ -38,7 +38,7 @@ fn rendezvous_of(n: usize) -> Vec<(u64, u64)> {
                 }
             });
         }
-        let mut team = cell.start(spec);
+        let mut team = cell.start(spec).unwrap();
         drive(
             &clock,
             Instant::from_start(Duration::from_secs(n as u64 + 1)),

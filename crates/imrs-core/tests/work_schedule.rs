@@ -100,7 +100,7 @@ fn an_empty_feeder_skips_its_step_and_the_others_still_run() {
                 Ok(())
             }
         });
-        let mut chip_it = cell.start(chip_it);
+        let mut chip_it = cell.start(chip_it).unwrap();
         drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
         assert_eq!(chip_it.finished().await, ModuleOutcome::Finished);
         assert_eq!(*inserted.lock().unwrap(), [(10, 10), (40, 10), (20, 10)]);

@@ -16,7 +16,8 @@ use imrs_ports::{
 use tracing::Instrument;
 
 use super::spec::ModuleSpec;
-use crate::cell::{CellShared, ModuleHandle, spawn_module};
+use crate::cell::{CellShared, Children, ModuleHandle, spawn_module};
+use crate::check::CellError;
 use crate::event::{Event, EventKind};
 use crate::exception::Exception;
 use crate::order::{Order, Rank};
@@ -75,6 +76,8 @@ pub(crate) struct ModuleShared<S> {
     pub(crate) state: ModuleState<S>,
     pub(crate) order: Order,
     pub(crate) cell: Arc<CellShared>,
+    /// The modules this copy costarted, stopped when it ends.
+    children: Children,
     raised: Mutex<VecDeque<Exception>>,
     restarts: Mutex<Vec<Name>>,
     /// Set while `raised` or `restarts` may hold something, so that the scheduler, which
@@ -89,6 +92,7 @@ impl<S> ModuleShared<S> {
         state: S,
         order: Order,
         cell: Arc<CellShared>,
+        children: Children,
     ) -> Self {
         Self {
             name: spec_name,
@@ -96,6 +100,7 @@ impl<S> ModuleShared<S> {
             state: ModuleState::new(state),
             order,
             cell,
+            children,
             raised: Mutex::new(VecDeque::new()),
             restarts: Mutex::new(Vec::new()),
             pending: AtomicBool::new(false),
@@ -384,34 +389,37 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         self.module.cell.kill(module)
     }
 
-    /// `COSTART`: starts `child` as a child module of this one.
-    pub fn costart<C: Send + Sync + 'static>(&self, child: ModuleSpec<C>) -> ModuleHandle {
+    /// `COSTART`: starts `child` as a child module of this one. The child belongs to this
+    /// copy of the module: when the copy ends (finished, failed, killed), the child is
+    /// stopped. Refused if a module of the child's name runs in the cell.
+    pub fn costart<C: Send + Sync + 'static>(
+        &self,
+        child: ModuleSpec<C>,
+    ) -> Result<ModuleHandle, CellError> {
         let cell = Arc::clone(&self.module.cell);
-        spawn_module(
-            cell,
-            Some(self.module.name.clone()),
-            RestartPolicy::NEVER,
-            child,
-            None,
-        )
+        let parent = Some(self.module.name.clone());
+        let handle = spawn_module(cell, parent, RestartPolicy::NEVER, child, None)?;
+        self.module.children.adopt(&handle);
+        Ok(handle)
     }
 
     /// As [`Ctx::costart`], with a factory that makes a new copy of the child after a
     /// failure, as `policy` allows.
-    pub fn costart_supervised<C, F>(&self, policy: RestartPolicy, mut factory: F) -> ModuleHandle
+    pub fn costart_supervised<C, F>(
+        &self,
+        policy: RestartPolicy,
+        mut factory: F,
+    ) -> Result<ModuleHandle, CellError>
     where
         C: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<C> + Send + 'static,
     {
         let cell = Arc::clone(&self.module.cell);
+        let parent = Some(self.module.name.clone());
         let first = factory();
-        spawn_module(
-            cell,
-            Some(self.module.name.clone()),
-            policy,
-            first,
-            Some(Box::new(factory)),
-        )
+        let handle = spawn_module(cell, parent, policy, first, Some(Box::new(factory)))?;
+        self.module.children.adopt(&handle);
+        Ok(handle)
     }
 
     pub(crate) fn event(&self, kind: EventKind) {

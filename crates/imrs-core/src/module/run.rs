@@ -28,6 +28,7 @@ use imrs_ports::{Name, Respond};
 
 use super::ctx::{Ctx, ModuleShared, SectionCell};
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
+use crate::cell::Children;
 use crate::event::EventKind;
 use crate::exception::Exception;
 use crate::order::{Order, Rank};
@@ -130,6 +131,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         cell: Arc<crate::cell::CellShared>,
         parent: Option<Name>,
         kill: Arc<KillSwitch>,
+        children: Children,
     ) -> Self {
         let order = Order::new(spec.name.clone(), spec.order);
         let background = order.background();
@@ -153,7 +155,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             .collect();
         let span = tracing::info_span!("module", name = %spec.name);
         let shared = Arc::new(ModuleShared::new(
-            spec.name, parent, spec.state, order, cell,
+            spec.name, parent, spec.state, order, cell, children,
         ));
         let tasks = spec
             .tasks
@@ -242,15 +244,25 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             }
             while response.end.is_pending() {
                 let end = &mut response.end;
-                let answered = self.shared.state.read(|state| end.respond(state));
-                if answered {
-                    self.shared.event(
-                        Some(&response.name),
-                        EventKind::Responded {
-                            handler: response.name.clone(),
-                        },
-                    );
-                }
+                // A panicking handler fails its one query (the querier gets `NoResponse`)
+                // and is logged; the module lives on, as after a panicking exception
+                // handler. The state is only read, so the panic cannot leave it half-done.
+                let answered = catch_unwind(AssertUnwindSafe(|| {
+                    self.shared.state.read(|state| end.respond(state))
+                }));
+                let kind = match answered {
+                    Ok(true) => EventKind::Responded {
+                        handler: response.name.clone(),
+                    },
+                    Ok(false) => continue,
+                    Err(panic) => EventKind::TaskFailed {
+                        reason: format!(
+                            "response handler panicked: {}",
+                            panic_message(panic.as_ref())
+                        ),
+                    },
+                };
+                self.shared.event(Some(&response.name), kind);
             }
         }
         started
@@ -461,11 +473,13 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
         if this.kill.poll_killed(cx) {
             return Poll::Ready(ModuleExit::Killed);
         }
+        let mut budget = TURN_BUDGET;
         loop {
             let mut progress = this.admit();
             // Running handlers are kept in rank order, most urgent first.
             let mut index = 0;
-            while index < this.handlers.len() {
+            while index < this.handlers.len() && budget > 0 {
+                budget -= 1;
                 if this.poll_handler(index, cx) {
                     progress = true;
                 } else {
@@ -474,6 +488,7 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
                 progress |= this.admit();
             }
             for index in 0..this.tasks.len() {
+                budget = budget.saturating_sub(1);
                 progress |= this.poll_task(index, cx);
                 progress |= this.admit();
             }
@@ -483,9 +498,20 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
             if !progress && !this.park(cx) {
                 return Poll::Pending;
             }
+            if budget == 0 {
+                // Still busy after a whole budget (say, a handler that raises its own
+                // exception again and again): let the other tasks of the thread run first.
+                cx.waker().wake_by_ref();
+                return Poll::Pending;
+            }
         }
     }
 }
+
+/// How many polls of its threads one poll of a module may run before it yields to the
+/// runtime, as a processor's turn does: a module that always has more to do cannot starve
+/// the other modules of its thread.
+const TURN_BUDGET: usize = 64;
 
 fn panic_message(panic: &(dyn std::any::Any + Send)) -> String {
     panic
