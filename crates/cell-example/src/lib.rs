@@ -14,6 +14,7 @@
 //! by side, with what rapier measured.
 
 pub mod chip;
+pub mod cli;
 pub mod faults;
 pub mod gate;
 pub mod help;
@@ -24,6 +25,7 @@ pub mod report;
 pub mod run;
 
 pub use chip::FeederPolicy;
+pub use cli::{USAGE, parse};
 pub use faults::{CellFault, CellFaultKind};
 pub use report::{Report, speed_line};
 pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, run};

@@ -76,6 +76,13 @@ pub enum RunError {
     Wiring(CellErrors),
     /// The simulated hours are not a number above 0 and at most [`MAX_HOURS`].
     Hours(f64),
+    /// A fault is set for after the run's end, so it would never fire.
+    FaultAfterEnd {
+        /// The fault, as `--fault` writes it.
+        fault: String,
+        /// The run's length in hours.
+        hours: f64,
+    },
 }
 
 impl std::fmt::Display for RunError {
@@ -88,6 +95,11 @@ impl std::fmt::Display for RunError {
                     "{hours} hours: expected a number of hours above 0, at most {MAX_HOURS}"
                 )
             }
+            Self::FaultAfterEnd { fault, hours } => write!(
+                f,
+                "--fault {fault}: set for after the run's end ({hours} h), so it would never fire; \
+                 run longer with --hours or set it earlier"
+            ),
         }
     }
 }
@@ -99,6 +111,13 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
     let hours_ok = config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS;
     if !hours_ok {
         return Err(RunError::Hours(config.hours));
+    }
+    let end = Duration::from_secs_f64(config.hours * 3600.0);
+    if let Some(late) = config.faults.iter().find(|fault| fault.at > end) {
+        return Err(RunError::FaultAfterEnd {
+            fault: late.to_string(),
+            hours: config.hours,
+        });
     }
     let wall = std::time::Instant::now();
     let mut record = if config.realtime {

@@ -1,0 +1,90 @@
+//! The chip cell's command line, as an operator meets it: bad input is refused with a message
+//! that names it, and the example never panics on its arguments or its output.
+
+use std::ffi::OsString;
+use std::os::unix::ffi::OsStringExt;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+use cell_example::{CellConfig, FeederPolicy, RunError, parse, run};
+
+fn args(list: &[&str]) -> Vec<OsString> {
+    list.iter().map(OsString::from).collect()
+}
+
+#[test]
+fn an_argument_that_is_not_utf8_is_refused_by_name() {
+    let bad = OsString::from_vec(vec![b'-', b'-', b'h', 0xff, b'u']);
+    let refused = parse([OsString::from("--hours"), bad]).unwrap_err();
+    assert!(
+        refused.starts_with("argument \"--h\u{fffd}u\" is not valid UTF-8"),
+        "{refused}"
+    );
+}
+
+#[test]
+fn flags_parse_into_a_config() {
+    let config = parse(args(&[
+        "--hours", "2", "--seed", "7", "--feeder", "appendix",
+    ]))
+    .unwrap();
+    assert_eq!(
+        (config.hours, config.seed, config.feeder),
+        (2.0, 7, FeederPolicy::Appendix)
+    );
+    let refused = parse(args(&["--hours"])).unwrap_err();
+    assert!(refused.starts_with("--hours needs a value"), "{refused}");
+}
+
+#[test]
+fn a_fault_after_the_end_of_the_run_is_refused() {
+    let config = CellConfig {
+        hours: 0.5,
+        ..parse(args(&["--fault", "robot:B@45m"])).unwrap()
+    };
+    let refused = run(&config).unwrap_err();
+    assert!(
+        matches!(refused, RunError::FaultAfterEnd { .. }),
+        "{refused}"
+    );
+    assert!(
+        refused
+            .to_string()
+            .starts_with("--fault robot:B@2700s: set for after the run's end (0.5 h)"),
+        "{refused}"
+    );
+}
+
+/// The example binary, built beside this test by `cargo test`.
+fn chip_cell() -> PathBuf {
+    let test = std::env::current_exe().unwrap();
+    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
+    profile_dir.join("examples").join("chip_cell")
+}
+
+#[test]
+fn a_reader_that_stops_reading_does_not_make_the_example_panic() {
+    let mut child = Command::new(chip_cell())
+        .args(["--hours", "0.01"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the example is built with the tests");
+    // Close the reading end at once, as `| head -0` would.
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+}
+
+#[test]
+fn the_example_refuses_a_non_utf8_argument_with_status_2() {
+    let output = Command::new(chip_cell())
+        .arg(OsString::from_vec(vec![0xff]))
+        .output()
+        .expect("the example is built with the tests");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("is not valid UTF-8"), "{stderr}");
+}
