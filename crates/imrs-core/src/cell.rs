@@ -7,7 +7,8 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::usage::{Plain, Usage};
 use imrs_ports::{
-    End, FilteredPort, Instant, Name, Port, SharedClock, UserList, VirtualClock, WireError, Wiring,
+    End, FilteredPort, Instant, Name, Port, Presence, SharedClock, UserList, VirtualClock,
+    WireError, Wiring,
 };
 use tokio::sync::watch;
 
@@ -330,6 +331,7 @@ fn supervisor<S: Send + Sync + 'static>(
         Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }),
         Entry::Vacant(vacant) => vacant.insert(Arc::clone(&kill)),
     };
+    let presence = Presence::new(name.clone());
     let (report, done) = watch::channel(None);
     let handle = ModuleHandle {
         name: name.clone(),
@@ -349,7 +351,6 @@ fn supervisor<S: Send + Sync + 'static>(
             let Some(spec) = next.take() else {
                 unreachable!("a copy is made before every run");
             };
-            kill.rearm();
             let children = Children::default();
             let copy = ModuleRun::new(
                 spec,
@@ -357,8 +358,12 @@ fn supervisor<S: Send + Sync + 'static>(
                 parent.clone(),
                 Arc::clone(&kill),
                 children.clone(),
+                Arc::clone(&presence),
             );
             let exit = copy.await;
+            // The kill that ended this copy is spent; one that comes later is for the next.
+            // (Rearming before a copy starts would lose a kill made before its first poll.)
+            kill.rearm();
             children.stop_all().await;
             let outcome = match exit {
                 ModuleExit::Finished => {
@@ -395,6 +400,8 @@ fn supervisor<S: Send + Sync + 'static>(
             cell.record(&name, EventKind::ModuleRestarted { attempt });
         };
         lock(&cell.modules).remove(&name);
+        // Gone for good: whoever waits on a port the module held fails now (PeerGone).
+        presence.set_gone();
         report.send_replace(Some(outcome));
     };
     Ok((handle, supervisor))

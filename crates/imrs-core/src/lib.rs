@@ -33,6 +33,16 @@
 //! waiter's port timeout bounds the wait, which is how the seed breaks the CHIP_IT/CHIP_IT2
 //! deadlock.
 //!
+//! # The dead-peer rule
+//!
+//! **Whoever waits on a port — to send, query, receive or be queried — whose other side was
+//! held by a module that has ended for good (finished, failed beyond its restart policy, or
+//! killed with no restart coming) gets `PeerGone` at once, and so does every later wait, until
+//! a new peer attaches; while a supervised restart is coming, it waits for the new copy,
+//! bounded by its timeout.** An end attached by a module's thread, or a response end given to
+//! its [`ModuleSpec`], belongs to the module; a costarted child belongs to the copy of its
+//! parent that started it and is stopped with it.
+//!
 //! Two modules: LOAD_IT queries its child LOAD_CARD for its status.
 //!
 //! ```

@@ -38,9 +38,18 @@ fn independent_a_proprietor_owns_the_shared_conveyor_state() {
                     async move {
                         let mut update = update.owner()?;
                         loop {
-                            let (change, done) = ctx.receive(&mut update).await?;
-                            ctx.state().update(|on| *on += change);
-                            done.reply(());
+                            match ctx.receive(&mut update).await {
+                                Ok((change, done)) => {
+                                    ctx.state().update(|on| *on += change);
+                                    done.reply(());
+                                }
+                                // Every station has finished for good: the count stands,
+                                // and the conveyor goes on answering OCCUPANCY.
+                                Err(error) if error.is_peer_gone() => {
+                                    std::future::pending::<()>().await;
+                                }
+                                Err(error) => return Err(error.into()),
+                            }
                         }
                     }
                 }
@@ -318,7 +327,8 @@ fn work_coupled_a_mate_takes_over_and_nothing_is_applied_twice_or_lost() {
                                 });
                                 ack.reply(());
                             }
-                            Err(error) if error.is_timeout() => break,
+                            // Silence, or LOAD_A known dead (it failed for good).
+                            Err(error) if error.is_timeout() || error.is_peer_gone() => break,
                             Err(error) => return Err(error.into()),
                         }
                     }

@@ -43,7 +43,12 @@ fn a_module_killed_mid_rendezvous_fails_its_users_and_its_copy_serves_them_after
                     async move {
                         let mut card_in_place = port.user_named("SCREW_IN_CARD")?;
                         loop {
-                            let (card, reply) = ctx.receive(&mut card_in_place).await?;
+                            let (card, reply) = match ctx.receive(&mut card_in_place).await {
+                                Ok(received) => received,
+                                // LOAD_CARD finished for good: no card will ever come again.
+                                Err(error) if error.is_peer_gone() => return Ok(()),
+                                Err(error) => return Err(error.into()),
+                            };
                             // The first copy takes 10 s to screw (and is killed meanwhile).
                             ctx.delay(secs(if copy == 0 { 10 } else { 1 })).await;
                             reply.reply(card as i32);
@@ -215,10 +220,12 @@ fn costarted_children_run_under_their_parent_and_answer_its_queries() {
         drive(&clock, at(20)).await;
         let results = results.lock().unwrap().clone();
         assert_eq!(results[0], Ok(0));
-        // The child is gone: the parent's query times out (the seed's note 2).
+        // The child is gone for good: the parent's query fails at once, not at its timeout.
         assert_eq!(
             results[1],
-            Err("query on port ASK_CHILD2 timed out before a response handler ran".into())
+            Err(
+                "module SCREW_IN_CARD, the responder on port ASK_CHILD2, has ended for good".into()
+            )
         );
         let started = cell
             .events()
@@ -232,5 +239,22 @@ fn costarted_children_run_under_their_parent_and_answer_its_queries() {
                 parent: Some("LOAD_IT".into())
             }
         );
+    });
+}
+
+#[test]
+fn a_kill_made_before_the_module_first_runs_is_not_lost() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let mut module = cell
+            .start(ModuleSpec::new("GATE", ()).task("GATE", |ctx| async move {
+                ctx.delay(secs(100)).await;
+                Ok(())
+            }))
+            .unwrap();
+        // Killed before its supervisor was ever polled.
+        assert!(cell.kill("GATE"));
+        drive(&clock, at(1)).await;
+        assert_eq!(module.finished().await, ModuleOutcome::Killed);
     });
 }

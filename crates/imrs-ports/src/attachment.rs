@@ -4,8 +4,9 @@ use std::sync::Arc;
 use std::task::Context;
 use std::time::Duration;
 
-use crate::core::{Core, SlotId};
+use crate::core::{Core, Gone, SlotId, hold};
 use crate::meta::Name;
+use crate::presence::Presence;
 use crate::slot::Slot;
 
 pub(crate) struct Attachment<Req, Rep> {
@@ -94,9 +95,23 @@ impl<Req, Rep> Attachment<Req, Rep> {
         }
     }
 
-    /// Whether no peer can ever come to this end again.
-    pub(crate) fn peer_gone(&self) -> bool {
+    /// Why no peer can ever come to this end again, if none can.
+    pub(crate) fn peer_gone(&self) -> Option<Gone> {
         self.core.peer_gone(self.is_owner())
+    }
+
+    /// Makes `presence` the presence of the module holding this end.
+    pub(crate) fn bind(&self, presence: &Arc<Presence>)
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+    {
+        hold(
+            &self.core,
+            self.at,
+            &self.module,
+            Some(Arc::clone(presence)),
+        );
     }
 
     /// How long a wait on this end may spin before it parks.

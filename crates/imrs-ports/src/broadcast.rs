@@ -172,10 +172,11 @@ fn poll_answers<Req, Rep>(
                 return Poll::Ready(Some((from, reply)));
             }
             Some(Answer::Unreplied) => user.in_broadcast.store(false, Ordering::Relaxed),
-            // A user that detached before taking the message will never answer it: take the
-            // message back (detaching wakes this task). One that took it may still reply
-            // through its handle, wherever that went.
-            None if !core.is_user_attached(index) => {
+            // A user that detached before taking the message, and will not come back (no
+            // restart of its module is coming), will never answer it: take the message back
+            // (detaching, and a module's end, wake this task). One that took it may still
+            // reply through its handle, wherever that went.
+            None if !core.is_user_attached(index) && !core.user_may_come_back(index) => {
                 // SAFETY: the owner end posted this request (`in_broadcast`) and is its only
                 // poster.
                 if unsafe { user.slot.withdraw_unsent() }.is_some() {

@@ -4,13 +4,47 @@
 //! declared, plus one slot for the owner's own posts. Users post into their own slot; the
 //! owner posts into its slot (any one user may take it) or, broadcasting, into every user's.
 
-use std::sync::{Mutex, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::task::Waker;
 
 use crate::clock::SharedClock;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
+use crate::presence::{Presence, Watcher};
 use crate::slot::Slot;
+
+/// Who holds, or last held, one side of a port: the module, and its presence when the end
+/// was attached inside a module.
+#[derive(Default)]
+pub(crate) struct Holder {
+    module: Option<Name>,
+    presence: Option<Arc<Presence>>,
+}
+
+impl Holder {
+    /// The module, if it held this side and has ended for good.
+    fn gone(&self) -> Option<&Name> {
+        let presence = self.presence.as_ref()?;
+        presence.is_gone().then_some(self.module.as_ref()?)
+    }
+
+    /// Whether this side was held by an end that may come back: one of a module that has
+    /// not ended for good.
+    fn may_come_back(&self) -> bool {
+        self.presence
+            .as_ref()
+            .is_some_and(|presence| !presence.is_gone())
+    }
+}
+
+/// Why nobody can serve or answer a waiter any more.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Gone {
+    /// No end is attached on the other side and no declaration is left to attach one.
+    Closed,
+    /// The module that held the other side has ended for good.
+    Peer(Name),
+}
 
 /// Which slot of a port: the owner's, or a user's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,8 +74,9 @@ pub(crate) struct UserSlot<Req, Rep> {
     attached: AtomicBool,
     /// Set by the owner while a broadcast of its awaits this user's answer.
     pub(crate) in_broadcast: AtomicBool,
-    /// The attached module, for broadcasts to say who answered. Written only on attach.
-    module: Mutex<Option<Name>>,
+    /// The attached (or last attached) module: for broadcasts to say who answered, and for
+    /// waiters to see whether it is gone. Written on attach and bind.
+    holder: Mutex<Holder>,
 }
 
 impl<Req, Rep> UserSlot<Req, Rep> {
@@ -51,7 +86,7 @@ impl<Req, Rep> UserSlot<Req, Rep> {
             waker: Padded(AtomicWaker::new()),
             attached: AtomicBool::new(false),
             in_broadcast: AtomicBool::new(false),
-            module: Mutex::new(None),
+            holder: Mutex::default(),
         }
     }
 }
@@ -66,6 +101,7 @@ pub(crate) struct Core<Req, Rep> {
     /// Wakes the owner while it waits to serve, or for a broadcast's answers.
     pub(crate) owner_waker: Padded<AtomicWaker>,
     owner_attached: AtomicBool,
+    owner_holder: Mutex<Holder>,
     /// Live `Port` handles: while one exists, a missing end may still attach.
     declarations: AtomicUsize,
     users_attached: AtomicUsize,
@@ -81,6 +117,7 @@ impl<Req, Rep> Core<Req, Rep> {
             owner_slot: Padded(Slot::new()),
             owner_waker: Padded(AtomicWaker::new()),
             owner_attached: AtomicBool::new(false),
+            owner_holder: Mutex::default(),
             declarations: AtomicUsize::new(1),
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
@@ -142,27 +179,34 @@ impl<Req, Rep> Core<Req, Rep> {
         self.wake_all();
     }
 
-    pub(crate) fn attach_user(&self, module: &Name) -> Option<usize> {
+    pub(crate) fn attach_user(&self) -> Option<usize> {
         let index = self.users.iter().position(|user| {
             user.attached
                 .compare_exchange(false, true, Ordering::AcqRel, Ordering::Acquire)
                 .is_ok()
         })?;
-        *self.users[index]
-            .module
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner) = Some(module.clone());
         self.users_attached.fetch_add(1, Ordering::AcqRel);
         Some(index)
     }
 
+    /// The holder record of slot `at`'s side.
+    fn holder(&self, at: SlotId) -> MutexGuard<'_, Holder> {
+        let holder = match at {
+            SlotId::Owner => &self.owner_holder,
+            SlotId::User(index) => &self.users[index].holder,
+        };
+        // Each critical section is one read or one write: never left half-done.
+        holder.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
     /// The module attached (or last attached) at user slot `index`.
     pub(crate) fn user_module(&self, index: usize) -> Option<Name> {
-        self.users[index]
-            .module
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .clone()
+        self.holder(SlotId::User(index)).module.clone()
+    }
+
+    /// Whether user slot `index` was last held by a module that may come back.
+    pub(crate) fn user_may_come_back(&self, index: usize) -> bool {
+        self.holder(SlotId::User(index)).may_come_back()
     }
 
     pub(crate) fn detach_user(&self, index: usize) {
@@ -189,21 +233,48 @@ impl<Req, Rep> Core<Req, Rep> {
         }
     }
 
-    /// Whether the other side of `side` is gone for good: nobody attached there, and no
-    /// declaration left from which anybody could attach.
-    pub(crate) fn peer_gone(&self, owner_side: bool) -> bool {
-        if self.declarations.load(Ordering::Acquire) > 0 {
-            return false;
+    /// Whether the other side of `side` is gone for good, and why: nobody attached there,
+    /// and either no declaration left from which anybody could attach, or the module that
+    /// held it (every module, for the users' side) has ended for good.
+    pub(crate) fn peer_gone(&self, owner_side: bool) -> Option<Gone> {
+        // The usual case, a peer attached, costs one load and takes no lock.
+        if self.other_side_attached(owner_side) {
+            return None;
         }
-        if owner_side {
-            self.users_attached() == 0
+        if self.declarations.load(Ordering::Acquire) == 0 {
+            return Some(Gone::Closed);
+        }
+        let gone = if owner_side {
+            let mut gone = None;
+            for index in 0..self.capacity() {
+                let holder = self.holder(SlotId::User(index));
+                match (&holder.module, holder.gone()) {
+                    (None, _) => {} // never held
+                    (Some(_), Some(module)) => gone = Some(module.clone()),
+                    (Some(_), None) => return None,
+                }
+            }
+            gone
         } else {
-            !self.owner_attached.load(Ordering::Acquire)
+            self.holder(SlotId::Owner).gone().cloned()
+        };
+        // A new peer may have attached while the holders were read.
+        if self.other_side_attached(owner_side) {
+            return None;
+        }
+        gone.map(Gone::Peer)
+    }
+
+    fn other_side_attached(&self, owner_side: bool) -> bool {
+        if owner_side {
+            self.users_attached() > 0
+        } else {
+            self.owner_attached.load(Ordering::Acquire)
         }
     }
 
     /// Wakes every waiter, so that each re-checks whether its peer is gone.
-    fn wake_all(&self) {
+    pub(crate) fn wake_all(&self) {
         self.owner_waker.wake();
         self.owner_slot.wake_poster();
         for user in self.users.iter() {
@@ -219,5 +290,28 @@ pub(crate) fn register_broadcast<Req, Rep>(core: &Core<Req, Rep>, waker: &Waker)
         if user.in_broadcast.load(Ordering::Relaxed) {
             user.slot.register_poster(waker);
         }
+    }
+}
+
+/// Records `module`, with the presence entered now (if any), as the holder of `at`, and has
+/// the presence wake the port's waiters when the module is gone.
+pub(crate) fn hold<Req: Send + 'static, Rep: Send + 'static>(
+    core: &Arc<Core<Req, Rep>>,
+    at: SlotId,
+    module: &Name,
+    presence: Option<Arc<Presence>>,
+) {
+    if let Some(presence) = &presence {
+        let watcher: Arc<dyn Watcher> = Arc::clone(core) as Arc<dyn Watcher>;
+        presence.watch(Arc::downgrade(&watcher));
+    }
+    let mut holder = core.holder(at);
+    holder.module = Some(module.clone());
+    holder.presence = presence;
+}
+
+impl<Req: Send, Rep: Send> Watcher for Core<Req, Rep> {
+    fn wake_all(&self) {
+        Core::wake_all(self);
     }
 }

@@ -4,6 +4,7 @@
 use std::error::Error;
 use std::fmt;
 
+use crate::core::Gone;
 use crate::meta::Name;
 use crate::usage::UsageKind;
 
@@ -33,6 +34,16 @@ pub enum SendError<T> {
         /// The message, undelivered.
         message: T,
     },
+    /// The module that received on this port has ended for good (finished, failed beyond
+    /// its restart policy, or killed with no restart coming); here is the message back.
+    PeerGone {
+        /// The port.
+        port: Name,
+        /// The module that is gone.
+        module: Name,
+        /// The message, undelivered.
+        message: T,
+    },
 }
 
 /// Why a [`query`](crate::End::query) failed.
@@ -58,6 +69,16 @@ pub enum QueryError<T> {
     Closed {
         /// The port.
         port: Name,
+        /// The query, unanswered.
+        query: T,
+    },
+    /// The module whose handler answered this port has ended for good; here is the query
+    /// back.
+    PeerGone {
+        /// The port.
+        port: Name,
+        /// The module that is gone.
+        module: Name,
         /// The query, unanswered.
         query: T,
     },
@@ -98,6 +119,13 @@ pub enum ReceiveError {
     Closed {
         /// The port.
         port: Name,
+    },
+    /// Every module that sent (or queried) on this port has ended for good.
+    PeerGone {
+        /// The port.
+        port: Name,
+        /// A module that is gone.
+        module: Name,
     },
 }
 
@@ -166,13 +194,19 @@ pub enum WireError {
 }
 
 impl<T> SendError<T> {
+    /// Whether the peer is gone for good: the port is closed, or its module has ended.
+    pub fn is_peer_gone(&self) -> bool {
+        matches!(self, Self::Closed { .. } | Self::PeerGone { .. })
+    }
+
     /// The port the send was on.
     pub fn port(&self) -> &Name {
         match self {
             Self::Timeout { port, .. }
             | Self::ReplyTimeout { port }
             | Self::NoReply { port }
-            | Self::Closed { port, .. } => port,
+            | Self::Closed { port, .. }
+            | Self::PeerGone { port, .. } => port,
         }
     }
 
@@ -184,20 +218,28 @@ impl<T> SendError<T> {
     /// The undelivered message, if it was never delivered.
     pub fn into_message(self) -> Option<T> {
         match self {
-            Self::Timeout { message, .. } | Self::Closed { message, .. } => Some(message),
+            Self::Timeout { message, .. }
+            | Self::Closed { message, .. }
+            | Self::PeerGone { message, .. } => Some(message),
             Self::ReplyTimeout { .. } | Self::NoReply { .. } => None,
         }
     }
 }
 
 impl<T> QueryError<T> {
+    /// Whether the peer is gone for good: the port is closed, or its module has ended.
+    pub fn is_peer_gone(&self) -> bool {
+        matches!(self, Self::Closed { .. } | Self::PeerGone { .. })
+    }
+
     /// The port the query was on.
     pub fn port(&self) -> &Name {
         match self {
             Self::Timeout { port, .. }
             | Self::ResponseTimeout { port }
             | Self::NoResponse { port }
-            | Self::Closed { port, .. } => port,
+            | Self::Closed { port, .. }
+            | Self::PeerGone { port, .. } => port,
         }
     }
 
@@ -209,7 +251,9 @@ impl<T> QueryError<T> {
     /// The unanswered query, if no handler ever took it.
     pub fn into_query(self) -> Option<T> {
         match self {
-            Self::Timeout { query, .. } | Self::Closed { query, .. } => Some(query),
+            Self::Timeout { query, .. }
+            | Self::Closed { query, .. }
+            | Self::PeerGone { query, .. } => Some(query),
             Self::ResponseTimeout { .. } | Self::NoResponse { .. } => None,
         }
     }
@@ -240,10 +284,24 @@ impl<T> BroadcastError<T> {
 }
 
 impl ReceiveError {
+    /// The error for a wait whose peers are gone for good, as `gone` says why.
+    pub(crate) fn gone(port: &Name, gone: Gone) -> Self {
+        let port = port.clone();
+        match gone {
+            Gone::Closed => Self::Closed { port },
+            Gone::Peer(module) => Self::PeerGone { port, module },
+        }
+    }
+
+    /// Whether the peer is gone for good: the port is closed, or every sender has ended.
+    pub fn is_peer_gone(&self) -> bool {
+        matches!(self, Self::Closed { .. } | Self::PeerGone { .. })
+    }
+
     /// The port the receive was on.
     pub fn port(&self) -> &Name {
         match self {
-            Self::Timeout { port } | Self::Closed { port } => port,
+            Self::Timeout { port } | Self::Closed { port } | Self::PeerGone { port, .. } => port,
         }
     }
 
@@ -272,6 +330,10 @@ impl<T> fmt::Display for SendError<T> {
                 )
             }
             Self::Closed { port, .. } => write!(f, "port {port} has no receiver any more"),
+            Self::PeerGone { port, module, .. } => write!(
+                f,
+                "module {module}, the receiver on port {port}, has ended for good"
+            ),
         }
     }
 }
@@ -295,6 +357,10 @@ impl<T> fmt::Display for QueryError<T> {
                 write!(f, "the response handler of port {port} gave no answer")
             }
             Self::Closed { port, .. } => write!(f, "port {port} has no response handler any more"),
+            Self::PeerGone { port, module, .. } => write!(
+                f,
+                "module {module}, the responder on port {port}, has ended for good"
+            ),
         }
     }
 }
@@ -314,6 +380,10 @@ impl fmt::Display for ReceiveError {
         match self {
             Self::Timeout { port } => write!(f, "receive on port {port} timed out"),
             Self::Closed { port } => write!(f, "port {port} has no sender any more"),
+            Self::PeerGone { port, module } => write!(
+                f,
+                "module {module}, the last sender on port {port}, has ended for good"
+            ),
         }
     }
 }
@@ -388,8 +458,8 @@ macro_rules! debug_without_payload {
 }
 
 debug_without_payload! {
-    SendError { Timeout, ReplyTimeout, NoReply, Closed }
-    QueryError { Timeout, ResponseTimeout, NoResponse, Closed }
+    SendError { Timeout, ReplyTimeout, NoReply, Closed, PeerGone }
+    QueryError { Timeout, ResponseTimeout, NoResponse, Closed, PeerGone }
     BroadcastError { Timeout, NoReply, NoUsers }
 }
 

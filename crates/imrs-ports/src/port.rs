@@ -8,10 +8,11 @@ use std::time::Duration;
 
 use crate::attachment::Attachment;
 use crate::clock::{RealClock, SharedClock};
-use crate::core::{Core, SlotId};
+use crate::core::{Core, SlotId, hold};
 use crate::end::End;
 use crate::error::WireError;
 use crate::meta::{Name, Named, PortMeta};
+use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::response::ResponseEnd;
@@ -205,6 +206,7 @@ where
                 module: meta.owner.clone(),
             });
         }
+        hold(&self.core, SlotId::Owner, &meta.owner, Presence::current());
         Ok(Attachment {
             core: Arc::clone(&self.core),
             at: SlotId::Owner,
@@ -265,7 +267,7 @@ where
 }
 
 /// Attaches a user of `core`: checks the user list and the number of active users.
-pub(crate) fn attach_user<Req, Rep>(
+pub(crate) fn attach_user<Req: Send + 'static, Rep: Send + 'static>(
     core: &Arc<Core<Req, Rep>>,
     module: Name,
 ) -> Result<Attachment<Req, Rep>, WireError> {
@@ -276,13 +278,14 @@ pub(crate) fn attach_user<Req, Rep>(
             module,
         });
     }
-    let Some(index) = core.attach_user(&module) else {
+    let Some(index) = core.attach_user() else {
         return Err(WireError::TooManyUsers {
             port: meta.name.clone(),
             module,
             capacity: core.capacity(),
         });
     };
+    hold(core, SlotId::User(index), &module, Presence::current());
     Ok(Attachment {
         core: Arc::clone(core),
         at: SlotId::User(index),

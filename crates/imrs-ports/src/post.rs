@@ -9,6 +9,7 @@ use pin_project_lite::pin_project;
 
 use crate::attachment::Attachment;
 use crate::clock::{Sleep, deadline_passed};
+use crate::core::Gone;
 use crate::error::{QueryError, SendError};
 use crate::meta::Name;
 use crate::slot::{Answer, Withdrawn};
@@ -24,6 +25,17 @@ pub enum Failure<Req> {
     Unanswered,
     /// Nobody can ever take it.
     Closed(Req),
+    /// The module that served the port has ended for good.
+    PeerGone(Req, Name),
+}
+
+impl<Req> Failure<Req> {
+    fn gone(request: Req, gone: Gone) -> Self {
+        match gone {
+            Gone::Closed => Self::Closed(request),
+            Gone::Peer(module) => Self::PeerGone(request, module),
+        }
+    }
 }
 
 /// What a posting primitive returns: [`SendOutcome`] or [`QueryOutcome`].
@@ -58,6 +70,11 @@ impl<Req, Rep> Outcome<Req, Rep> for SendOutcome {
             Failure::AnswerTimeout => SendError::ReplyTimeout { port },
             Failure::Unanswered => SendError::NoReply { port },
             Failure::Closed(message) => SendError::Closed { port, message },
+            Failure::PeerGone(message, module) => SendError::PeerGone {
+                port,
+                module,
+                message,
+            },
         })
     }
 }
@@ -76,6 +93,11 @@ impl<Req, Rep> Outcome<Req, Rep> for QueryOutcome {
             Failure::AnswerTimeout => QueryError::ResponseTimeout { port },
             Failure::Unanswered => QueryError::NoResponse { port },
             Failure::Closed(query) => QueryError::Closed { port, query },
+            Failure::PeerGone(query, module) => QueryError::PeerGone {
+                port,
+                module,
+                query,
+            },
         })
     }
 }
@@ -158,16 +180,17 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
                 }
             }
             if *this.stage == Stage::Posting {
-                let failure = if attachment.peer_gone() {
-                    Failure::Closed
-                } else if deadline_passed(this.deadline.as_mut(), cx) {
-                    Failure::Timeout
-                } else {
+                let gone = attachment.peer_gone();
+                if gone.is_none() && !deadline_passed(this.deadline.as_mut(), cx) {
                     return Poll::Pending;
-                };
+                }
                 *this.stage = Stage::Done;
                 let request = this.request.take().expect("an unposted request is kept");
-                return Poll::Ready(O::failed(failure(request), port));
+                let failure = match gone {
+                    Some(gone) => Failure::gone(request, gone),
+                    None => Failure::Timeout(request),
+                };
+                return Poll::Ready(O::failed(failure, port));
             }
         }
         if *this.stage != Stage::Posted {
@@ -187,20 +210,24 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
             *this.stage = Stage::Done;
             return Poll::Ready(finish::<Req, Rep, O>(answer, port));
         }
-        let closed = attachment.peer_gone() && slot.posted_ticket().is_some();
-        if !closed && !deadline_passed(this.deadline.as_mut(), cx) {
+        // Only a request nobody took is failed for a gone peer: one that was taken is
+        // answered, or its dropped reply handle says `NoReply`.
+        let gone = slot.posted_ticket().and_then(|_| attachment.peer_gone());
+        if gone.is_none() && !deadline_passed(this.deadline.as_mut(), cx) {
             return Poll::Pending;
         }
         *this.stage = Stage::Done;
         // SAFETY: as above.
         let withdrawn = unsafe { slot.withdraw() };
-        Poll::Ready(match withdrawn {
-            Withdrawn::Unsent(request) if closed => O::failed(Failure::Closed(request), port),
-            Withdrawn::Unsent(request) => O::failed(Failure::Timeout(request), port),
-            Withdrawn::Abandoned if closed => O::failed(Failure::Unanswered, port),
-            Withdrawn::Abandoned => O::failed(Failure::AnswerTimeout, port),
+        Poll::Ready(match (withdrawn, gone) {
+            (Withdrawn::Unsent(request), Some(gone)) => {
+                O::failed(Failure::gone(request, gone), port)
+            }
+            (Withdrawn::Unsent(request), None) => O::failed(Failure::Timeout(request), port),
+            (Withdrawn::Abandoned, Some(_)) => O::failed(Failure::Unanswered, port),
+            (Withdrawn::Abandoned, None) => O::failed(Failure::AnswerTimeout, port),
             // The answer beat the timeout: it wins.
-            Withdrawn::Answered(answer) => finish::<Req, Rep, O>(answer, port),
+            (Withdrawn::Answered(answer), _) => finish::<Req, Rep, O>(answer, port),
         })
     }
 }

@@ -56,8 +56,8 @@ impl<Req: Send + 'static, Rep: Send + 'static> Future for Receiving<'_, Req, Rep
         }
         // The port's name is cloned only for an error: a clone is two atomic operations.
         let port = || attachment.port().clone();
-        if attachment.peer_gone() {
-            return Poll::Ready(Err(ReceiveError::Closed { port: port() }));
+        if let Some(gone) = attachment.peer_gone() {
+            return Poll::Ready(Err(ReceiveError::gone(attachment.port(), gone)));
         }
         if deadline_passed(this.deadline, cx) {
             Poll::Ready(Err(ReceiveError::Timeout { port: port() }))

@@ -10,7 +10,7 @@
 use std::fmt;
 use std::future::{Future, poll_fn};
 use std::pin::pin;
-use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
 use std::task::{Context, Poll};
 use std::time::Duration;
 
@@ -18,6 +18,7 @@ use crate::attachment::Attachment;
 use crate::clock::deadline_passed;
 use crate::error::ReceiveError;
 use crate::meta::Name;
+use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::receive::ReplyHandle;
 
@@ -80,10 +81,8 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> ResponseEnd<Req, Rep, S> {
         self.attachment.register_server(cx);
         if self.is_pending() {
             Poll::Ready(Ok(()))
-        } else if self.attachment.peer_gone() {
-            Poll::Ready(Err(ReceiveError::Closed {
-                port: self.port().clone(),
-            }))
+        } else if let Some(gone) = self.attachment.peer_gone() {
+            Poll::Ready(Err(ReceiveError::gone(self.port(), gone)))
         } else {
             Poll::Pending
         }
@@ -145,6 +144,11 @@ pub trait Respond<S> {
     fn poll_pending(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), ReceiveError>>;
     /// Answers one waiting query; see [`ResponseEnd::respond`].
     fn respond(&mut self, state: &S) -> bool;
+    /// Records that this end is held by the module of `presence`, for an end attached before
+    /// its module ran (see [`presence`](crate::presence)). By default, nothing.
+    fn bind(&mut self, presence: &Arc<Presence>) {
+        let _ = presence;
+    }
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req, Rep, S> {
@@ -158,6 +162,10 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req
 
     fn respond(&mut self, state: &S) -> bool {
         ResponseEnd::respond(self, state)
+    }
+
+    fn bind(&mut self, presence: &Arc<Presence>) {
+        self.attachment.bind(presence);
     }
 }
 

@@ -55,7 +55,7 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Receives> Alternative for &mut
     }
 
     fn is_closed(&self) -> bool {
-        self.attachment.peer_gone() && !self.attachment.has_waiting()
+        self.attachment.peer_gone().is_some() && !self.attachment.has_waiting()
     }
 }
 

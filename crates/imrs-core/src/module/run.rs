@@ -24,7 +24,7 @@ use std::task::{Context, Poll};
 
 use atomic_waker::AtomicWaker;
 use imrs_ports::clock::Sleep;
-use imrs_ports::{Name, Respond};
+use imrs_ports::{Name, Presence, Respond};
 
 use super::ctx::{Ctx, ModuleShared, SectionCell};
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
@@ -122,6 +122,9 @@ pub(crate) struct ModuleRun<S> {
     responses: Vec<ResponseRun<S>>,
     exception_handlers: Vec<(Name, Rank, ExceptionHandler<S>)>,
     kill: Arc<KillSwitch>,
+    /// The module's presence, entered around every poll so that the ends its threads attach
+    /// are known as the module's (taken out while it is entered).
+    presence: Option<Arc<Presence>>,
     span: tracing::Span,
 }
 
@@ -132,16 +135,21 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         parent: Option<Name>,
         kill: Arc<KillSwitch>,
         children: Children,
+        presence: Arc<Presence>,
     ) -> Self {
         let order = Order::new(spec.name.clone(), spec.order);
         let background = order.background();
         let mut responses: Vec<_> = spec
             .responses
             .into_iter()
-            .map(|(name, end)| ResponseRun {
-                rank: order.handler_rank(name.as_str()),
-                name,
-                end,
+            .map(|(name, mut end)| {
+                // Attached before the module ran: held by it all the same.
+                end.bind(&presence);
+                ResponseRun {
+                    rank: order.handler_rank(name.as_str()),
+                    name,
+                    end,
+                }
             })
             .collect();
         responses.sort_by_key(|response| response.rank);
@@ -157,6 +165,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         let shared = Arc::new(ModuleShared::new(
             spec.name, parent, spec.state, order, cell, children,
         ));
+        let entered = Presence::enter(Some(presence));
         let tasks = spec
             .tasks
             .into_iter()
@@ -187,6 +196,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             responses,
             exception_handlers,
             kill,
+            presence: entered.leave(),
             span,
         }
     }
@@ -473,6 +483,17 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
         if this.kill.poll_killed(cx) {
             return Poll::Ready(ModuleExit::Killed);
         }
+        let entered = Presence::enter(this.presence.take());
+        let poll = this.poll_threads(cx);
+        this.presence = entered.leave();
+        poll
+    }
+}
+
+impl<S: Send + Sync + 'static> ModuleRun<S> {
+    /// One poll of the module: its threads, and the handlers their ranks admit.
+    fn poll_threads(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
+        let this = self;
         let mut budget = TURN_BUDGET;
         loop {
             let mut progress = this.admit();
