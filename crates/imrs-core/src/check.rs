@@ -87,6 +87,31 @@ pub enum CellError {
         /// The usage the port's users side was declared with.
         declared: UsageKind,
     },
+    /// An exception handler for an exception the module cannot raise: no port or barrier
+    /// of it times out under that name, no task of it fails under it, and the module does
+    /// not declare that it raises it.
+    UnknownException {
+        /// The module.
+        module: Name,
+        /// The handler's exception name.
+        exception: Name,
+    },
+    /// A response handler named after one port, on the end of another.
+    HandlerOnWrongPort {
+        /// The module.
+        module: Name,
+        /// The handler's name (`PORT.resp`).
+        handler: Name,
+        /// The port its end answers.
+        port: Name,
+    },
+    /// A module holds a response end on a port it neither owns nor uses.
+    UndeclaredPort {
+        /// The module.
+        module: Name,
+        /// The port.
+        port: Name,
+    },
     /// An order names something the module does not have.
     UnknownOrderName {
         /// The module.
@@ -159,6 +184,23 @@ impl fmt::Display for CellError {
                 f,
                 "module {module} filters port {port} with USAGE={filter}, but the port is declared USAGE={declared}"
             ),
+            Self::UnknownException { module, exception } => write!(
+                f,
+                "module {module} handles exception {exception}, which it cannot raise: no port \
+                 or task of it has that name, and it does not declare it in `raises`"
+            ),
+            Self::HandlerOnWrongPort {
+                module,
+                handler,
+                port,
+            } => write!(
+                f,
+                "module {module} names its response handler {handler}, but its end answers port {port} (name it {port}.<resp>)"
+            ),
+            Self::UndeclaredPort { module, port } => write!(
+                f,
+                "module {module} answers queries on port {port}, which it neither owns nor uses"
+            ),
             Self::UnknownOrderName { module, name } => write!(
                 f,
                 "the order of module {module} names {name}, which is not its background, a section, a handler or a port of it"
@@ -197,7 +239,11 @@ impl From<WireError> for CellErrors {
 }
 
 pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
-    let mut problems = Vec::new();
+    // What went wrong when ports were declared or attached by name, earlier.
+    let mut problems: Vec<CellError> = match wiring.check() {
+        Ok(()) => Vec::new(),
+        Err(earlier) => earlier.0.into_iter().map(CellError::Wire).collect(),
+    };
     let mut seen = BTreeSet::new();
     for module in modules {
         if !seen.insert(&module.name) {
@@ -209,9 +255,11 @@ pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellE
     check_owners(wiring, modules, &mut problems);
     check_users(wiring, modules, &mut problems);
     check_filters(wiring, modules, &mut problems);
-    modules
-        .iter()
-        .for_each(|module| check_order(module, &mut problems));
+    for module in modules {
+        check_order(module, &mut problems);
+        check_exceptions(module, &mut problems);
+        check_responses(module, &mut problems);
+    }
     if problems.is_empty() {
         Ok(())
     } else {
@@ -329,24 +377,72 @@ fn check_filters(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<Cel
     }
 }
 
-fn check_order(module: &ModuleDecl, problems: &mut Vec<CellError>) {
-    let ports = module
+/// The ports a module declares it owns, uses or filters.
+fn ports_of(module: &ModuleDecl) -> impl Iterator<Item = &Name> {
+    module
         .owns
         .iter()
         .chain(module.uses.iter().map(|(port, _)| port))
-        .chain(module.filters.iter().map(|(port, _)| port));
-    let mut known: BTreeSet<Name> = ports
+        .chain(module.filters.iter().map(|(port, _)| port))
+}
+
+/// Every exception module can raise: its ports' timeouts, its tasks' failures, and those it
+/// declares.
+fn raisable(module: &ModuleDecl) -> BTreeSet<Name> {
+    let mut raisable: BTreeSet<Name> = ports_of(module)
         .map(|port| Exception::timeout_of(port.as_str()))
         .collect();
-    known.extend(
+    raisable.extend(
         module
             .tasks
             .iter()
             .map(|task| Exception::failure_of(task.as_str())),
     );
+    raisable.extend(module.raises.iter().cloned());
+    raisable
+}
+
+fn check_exceptions(module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    let raisable = raisable(module);
+    for exception in &module.exceptions {
+        if !raisable.contains(exception) {
+            problems.push(CellError::UnknownException {
+                module: module.name.clone(),
+                exception: exception.clone(),
+            });
+        }
+    }
+}
+
+fn check_responses(module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    let declared: BTreeSet<&Name> = module
+        .owns
+        .iter()
+        .chain(module.uses.iter().map(|(port, _)| port))
+        .collect();
+    for (handler, port) in &module.responses {
+        let named_port = handler.as_str().split_once('.').map(|(port, _)| port);
+        if named_port != Some(port.as_str()) {
+            problems.push(CellError::HandlerOnWrongPort {
+                module: module.name.clone(),
+                handler: handler.clone(),
+                port: port.clone(),
+            });
+        }
+        if !declared.contains(port) {
+            problems.push(CellError::UndeclaredPort {
+                module: module.name.clone(),
+                port: port.clone(),
+            });
+        }
+    }
+}
+
+fn check_order(module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    let mut known = raisable(module);
     known.insert(module.name.clone());
     known.extend(module.sections.iter().cloned());
-    known.extend(module.responses.iter().cloned());
+    known.extend(module.responses.iter().map(|(handler, _)| handler.clone()));
     known.extend(module.exceptions.iter().cloned());
     for name in &module.order {
         if !known.contains(name) {

@@ -132,6 +132,11 @@ pub enum ReceiveError {
 /// A problem found when a port end is attached: the seed's load-time errors.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum WireError {
+    /// The port was declared with a typed user list and a named one.
+    TwoUserLists {
+        /// The port.
+        port: Name,
+    },
     /// No port of that name was declared.
     UnknownPort {
         /// The port asked for.
@@ -391,6 +396,10 @@ impl fmt::Display for ReceiveError {
 impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            Self::TwoUserLists { port } => write!(
+                f,
+                "port {port} is declared with a typed user list and a named one: keep one"
+            ),
             Self::UnknownPort { port, module } => {
                 write!(
                     f,

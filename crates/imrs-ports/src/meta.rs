@@ -4,6 +4,8 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
+use crate::error::WireError;
+
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::usage::UsageKind;
@@ -67,12 +69,25 @@ pub(crate) struct PortMeta {
     pub(crate) owner: Name,
     pub(crate) usage: UsageKind,
     pub(crate) user_list: Option<Box<[Name]>>,
+    /// The port was declared with a typed user list and a named one: refused on every
+    /// attach and by the wiring, never resolved silently.
+    pub(crate) two_user_lists: bool,
     pub(crate) timeout: Option<Duration>,
     pub(crate) priority: Priority,
     pub(crate) process_type: ProcessType,
 }
 
 impl PortMeta {
+    /// Refuses a port declared with two user lists.
+    pub(crate) fn check_user_lists(&self) -> Result<(), WireError> {
+        if self.two_user_lists {
+            return Err(WireError::TwoUserLists {
+                port: self.name.clone(),
+            });
+        }
+        Ok(())
+    }
+
     pub(crate) fn admits(&self, module: &str) -> bool {
         self.user_list
             .as_ref()

@@ -126,6 +126,14 @@ where
     L: UserList,
 {
     /// Declares the port.
+    ///
+    /// A port whose user list is both a type (`L`) and names ([`PortSpec::user_list`]) is
+    /// refused at every attach and by the [`Wiring`](crate::Wiring) with
+    /// [`WireError::TwoUserLists`]: neither list silently wins.
+    ///
+    /// `N = 0` is refused when the port is built (`cargo build`, `cargo test`): the check is a
+    /// constant evaluated for each `N`, which `cargo check` does not evaluate, since stable
+    /// Rust cannot bound a const generic in a `where` clause.
     pub fn declare(spec: PortSpec) -> Self {
         const {
             assert!(
@@ -133,6 +141,7 @@ where
                 "a port needs room for at least one user (#USERS >= 1)"
             )
         };
+        let two_user_lists = L::NAMES.is_some() && spec.user_list.is_some();
         let user_list = match L::NAMES {
             Some(names) => Some(names.iter().map(|&name| Name::from(name)).collect()),
             None => spec.user_list.map(Vec::into_boxed_slice),
@@ -142,6 +151,7 @@ where
             owner: spec.owner,
             usage: U::KIND,
             user_list,
+            two_user_lists,
             timeout: spec.timeout,
             priority: spec.priority,
             process_type: spec.process_type,
@@ -200,6 +210,7 @@ where
 
     pub(crate) fn attach_owner(&self) -> Result<Attachment<Req, Rep>, WireError> {
         let meta = &self.core.meta;
+        meta.check_user_lists()?;
         if !self.core.attach_owner() {
             return Err(WireError::OwnerTaken {
                 port: meta.name.clone(),
@@ -272,6 +283,7 @@ pub(crate) fn attach_user<Req: Send + 'static, Rep: Send + 'static>(
     module: Name,
 ) -> Result<Attachment<Req, Rep>, WireError> {
     let meta = &core.meta;
+    meta.check_user_lists()?;
     if !meta.admits(module.as_str()) {
         return Err(WireError::NotOnUserList {
             port: meta.name.clone(),

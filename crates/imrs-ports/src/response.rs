@@ -137,6 +137,8 @@ impl<Req, Rep, S> fmt::Debug for ResponseEnd<Req, Rep, S> {
 
 /// A response end as seen by whatever decides when handlers run.
 pub trait Respond<S> {
+    /// The port this end answers.
+    fn port(&self) -> &Name;
     /// Whether a query waits, without registering for a wake; see
     /// [`ResponseEnd::is_pending`].
     fn is_pending(&self) -> bool;
@@ -152,6 +154,10 @@ pub trait Respond<S> {
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req, Rep, S> {
+    fn port(&self) -> &Name {
+        ResponseEnd::port(self)
+    }
+
     fn is_pending(&self) -> bool {
         ResponseEnd::is_pending(self)
     }

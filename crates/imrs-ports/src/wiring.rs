@@ -80,6 +80,7 @@ impl Wiring {
         L: UserList,
     {
         let name = port.name().clone();
+        self.note(Port::core(port).meta.check_user_lists())?;
         if self.ports.contains_key(&name) {
             return self.note(Err(WireError::DuplicatePort {
                 port: name,

@@ -419,11 +419,17 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             Some(delay) => Stage::Restarting(Box::pin(self.shared.cell.clock.sleep(delay))),
             None => Stage::GaveUp(reason.clone()),
         };
+        let restarting = matches!(task.stage, Stage::Restarting(_));
         let exception = Exception {
             name: Exception::failure_of(task.name.as_str()),
             task: Some(task.name.clone()),
             detail: reason,
         };
+        // A failure that the task's restart policy handles needs no handler: raise it only
+        // for a handler that asked for it, so the log does not call it unhandled.
+        if restarting && self.handler_for(&exception.name).is_none() {
+            return;
+        }
         self.shared.raise(exception);
     }
 

@@ -46,6 +46,7 @@ pub struct ModuleSpec<S> {
     pub(crate) tasks: Vec<TaskSpec<S>>,
     pub(crate) responses: Vec<(Name, Box<dyn Respond<S> + Send>)>,
     pub(crate) exceptions: Vec<(Name, ExceptionHandler<S>)>,
+    pub(crate) raises: Vec<Name>,
 }
 
 impl<S: Send + Sync + 'static> ModuleSpec<S> {
@@ -63,6 +64,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
             tasks: Vec::new(),
             responses: Vec::new(),
             exceptions: Vec::new(),
+            raises: Vec::new(),
         }
     }
 
@@ -173,6 +175,19 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         self
     }
 
+    /// Declares the exceptions this module raises itself, beyond its ports' `PORT.TIMEOUT`s
+    /// and its tasks' `TASK.FAILED`s: those it raises with [`Ctx::raise`], and the
+    /// `BARRIER.TIMEOUT`s of the `waitfor` barriers it meets. The wiring check refuses an
+    /// exception handler for anything the module cannot raise.
+    pub fn raises<I, N>(mut self, exceptions: I) -> Self
+    where
+        I: IntoIterator<Item = N>,
+        N: Into<Name>,
+    {
+        self.raises.extend(exceptions.into_iter().map(Into::into));
+        self
+    }
+
     /// What the wiring check needs to know of this module.
     pub fn declaration(&self) -> ModuleDecl {
         ModuleDecl {
@@ -185,7 +200,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
             responses: self
                 .responses
                 .iter()
-                .map(|(name, _)| name.clone())
+                .map(|(name, end)| (name.clone(), end.port().clone()))
                 .collect(),
             exceptions: self
                 .exceptions
@@ -193,6 +208,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
                 .map(|(name, _)| name.clone())
                 .collect(),
             tasks: self.tasks.iter().map(|task| task.name.clone()).collect(),
+            raises: self.raises.clone(),
         }
     }
 }
@@ -225,10 +241,12 @@ pub struct ModuleDecl {
     pub uses: Vec<(Name, UsageKind)>,
     /// The ports it filters, with the filter's usage toward the users.
     pub filters: Vec<(Name, UsageKind)>,
-    /// Its response handlers (`PORT.resp`).
-    pub responses: Vec<Name>,
+    /// Its response handlers (`PORT.resp`), each with the port its end answers.
+    pub responses: Vec<(Name, Name)>,
     /// Its exception handlers.
     pub exceptions: Vec<Name>,
     /// Its tasks.
     pub tasks: Vec<Name>,
+    /// The exceptions it declares it raises itself ([`ModuleSpec::raises`]).
+    pub raises: Vec<Name>,
 }
