@@ -43,6 +43,27 @@
 //! its [`ModuleSpec`], belongs to the module; a costarted child belongs to the copy of its
 //! parent that started it and is stopped with it.
 //!
+//! # What the types do not stop
+//!
+//! - **Read-only handlers can still write through interior mutability.** A response handler
+//!   gets `&S`, so it cannot assign to the state; but an atomic, a `Mutex` or any other cell
+//!   inside `S` can be changed through `&S`. Doing so gives up what the order promises: a
+//!   change made by a handler lands in the middle of whatever section of the background it
+//!   interrupted, the background's `update` closures no longer see the state they left, and
+//!   a run on virtual time may stop being reproducible once a handler's write races a task's.
+//!   Keep `S` plain data; let a handler that must cause a change send a message or raise an
+//!   exception, whose handler changes the state at its rank.
+//! - **A caught panic is still printed.** A task (or handler) that panics is caught: the task
+//!   fails, its restart policy and its `TASK.FAILED` handler apply, and the module lives on.
+//!   Rust's panic hook runs before the catch, though, so the default hook prints the panic
+//!   and its location to standard error. To keep a cell's output clean, return an `Err`
+//!   instead of panicking, or install a hook of your own with [`std::panic::set_hook`] (for
+//!   example one that logs through `tracing`); the failure is in the event log either way.
+//! - **Virtual time needs a paused current-thread runtime.** [`time::drive`] advances a
+//!   [`VirtualClock`](imrs_ports::VirtualClock) whenever every task is idle, which it reads
+//!   from tokio's paused clock: build the runtime with `new_current_thread()` and
+//!   `start_paused(true)`, which needs tokio's `test-util` feature.
+//!
 //! Two modules: LOAD_IT queries its child LOAD_CARD for its status.
 //!
 //! ```
