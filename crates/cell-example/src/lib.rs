@@ -23,9 +23,11 @@ pub mod names;
 pub mod ports;
 pub mod report;
 pub mod run;
+pub mod tally;
 
 pub use chip::FeederPolicy;
 pub use cli::{USAGE, parse};
 pub use faults::{CellFault, CellFaultKind};
 pub use report::{Report, speed_line};
 pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, run};
+pub use tally::Tally;

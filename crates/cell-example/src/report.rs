@@ -1,11 +1,10 @@
 //! The report of a run, readable at a glance, and the same byte for byte for the same seed
 //! and flags (the last line, wall time, aside).
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::fmt;
 
-use imrs_sim::imrs_core::EventKind;
-use imrs_sim::{PalletId, RobotId, SimEventKind};
+use imrs_sim::PalletId;
 
 use crate::chip::{FeederPolicy, ZoneWaits};
 use crate::run::RunRecord;
@@ -82,103 +81,24 @@ pub struct Report {
 impl Report {
     /// The report of `record`.
     pub fn of(record: &RunRecord) -> Self {
-        let mut lines: [LineFigures; 2] = Default::default();
-        let mut done_at: [Vec<f64>; 2] = Default::default();
-        let mut placed = BTreeSet::new();
-        let mut screwed = BTreeSet::new();
-        let mut early_screw = Vec::new();
-        let mut early_chip = Vec::new();
-        let mut inside: BTreeMap<RobotId, f64> = BTreeMap::new();
-        let (mut zone_entries, mut zone_conflicts, mut shared_since, mut zone_shared) =
-            ([0; 2], 0, None, 0.0);
-        let mut collisions = 0;
-        let mut chips_inserted_after: [Option<f64>; 2] = [None; 2];
-        for event in &record.sim_events {
-            let at = event.at.since_start().as_secs_f64();
-            match &event.kind {
-                SimEventKind::PalletReleased { line, .. } => lines[line.index()].released += 1,
-                SimEventKind::PalletDone { line, chips, .. } => {
-                    let figures = &mut lines[line.index()];
-                    figures.completed += 1;
-                    figures.chips += chips;
-                    done_at[line.index()].push(at);
-                }
-                SimEventKind::PalletScrapped { line, .. } => lines[line.index()].scrapped += 1,
-                SimEventKind::CardPlaced { line, pallet } => {
-                    placed.insert((*line, *pallet));
-                }
-                SimEventKind::CardScrewed { line, pallet } => {
-                    if !placed.contains(&(*line, *pallet)) {
-                        early_screw.push(*pallet);
-                    }
-                    screwed.insert((*line, *pallet));
-                }
-                SimEventKind::ChipInserted { line, pallet, .. } => {
-                    if !screwed.contains(&(*line, *pallet)) {
-                        early_chip.push(*pallet);
-                    }
-                    chips_inserted_after[line.index()] = Some(at);
-                }
-                SimEventKind::ZoneEntered { robot } => {
-                    zone_entries[robot.line.index()] += 1;
-                    if !inside.is_empty() {
-                        zone_conflicts += 1;
-                        shared_since = Some(at);
-                    }
-                    inside.insert(*robot, at);
-                }
-                SimEventKind::ZoneLeft { robot } => {
-                    inside.remove(robot);
-                    if let Some(since) = shared_since.take() {
-                        zone_shared += at - since;
-                    }
-                }
-                SimEventKind::Collision { .. } => collisions += 1,
-                _ => {}
-            }
-        }
+        let tally = &record.tally;
+        let mut lines = tally.lines.clone();
         for (line, figures) in lines.iter_mut().enumerate() {
             figures.in_progress = record
                 .pallets_left
                 .iter()
                 .filter(|(l, _, _)| l.index() == line)
                 .count() as u32;
-            let gaps: Vec<f64> = done_at[line]
-                .windows(2)
-                .map(|pair| pair[1] - pair[0])
-                .collect();
-            if !gaps.is_empty() {
-                let mean = gaps.iter().sum::<f64>() / gaps.len() as f64;
-                let worst = gaps.iter().copied().fold(0.0, f64::max);
-                figures.cycle = Some((mean, worst));
-            }
+            figures.cycle = tally.cycles[line].mean_and_worst();
         }
-
-        let mut timeouts = BTreeMap::new();
-        let (mut restarts, mut alarms, mut deadlocks, mut last_deadlock) = (0, 0, 0, None);
-        for event in &record.cell_events {
-            match &event.kind {
-                EventKind::ExceptionRaised { exception } => {
-                    if let Some(port) = exception.as_str().strip_suffix(".TIMEOUT") {
-                        *timeouts.entry(port.to_string()).or_insert(0) += 1;
-                    }
-                }
-                EventKind::TaskRestarted { .. } | EventKind::ModuleRestarted { .. } => {
-                    restarts += 1
-                }
-                EventKind::Alarm { .. } => alarms += 1,
-                EventKind::Deadlock { .. } => {
-                    deadlocks += 1;
-                    last_deadlock = Some(event.at.since_start().as_secs_f64());
-                }
-                _ => {}
-            }
-        }
-        let deadlocks_broken = last_deadlock.is_none_or(|last| {
-            chips_inserted_after
+        let deadlocks_broken = tally.last_deadlock.is_none_or(|last| {
+            tally
+                .chips_inserted_after
                 .iter()
                 .all(|after| after.is_some_and(|at| at > last))
         });
+        let (early_screw, early_chip) = (&tally.early_screw, &tally.early_chip);
+        let (zone_conflicts, zone_shared) = (tally.zone_conflicts, tally.zone_shared);
 
         let mut invariants = Vec::new();
         let lost: Vec<String> = lines
@@ -200,12 +120,12 @@ impl Report {
         invariants.push(Invariant {
             rule: "no card screwed before it was loaded",
             held: early_screw.is_empty(),
-            detail: pallets(&early_screw),
+            detail: pallets(early_screw),
         });
         invariants.push(Invariant {
             rule: "no chip inserted before its card was screwed",
             held: early_chip.is_empty(),
-            detail: pallets(&early_chip),
+            detail: pallets(early_chip),
         });
         if record.config.feeder == FeederPolicy::Arbiter {
             invariants.push(Invariant {
@@ -226,15 +146,15 @@ impl Report {
                 .map(ToString::to_string)
                 .collect(),
             lines,
-            timeouts,
-            restarts,
-            alarms,
-            deadlocks,
+            timeouts: tally.timeouts.clone(),
+            restarts: tally.restarts,
+            alarms: tally.alarms,
+            deadlocks: tally.deadlocks,
             deadlocks_broken,
-            zone_entries,
+            zone_entries: tally.zone_entries,
             zone_conflicts,
             zone_shared_seconds: zone_shared,
-            collisions,
+            collisions: tally.collisions,
             waits: record.waits,
             invariants,
             simulated: record.simulated.as_secs_f64(),

@@ -1,12 +1,12 @@
 //! Running the cell: on virtual time (the default) or on the wall clock.
 
 use std::io::{IsTerminal, Write};
-use std::sync::{Arc, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
 use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::{CellErrors, time::drive};
+use imrs_sim::imrs_core::{CellErrors, Log, time::drive};
 use imrs_sim::{
     Fault, FaultKind, Line, PalletId, RobotId, Role, Sim, SimConfig, SimEvent, Station,
 };
@@ -16,6 +16,7 @@ use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{ReleaseDeath, gate};
 use crate::load::{load_card, load_it, screw_in_card};
 use crate::ports::CellPorts;
+use crate::tally::Tally;
 
 /// How a run is made.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +33,9 @@ pub struct CellConfig {
     pub faults: Vec<CellFault>,
     /// Show a progress bar on a terminal.
     pub progress: bool,
+    /// How many of the most recent events each log keeps in memory for the record (the
+    /// report is folded from every event as it comes, whatever this is).
+    pub kept_events: usize,
 }
 
 impl Default for CellConfig {
@@ -43,6 +47,7 @@ impl Default for CellConfig {
             realtime: false,
             faults: Vec::new(),
             progress: false,
+            kept_events: Log::<Event>::DEFAULT_CAPACITY,
         }
     }
 }
@@ -52,9 +57,12 @@ impl Default for CellConfig {
 pub struct RunRecord {
     /// The configuration it ran with.
     pub config: CellConfig,
-    /// The physical facts, from the simulation.
+    /// Everything the report counts, folded from every event of the run.
+    pub tally: Tally,
+    /// The most recent physical facts from the simulation (at most
+    /// [`CellConfig::kept_events`]; all of a short run).
     pub sim_events: Vec<SimEvent>,
-    /// The modules' event log.
+    /// The most recent events of the modules (at most [`CellConfig::kept_events`]).
     pub cell_events: Vec<Event>,
     /// The pallets still on the conveyors at the end.
     pub pallets_left: Vec<(Line, PalletId, [f32; 3])>,
@@ -150,6 +158,14 @@ async fn simulate(
 ) -> Result<RunRecord, CellErrors> {
     let cell = Cell::new(clock.clone());
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
+    cell.events().set_capacity(config.kept_events);
+    sim.log().set_capacity(config.kept_events);
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let folded = Arc::clone(&tally);
+    cell.events()
+        .subscribe(move |event| lock(&folded).cell(event));
+    let folded = Arc::clone(&tally);
+    sim.log().subscribe(move |event| lock(&folded).sim(event));
     let ports = CellPorts::declare(&cell, config.feeder == FeederPolicy::Arbiter)?;
     let deaths: [ReleaseDeath; 2] = Default::default();
     let waits: SharedWaits = Arc::default();
@@ -217,6 +233,7 @@ async fn simulate(
     let waits = *waits.lock().unwrap_or_else(PoisonError::into_inner);
     Ok(RunRecord {
         config: config.clone(),
+        tally: lock(&tally).clone(),
         sim_events: sim.log().snapshot(),
         cell_events: cell.events().snapshot(),
         pallets_left: sim.pallets(),
@@ -254,4 +271,9 @@ fn progress(reached: Instant, end: Instant) {
         share * 100.0
     );
     let _ = std::io::stderr().flush();
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // A fold is one call; a panic in it leaves the tally as the last whole event left it.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }

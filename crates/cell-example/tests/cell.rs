@@ -148,3 +148,23 @@ fn hours_out_of_range_are_refused_not_panicked_on() {
         );
     }
 }
+
+#[test]
+fn the_report_is_folded_from_every_event_whatever_the_logs_keep() {
+    let everything = config(0.3, 3, FeederPolicy::Arbiter);
+    let little = CellConfig {
+        kept_events: 100,
+        ..everything.clone()
+    };
+    let full = run(&everything).unwrap();
+    let kept_little = run(&little).unwrap();
+    assert!(kept_little.cell_events.len() <= 100 && kept_little.sim_events.len() <= 100);
+    assert!(full.cell_events.len() > 100, "the full run kept more");
+    let report = |record| Report {
+        wall: 0.0,
+        ..Report::of(record)
+    };
+    assert_eq!(report(&kept_little), report(&full));
+    // What the fold keeps per pallet is dropped when the pallet leaves the line.
+    assert!(full.tally.in_flight() <= 2 * full.pallets_left.len());
+}

@@ -1,6 +1,13 @@
-//! A log of records: kept in memory, and streamed to subscribers as it grows. The cell's
-//! event log and the simulation's log of measured facts are both one.
+//! A log of records: the most recent ones kept in memory, and every one streamed to
+//! subscribers as it is made. The cell's event log and the simulation's log of measured facts
+//! are both one.
+//!
+//! Memory is bounded: a log keeps at most its capacity of records (by default
+//! [`Log::DEFAULT_CAPACITY`]) and forgets the oldest beyond it, counting them, so that a run
+//! of any length fits in a fixed budget. Whatever needs every record — a report, a recorder —
+//! subscribes and folds the stream as it comes.
 
+use std::collections::VecDeque;
 use std::fmt;
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
@@ -18,28 +25,49 @@ pub struct Log<E> {
 }
 
 struct Inner<E> {
-    records: Vec<E>,
-    forget: bool,
+    records: VecDeque<E>,
+    capacity: usize,
+    forgotten: u64,
     sinks: Vec<Sink<E>>,
 }
 
 impl<E: Record> Log<E> {
-    /// An empty log that keeps every record.
+    /// How many records a log keeps unless told otherwise: the most recent 65,536.
+    pub const DEFAULT_CAPACITY: usize = 1 << 16;
+
+    /// An empty log that keeps the most recent [`Log::DEFAULT_CAPACITY`] records.
     pub fn new() -> Self {
+        Self::with_capacity(Self::DEFAULT_CAPACITY)
+    }
+
+    /// An empty log that keeps the most recent `capacity` records (0: none; subscribers
+    /// still see every one).
+    pub fn with_capacity(capacity: usize) -> Self {
         Self {
             inner: Mutex::new(Inner {
-                records: Vec::new(),
-                forget: false,
+                records: VecDeque::new(),
+                capacity,
+                forgotten: 0,
                 sinks: Vec::new(),
             }),
         }
     }
 
-    /// Stops keeping records in memory (subscribers still see them): for long runs.
-    pub fn forget_events(&self) {
+    /// Keeps at most `capacity` records from now on, forgetting the oldest beyond it.
+    pub fn set_capacity(&self, capacity: usize) {
         let mut inner = self.lock();
-        inner.forget = true;
-        inner.records = Vec::new();
+        inner.capacity = capacity;
+        inner.trim();
+    }
+
+    /// Stops keeping records in memory (subscribers still see them): `set_capacity(0)`.
+    pub fn forget_events(&self) {
+        self.set_capacity(0);
+    }
+
+    /// How many records were forgotten to stay within the capacity.
+    pub fn forgotten(&self) -> u64 {
+        self.lock().forgotten
     }
 
     /// Calls `sink` with every record made from now on, in order.
@@ -54,14 +82,17 @@ impl<E: Record> Log<E> {
         for sink in &mut inner.sinks {
             sink(&record);
         }
-        if !inner.forget {
-            inner.records.push(record);
+        if inner.capacity > 0 {
+            inner.records.push_back(record);
+            inner.trim();
+        } else {
+            inner.forgotten += 1;
         }
     }
 
-    /// Every record kept so far.
+    /// The records kept: every one made, or, past the capacity, the most recent.
     pub fn snapshot(&self) -> Vec<E> {
-        self.lock().records.clone()
+        self.lock().records.iter().cloned().collect()
     }
 
     /// How many records are kept.
@@ -80,6 +111,15 @@ impl<E: Record> Log<E> {
     }
 }
 
+impl<E> Inner<E> {
+    fn trim(&mut self) {
+        while self.records.len() > self.capacity {
+            self.records.pop_front();
+            self.forgotten += 1;
+        }
+    }
+}
+
 impl<E: Record> Default for Log<E> {
     fn default() -> Self {
         Self::new()
@@ -88,6 +128,11 @@ impl<E: Record> Default for Log<E> {
 
 impl<E: Record> fmt::Debug for Log<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Log").field("records", &self.len()).finish()
+        let inner = self.lock();
+        f.debug_struct("Log")
+            .field("records", &inner.records.len())
+            .field("capacity", &inner.capacity)
+            .field("forgotten", &inner.forgotten)
+            .finish()
     }
 }
