@@ -152,7 +152,7 @@ pub fn chip_it(
             "chip station freeze relay".into(),
         ])
         .owns(n.ready_to_chip.clone())
-        .uses(n.frequency.clone(), UsageKind::Send);
+        .uses_named(n.frequency.clone(), UsageKind::Send);
     let line_ports = &ports.lines[line.index()];
     let twin_ports = &ports.lines[twin_line.index()];
     // The Appendix's feeder ports are declared under both policies, so that the module keeps
@@ -163,12 +163,12 @@ pub fn chip_it(
         .responder_named(n.chip_it.clone(), |_: &ChipItState, ()| 1);
     spec = spec
         .owns(n.share_feeder.clone())
-        .uses(twin.share_feeder.clone(), UsageKind::Response);
+        .uses_named(twin.share_feeder.clone(), UsageKind::Response);
     spec = with_response(spec, crit_section, handler);
     if policy == FeederPolicy::Arbiter {
         spec = spec
-            .uses(ZONE_REQUEST, UsageKind::Send)
-            .uses(ZONE_RELEASE, UsageKind::Send);
+            .uses_named(ZONE_REQUEST, UsageKind::Send)
+            .uses_named(ZONE_RELEASE, UsageKind::Send);
     }
     // The asymmetric timeout handlers (note 6): CHIP_IT steps into a procedure ranked below
     // CRIT_SECTION for a moment, so its twin's pending query is answered; CHIP_IT2 just

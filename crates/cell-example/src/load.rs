@@ -45,7 +45,7 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
         .order([timeout1.clone(), timeout2.clone(), n.load_it.clone()])
         .owns(n.ask_child1.clone())
         .owns(n.ask_child2.clone())
-        .uses(n.frequency.clone(), UsageKind::Send)
+        .uses_named(n.frequency.clone(), UsageKind::Send)
         .task(n.load_it.clone(), move |ctx| {
             let (ports, sim, n) = (ports.clone(), sim.clone(), n.clone());
             async move {
@@ -128,7 +128,7 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
         ])
         .owns(n.pallet_in_place.clone())
         .owns(n.card_in_place.clone())
-        .uses(n.ask_child1.clone(), UsageKind::Response);
+        .uses_named(n.ask_child1.clone(), UsageKind::Response);
     // WHEN ASK_CHILD1.STATUS(RC1, NUM1, CYCLE1) ==> RC1 := 0; NUM1 := NUM_LOADED; ...
     let status = ports
         .ask_child1
@@ -229,8 +229,8 @@ pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()>
             n.screw_in_card.clone(),
         ])
         .hardware([format!("screw robot of line {line:?}")])
-        .uses(n.ask_child2.clone(), UsageKind::Response)
-        .uses(n.card_in_place.clone(), UsageKind::Receive);
+        .uses_named(n.ask_child2.clone(), UsageKind::Response)
+        .uses_named(n.card_in_place.clone(), UsageKind::Receive);
     // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
     let status = ports
         .ask_child2

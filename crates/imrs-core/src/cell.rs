@@ -326,6 +326,9 @@ fn supervisor<S: Send + Sync + 'static>(
     mut factory: Option<Factory<S>>,
 ) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellError> {
     let name = first.name.clone();
+    if let Some(problem) = first.problems.first() {
+        return Err(CellError::Wire(problem.clone()));
+    }
     let kill = Arc::new(KillSwitch::default());
     match lock(&cell.modules).entry(name.clone()) {
         Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }),
@@ -396,7 +399,19 @@ fn supervisor<S: Send + Sync + 'static>(
             if kill.is_stopped() {
                 break outcome;
             }
-            next = Some(factory());
+            let copy = factory();
+            if let Some(problem) = copy.problems.first() {
+                // The new copy cannot even be wired (say, its response end is taken).
+                let reason = format!("a new copy cannot be wired: {problem}");
+                cell.record(
+                    &name,
+                    EventKind::ModuleFailed {
+                        reason: reason.clone(),
+                    },
+                );
+                break ModuleOutcome::Failed(reason);
+            }
+            next = Some(copy);
             cell.record(&name, EventKind::ModuleRestarted { attempt });
         };
         lock(&cell.modules).remove(&name);

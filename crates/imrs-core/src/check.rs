@@ -256,6 +256,7 @@ pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellE
     check_users(wiring, modules, &mut problems);
     check_filters(wiring, modules, &mut problems);
     for module in modules {
+        problems.extend(module.problems.iter().cloned().map(CellError::Wire));
         check_order(module, &mut problems);
         check_exceptions(module, &mut problems);
         check_responses(module, &mut problems);

@@ -82,20 +82,21 @@
 //! #[derive(Default)]
 //! struct LoadCard { num_loaded: u32 }
 //! let load_card = ModuleSpec::new("LOAD_CARD", LoadCard::default())
-//!     .order(["ASK_CHILD1.STATUS", "LOAD_CARD"])
-//!     .response("ASK_CHILD1.STATUS", ask_child1.responder_named("LOAD_CARD", |s: &LoadCard, ()| (0, s.num_loaded))?)
+//!     .order([ask_child1.handler("STATUS"), "LOAD_CARD".into()])
+//!     .respond(&ask_child1, "STATUS", |s: &LoadCard, ()| (0, s.num_loaded))
 //!     .task("LOAD_CARD", |ctx| async move {
 //!         loop {
 //!             ctx.delay(Duration::from_secs(10)).await; // load a card
 //!             ctx.state().update(|s| s.num_loaded += 1);
 //!         }
 //!     });
+//! let loaded = load_card.view();
 //!
-//! let load_it = ModuleSpec::new("LOAD_IT", ()).task("LOAD_IT", move |ctx| {
+//! let load_it = ModuleSpec::new("LOAD_IT", ()).owns(&ask_child1).task("LOAD_IT", move |ctx| {
 //!     // Each copy of the task attaches anew: a restarted copy re-attaches to the same port.
-//!     let ask_child1 = ask_child1.clone();
+//!     let ask_child1 = ctx.owner(&ask_child1);
 //!     async move {
-//!         let mut ask_child1 = ask_child1.owner()?;
+//!         let mut ask_child1 = ask_child1?;
 //!         ctx.delay(Duration::from_secs(25)).await;
 //!         let (rc, num_loaded) = ctx.query(&mut ask_child1, ()).await?;
 //!         assert_eq!((rc, num_loaded), (0, 2));
@@ -106,6 +107,7 @@
 //! let mut load_it = cell.start(load_it)?;
 //! imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(30))).await;
 //! assert_eq!(load_it.finished().await, ModuleOutcome::Finished);
+//! assert_eq!(loaded.inspect(|s| s.num_loaded), 3);
 //! # Ok::<_, Box<dyn std::error::Error>>(())
 //! # })?;
 //! # Ok(())
@@ -133,7 +135,7 @@ pub use exception::Exception;
 pub use imrs_ports;
 pub use log::{Log, Record};
 pub use module::ctx::Ctx;
-pub use module::spec::{ModuleDecl, ModuleSpec, TaskError, TaskResult};
+pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult};
 pub use order::{Order, Rank};
 pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;

@@ -38,7 +38,7 @@ fn chip_robot(
         ])
         .sections(["GRASP", "INSERT", "BACK_OFF"])
         .owns(asks_name)
-        .uses(answers_name, UsageKind::Response)
+        .uses_named(answers_name, UsageKind::Response)
         .response(
             crit_section,
             answers.responder_named(name, |_: &(), ()| 1).unwrap(),

@@ -86,7 +86,7 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
         for asked in [5, 12, 25, 33] {
             let port = share_feeder1.clone();
             let asker = ModuleSpec::new(format!("ASK{asked}"), ())
-                .uses("SHARE_FEEDER1", UsageKind::Query)
+                .uses_named("SHARE_FEEDER1", UsageKind::Query)
                 .task("ASK", move |ctx| {
                     let port = port.clone();
                     async move {

@@ -57,7 +57,7 @@ fn independent_a_proprietor_owns_the_shared_conveyor_state() {
         let station = |name: &'static str, change: i32, every: u64, times: u32| {
             let update = update.clone();
             ModuleSpec::new(name, ())
-                .uses("UPDATE", UsageKind::Send)
+                .uses_named("UPDATE", UsageKind::Send)
                 .task(name, move |ctx| {
                     let update = update.clone();
                     async move {

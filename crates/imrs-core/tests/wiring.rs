@@ -52,15 +52,15 @@ fn a_correct_cell_passes() {
             ModuleSpec::new("LOAD_IT", ())
                 .order(["ASK_CHILD1.TIMEOUT", "LOAD_IT"])
                 .owns("ASK_CHILD1")
-                .uses("FREQUENCY", UsageKind::Send),
+                .uses_named("FREQUENCY", UsageKind::Send),
         ),
         decl(
             ModuleSpec::new("LOAD_CARD", ())
                 .owns("CARD_IN_PLACE")
-                .uses("ASK_CHILD1", UsageKind::Response),
+                .uses_named("ASK_CHILD1", UsageKind::Response),
         ),
-        decl(ModuleSpec::new("SCREW_IN_CARD", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
-        decl(ModuleSpec::new("RELEASER", ()).uses("LET_1_GO", UsageKind::Receive)),
+        decl(ModuleSpec::new("SCREW_IN_CARD", ()).uses_named("CARD_IN_PLACE", UsageKind::Receive)),
+        decl(ModuleSpec::new("RELEASER", ()).uses_named("LET_1_GO", UsageKind::Receive)),
     ];
     assert_eq!(cell.check(&modules), Ok(()));
 }
@@ -87,12 +87,12 @@ fn every_problem_is_reported_at_once_naming_module_and_port() {
         // Not on ASK_CHILD1's user list; and both ends of CARD_IN_PLACE say SEND.
         decl(
             ModuleSpec::new("SCREW_IN_CARD", ())
-                .uses("ASK_CHILD1", UsageKind::Response)
-                .uses("CARD_IN_PLACE", UsageKind::Send),
+                .uses_named("ASK_CHILD1", UsageKind::Response)
+                .uses_named("CARD_IN_PLACE", UsageKind::Send),
         ),
         // Three users for a port of two.
-        decl(ModuleSpec::new("A", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
-        decl(ModuleSpec::new("B", ()).uses("CARD_IN_PLACE", UsageKind::Receive)),
+        decl(ModuleSpec::new("A", ()).uses_named("CARD_IN_PLACE", UsageKind::Receive)),
+        decl(ModuleSpec::new("B", ()).uses_named("CARD_IN_PLACE", UsageKind::Receive)),
     ];
     let problems = cell.check(&modules).unwrap_err();
     let expected = [

@@ -16,7 +16,7 @@ use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::response::ResponseEnd;
-use crate::usage::{self, Plain, Usage};
+use crate::usage::{self, Answers, Plain, Usage, UsageKind};
 use crate::user_list::{Admits, AnyUser, UserList};
 
 /// The restrictions of a port that are values rather than types: its name and owner,
@@ -173,6 +173,23 @@ where
         &self.core.meta.owner
     }
 
+    /// The name of this port's handler or exception `what`: `PORT.what`, as an order names
+    /// it (`ask_child1.handler("STATUS")` is `"ASK_CHILD1.STATUS"`, `.handler("TIMEOUT")`
+    /// its timeout). Built from the port, so it cannot name another one by a typo.
+    pub fn handler(&self, what: &str) -> Name {
+        Name::from(format!("{}.{what}", self.core.meta.name))
+    }
+
+    /// The usage of this port's owner end.
+    pub fn owner_usage(&self) -> UsageKind {
+        U::KIND
+    }
+
+    /// The usage of this port's user ends: the complement of the owner's.
+    pub fn user_usage(&self) -> UsageKind {
+        <U::Complement as Usage>::KIND
+    }
+
     /// How many users are attached now.
     pub fn users_attached(&self) -> usize {
         self.core.users_attached()
@@ -274,6 +291,37 @@ where
     ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
         let attachment = attach_user(&self.core, module.into())?;
         Ok(ResponseEnd::new(attachment, Box::new(handler)))
+    }
+}
+
+impl<Req, Rep, U, L, const N: usize> Port<Req, Rep, U, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: Answers,
+    L: UserList,
+{
+    /// Attaches the side of this port that answers queries, for module `module`, with its
+    /// response handler: the owner end of a `RESPONSE` port, or a user end of a `QUERY` or
+    /// `CALLALL` port (checked against the user list and the number of users).
+    pub fn answer<S>(
+        &self,
+        module: impl Into<Name>,
+        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+    ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
+        let attachment = if U::OWNER_ANSWERS {
+            self.attach_owner()?
+        } else {
+            attach_user(&self.core, module.into())?
+        };
+        Ok(ResponseEnd::new(attachment, Box::new(handler)))
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> From<&Port<Req, Rep, U, L, N>> for Name {
+    /// The port's name: `.owns(&port)` names a port through its declaration.
+    fn from(port: &Port<Req, Rep, U, L, N>) -> Self {
+        port.core.meta.name.clone()
     }
 }
 

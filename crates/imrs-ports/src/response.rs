@@ -10,7 +10,7 @@
 use std::fmt;
 use std::future::{Future, poll_fn};
 use std::pin::pin;
-use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
 use std::task::{Context, Poll};
 use std::time::Duration;
 
@@ -136,6 +136,11 @@ impl<Req, Rep, S> fmt::Debug for ResponseEnd<Req, Rep, S> {
 }
 
 /// A response end as seen by whatever decides when handlers run.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` is not a response end answering from a state `{S}`",
+    label = "expected an end built with its response handler",
+    note = "build one with `Port::answer`, `responder` or `owner_responder`, whose handler takes `&{S}`"
+)]
 pub trait Respond<S> {
     /// The port this end answers.
     fn port(&self) -> &Name;
@@ -206,6 +211,13 @@ impl<S> ModuleState<S> {
     /// If called from inside an `update` or `read` of the same state.
     pub fn read<R>(&self, look: impl FnOnce(&S) -> R) -> R {
         look(&self.lock())
+    }
+
+    /// Reads the state from outside its module — a test, a report — waiting for an update in
+    /// progress on another thread to end. Never call it from the module's own tasks or
+    /// handlers: there, use [`ModuleState::read`].
+    pub fn inspect<R>(&self, look: impl FnOnce(&S) -> R) -> R {
+        look(&self.0.lock().unwrap_or_else(PoisonError::into_inner))
     }
 
     /// The state, unwrapped.

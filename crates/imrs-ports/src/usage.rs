@@ -113,7 +113,7 @@ impl Receives for Receive {}
 #[diagnostic::on_unimplemented(
     message = "this port end cannot `query`: its usage is `{Self}`",
     label = "`query` needs an end whose usage is `usage::Query`",
-    note = "a SEND port is used with `send`; declare the port `usage::Query` to reach a response handler"
+    note = "`query` reaches the response handler at the other end of a QUERY port; a SEND end uses `send`, a CALLALL owner `call_all`"
 )]
 pub trait Queries: Usage {}
 impl Queries for Query {}
@@ -146,3 +146,25 @@ impl Plain for Receive {}
 impl Plain for Query {}
 impl Plain for SendAll {}
 impl Plain for CallAll {}
+
+/// Usages of a port whose one side answers queries with a response handler: a `RESPONSE`
+/// owner, or the users of a `QUERY` or `CALLALL` port. [`Port::answer`](crate::Port::answer)
+/// attaches the answering side, whichever it is.
+#[diagnostic::on_unimplemented(
+    message = "no end of a `{Self}` port answers queries",
+    label = "`answer` needs a port declared `usage::Response`, `usage::Query` or `usage::CallAll`",
+    note = "a response handler answers a QUERY or CALLALL port's users, or owns a RESPONSE port"
+)]
+pub trait Answers: Usage {
+    /// Whether the answering side is the owner's.
+    const OWNER_ANSWERS: bool;
+}
+impl Answers for Response {
+    const OWNER_ANSWERS: bool = true;
+}
+impl Answers for Query {
+    const OWNER_ANSWERS: bool = false;
+}
+impl Answers for CallAll {
+    const OWNER_ANSWERS: bool = false;
+}

@@ -9,9 +9,10 @@ use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_ports::usage::{Queries, Receives, Sends};
+use imrs_ports::usage::{Plain, Queries, Receives, Sends, Usage};
 use imrs_ports::{
-    End, Instant, ModuleState, Name, QueryError, ReceiveError, ReplyHandle, SendError, SharedClock,
+    End, Instant, ModuleState, Name, Port, QueryError, ReceiveError, ReplyHandle, SendError,
+    SharedClock, UserList, WireError,
 };
 use tracing::Instrument;
 
@@ -73,7 +74,7 @@ impl SectionCell {
 pub(crate) struct ModuleShared<S> {
     pub(crate) name: Name,
     pub(crate) parent: Option<Name>,
-    pub(crate) state: ModuleState<S>,
+    pub(crate) state: Arc<ModuleState<S>>,
     pub(crate) order: Order,
     pub(crate) cell: Arc<CellShared>,
     /// The modules this copy costarted, stopped when it ends.
@@ -89,7 +90,7 @@ impl<S> ModuleShared<S> {
     pub(crate) fn new(
         spec_name: Name,
         parent: Option<Name>,
-        state: S,
+        state: Arc<ModuleState<S>>,
         order: Order,
         cell: Arc<CellShared>,
         children: Children,
@@ -97,7 +98,7 @@ impl<S> ModuleShared<S> {
         Self {
             name: spec_name,
             parent,
-            state: ModuleState::new(state),
+            state,
             order,
             cell,
             children,
@@ -207,6 +208,45 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// The module's state: change it with `update`, read it with `read`.
     pub fn state(&self) -> &ModuleState<S> {
         &self.module.state
+    }
+
+    /// Attaches the owner end of `port` for this module. Call it where a task copy is made
+    /// (in the task's closure, before its `async` block), so that the closure keeps the one
+    /// clone of the port it was given and each copy of the task attaches anew:
+    ///
+    /// ```text
+    /// .task("LOAD_IT", move |ctx| {
+    ///     let ask_child1 = ctx.owner(&ask_child1);
+    ///     async move { let mut ask_child1 = ask_child1?; /* ... */ Ok(()) }
+    /// })
+    /// ```
+    pub fn owner<Req, Rep, U, L, const N: usize>(
+        &self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<End<Req, Rep, U>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage + Plain,
+        L: UserList,
+    {
+        port.owner()
+    }
+
+    /// Attaches a user end of `port` for this module, checked against the port's user list
+    /// and number of users; see [`Ctx::owner`] for where to call it.
+    pub fn user<Req, Rep, U, L, const N: usize>(
+        &self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<End<Req, Rep, U::Complement>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        U::Complement: Plain,
+        L: UserList,
+    {
+        port.user_named(self.module.name.clone())
     }
 
     /// The cell's clock.

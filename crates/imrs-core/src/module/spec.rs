@@ -7,7 +7,8 @@ use std::future::Future;
 use std::pin::Pin;
 use std::sync::Arc;
 
-use imrs_ports::{Name, Respond, UsageKind};
+use imrs_ports::usage::{Answers, Usage};
+use imrs_ports::{ModuleState, Name, Port, Respond, UsageKind, UserList, WireError};
 
 use super::ctx::Ctx;
 use crate::exception::Exception;
@@ -36,7 +37,7 @@ pub(crate) struct TaskSpec<S> {
 /// [`ModuleState::update`](imrs_ports::ModuleState::update); response handlers read it.
 pub struct ModuleSpec<S> {
     pub(crate) name: Name,
-    pub(crate) state: S,
+    pub(crate) state: Arc<ModuleState<S>>,
     pub(crate) order: Vec<Name>,
     pub(crate) sections: Vec<Name>,
     pub(crate) hardware: Vec<Name>,
@@ -47,6 +48,9 @@ pub struct ModuleSpec<S> {
     pub(crate) responses: Vec<(Name, Box<dyn Respond<S> + Send>)>,
     pub(crate) exceptions: Vec<(Name, ExceptionHandler<S>)>,
     pub(crate) raises: Vec<Name>,
+    /// Ends that could not be attached while the module was declared: reported by the
+    /// wiring check, and a module that has any is refused at start.
+    pub(crate) problems: Vec<WireError>,
 }
 
 impl<S: Send + Sync + 'static> ModuleSpec<S> {
@@ -54,7 +58,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
     pub fn new(name: impl Into<Name>, state: S) -> Self {
         Self {
             name: name.into(),
-            state,
+            state: Arc::new(ModuleState::new(state)),
             order: Vec::new(),
             sections: Vec::new(),
             hardware: Vec::new(),
@@ -65,6 +69,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
             responses: Vec::new(),
             exceptions: Vec::new(),
             raises: Vec::new(),
+            problems: Vec::new(),
         }
     }
 
@@ -103,16 +108,67 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         self
     }
 
-    /// `PORT ...`: declares that this module owns `port`.
+    /// `PORT ...`: declares that this module owns `port` — its declaration (`&port`), or
+    /// its name.
     pub fn owns(mut self, port: impl Into<Name>) -> Self {
         self.owns.push(port.into());
         self
     }
 
-    /// `USE PORT ... USAGE=usage`: declares that this module uses `port` with `usage`.
-    pub fn uses(mut self, port: impl Into<Name>, usage: UsageKind) -> Self {
+    /// `USE PORT ...`: declares that this module uses `port`, with the usage its type gives
+    /// a user (the complement of the owner's).
+    pub fn uses<Req, Rep, U, L, const N: usize>(mut self, port: &Port<Req, Rep, U, L, N>) -> Self
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        L: UserList,
+    {
+        self.uses.push((port.name().clone(), port.user_usage()));
+        self
+    }
+
+    /// `USE PORT ... USAGE=usage`, for a port known only by name (wired through
+    /// [`Cell::use_port`](crate::Cell::use_port)).
+    pub fn uses_named(mut self, port: impl Into<Name>, usage: UsageKind) -> Self {
         self.uses.push((port.into(), usage));
         self
+    }
+
+    /// `WHEN PORT.what ==>`: a response handler on `port`, named `PORT.what` as the order
+    /// names it (build the name with [`Port::handler`]). The answering end is attached here,
+    /// for this module: the owner end of a `RESPONSE` port, or a user end of a `QUERY` or
+    /// `CALLALL` port; and the module is declared to own or use the port. An end that cannot
+    /// be attached is reported by the wiring check and refuses the module at start.
+    pub fn respond<Req, Rep, U, L, const N: usize>(
+        mut self,
+        port: &Port<Req, Rep, U, L, N>,
+        what: &str,
+        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+    ) -> Self
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Answers,
+        L: UserList,
+    {
+        if U::OWNER_ANSWERS {
+            self.owns.push(port.name().clone());
+        } else {
+            self.uses.push((port.name().clone(), UsageKind::Response));
+        }
+        match port.answer(self.name.clone(), handler) {
+            Ok(end) => self.responses.push((port.handler(what), Box::new(end))),
+            Err(problem) => self.problems.push(problem),
+        }
+        self
+    }
+
+    /// A view of this module's state from outside, for a test or a report to read during or
+    /// after a run (`view.inspect(|s| ...)`). It sees this copy of the module; a supervised
+    /// module's next copy has a state of its own.
+    pub fn view(&self) -> StateView<S> {
+        StateView(Arc::clone(&self.state))
     }
 
     /// Declares that a task of this module is the filter of `port`, serving the port's users
@@ -209,6 +265,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
                 .collect(),
             tasks: self.tasks.iter().map(|task| task.name.clone()).collect(),
             raises: self.raises.clone(),
+            problems: self.problems.clone(),
         }
     }
 }
@@ -249,4 +306,28 @@ pub struct ModuleDecl {
     pub tasks: Vec<Name>,
     /// The exceptions it declares it raises itself ([`ModuleSpec::raises`]).
     pub raises: Vec<Name>,
+    /// The ends it could not attach when it was declared ([`ModuleSpec::respond`]).
+    pub problems: Vec<WireError>,
+}
+
+/// A module's state seen from outside; see [`ModuleSpec::view`].
+pub struct StateView<S>(Arc<ModuleState<S>>);
+
+impl<S> StateView<S> {
+    /// Reads the state, waiting for an update in progress to end.
+    pub fn inspect<R>(&self, look: impl FnOnce(&S) -> R) -> R {
+        self.0.inspect(look)
+    }
+}
+
+impl<S> Clone for StateView<S> {
+    fn clone(&self) -> Self {
+        Self(Arc::clone(&self.0))
+    }
+}
+
+impl<S> fmt::Debug for StateView<S> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("StateView").finish_non_exhaustive()
+    }
 }
