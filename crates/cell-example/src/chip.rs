@@ -8,7 +8,7 @@ use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{DeviceError, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{drive_relay, insisted, retried, with_response};
+use crate::help::{drive_relay, insisted, retried};
 use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
 use crate::ports::{CellPorts, ZonePort};
 
@@ -130,17 +130,18 @@ pub fn chip_it(
 ) -> ModuleSpec<ChipItState> {
     let n = LineNames::of(line);
     let twin_line = line.other();
-    let twin = LineNames::of(twin_line);
-    let crit_section = format!("{}.CRIT_SECTION", twin.share_feeder);
-    let own_timeout = format!("{}.TIMEOUT", n.share_feeder);
+    let line_ports = &ports.lines[line.index()];
+    let twin_ports = &ports.lines[twin_line.index()];
+    let crit_section = twin_ports.share_feeder.handler("CRIT_SECTION");
+    let own_timeout = line_ports.share_feeder.handler("TIMEOUT");
     let mut spec = ModuleSpec::new(n.chip_it.clone(), ChipItState::default())
         // 1) timeouts first; 2) never preempt the background, else a QUERY could be
         // interrupted by a QUERY from the twin; 3) nor the critical region; 4) then the twin's
         // query; 5) the insertion last: a query is answered only while inserting.
         .order([
-            format!("{}.TIMEOUT", n.ready_to_chip),
+            line_ports.ready_to_chip.handler("TIMEOUT"),
             own_timeout.clone(),
-            n.chip_it.clone(),
+            n.chip_it.as_str().into(),
             "GRASP".into(),
             crit_section.clone(),
             "INSERT".into(),
@@ -151,20 +152,17 @@ pub fn chip_it(
             format!("chip robot of line {line:?}"),
             "chip station freeze relay".into(),
         ])
-        .owns(n.ready_to_chip.clone())
-        .uses_named(n.frequency.clone(), UsageKind::Send);
-    let line_ports = &ports.lines[line.index()];
-    let twin_ports = &ports.lines[twin_line.index()];
-    // The Appendix's feeder ports are declared under both policies, so that the module keeps
-    // the Appendix's shape; under the arbiter nobody queries them.
-    // WHEN SHARE_FEEDER1.CRIT_SECTION(CLEAR) ==> CLEAR := 1: the order decides when.
-    let handler = twin_ports
-        .share_feeder
-        .responder_named(n.chip_it.clone(), |_: &ChipItState, ()| 1);
-    spec = spec
-        .owns(n.share_feeder.clone())
-        .uses_named(twin.share_feeder.clone(), UsageKind::Response);
-    spec = with_response(spec, crit_section, handler);
+        .owns(&line_ports.ready_to_chip)
+        .uses_named(n.frequency.clone(), UsageKind::Send)
+        // The Appendix's feeder ports are declared under both policies, so that the module
+        // keeps the Appendix's shape; under the arbiter nobody queries them.
+        .owns(&line_ports.share_feeder)
+        // WHEN SHARE_FEEDER1.CRIT_SECTION(CLEAR) ==> CLEAR := 1: the order decides when.
+        .respond(
+            &twin_ports.share_feeder,
+            "CRIT_SECTION",
+            |_: &ChipItState, ()| 1,
+        );
     if policy == FeederPolicy::Arbiter {
         spec = spec
             .uses_named(ZONE_REQUEST, UsageKind::Send)
@@ -267,7 +265,7 @@ pub fn chip_it(
             }
         })
         .exception(
-            format!("{}.TIMEOUT", n.ready_to_chip),
+            line_ports.ready_to_chip.handler("TIMEOUT"),
             |ctx: Ctx<ChipItState>, _| async move {
                 ctx.alarm("no card at the chip station for 60 s");
             },

@@ -35,7 +35,7 @@ pub fn gate(
     death: ReleaseDeath,
 ) -> ModuleSpec<GateState> {
     let n = LineNames::of(line);
-    let timeout = format!("{}.TIMEOUT", n.let_1_go);
+    let timeout = ports.let_1_go.handler("TIMEOUT");
     let state = GateState {
         cycle_time: 10.0,
         speeds: [20.0, 40.0],
@@ -46,9 +46,9 @@ pub fn gate(
     let (release_port, buffer_port) = (ports.let_1_go.clone(), ports.frequency.clone());
     let device = sim.gate(line);
     ModuleSpec::new(n.gate.clone(), state)
-        .order([timeout.clone(), n.gate.clone()])
+        .order([timeout.clone(), n.gate.as_str().into()])
         .hardware([format!("gate relay and photocell of line {line:?}")])
-        .owns(n.let_1_go.clone())
+        .owns(&ports.let_1_go)
         .filters(n.frequency.clone(), UsageKind::Receive)
         .task(n.gate.clone(), move |ctx| {
             let (let_1_go, frequency) = (let_1_go.clone(), frequency.clone());

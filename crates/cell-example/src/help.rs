@@ -3,8 +3,8 @@
 use std::future::Future;
 use std::time::Duration;
 
-use imrs_sim::imrs_core::imrs_ports::{End, Respond, usage};
-use imrs_sim::imrs_core::{Ctx, ModuleSpec};
+use imrs_sim::imrs_core::Ctx;
+use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::{DeviceError, PalletId, Relay};
 
 /// How long an operator takes to reset a faulted robot.
@@ -80,34 +80,5 @@ where
             }
             Err(error) => return Err(error),
         }
-    }
-}
-
-/// A module that cannot start because a port refused it: it fails at once, with the
-/// refusal as its reason, so that its supervisor reports it.
-fn refused<S: Send + Sync + 'static>(
-    spec: ModuleSpec<S>,
-    error: impl std::fmt::Display,
-) -> ModuleSpec<S> {
-    let reason = error.to_string();
-    spec.task("WIRING", move |_ctx| {
-        let reason = reason.clone();
-        async move { Err(reason.into()) }
-    })
-}
-
-/// Adds a response handler, or makes the module fail with the wiring error.
-pub fn with_response<S, E>(
-    spec: ModuleSpec<S>,
-    name: String,
-    end: Result<E, impl std::fmt::Display>,
-) -> ModuleSpec<S>
-where
-    S: Send + Sync + 'static,
-    E: Respond<S> + Send + 'static,
-{
-    match end {
-        Ok(end) => spec.response(name, end),
-        Err(error) => refused(spec, error),
     }
 }

@@ -6,7 +6,7 @@ use std::time::Duration;
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, RobotId, Role, Sim, Station, Target};
 
-use crate::help::{drive_relay, insisted, retried, with_response};
+use crate::help::{drive_relay, insisted, retried};
 use crate::names::LineNames;
 use crate::ports::LinePorts;
 
@@ -35,16 +35,20 @@ pub struct LoadCardState {
 pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItState> {
     let n = LineNames::of(line);
     let (timeout1, timeout2) = (
-        format!("{}.TIMEOUT", n.ask_child1),
-        format!("{}.TIMEOUT", n.ask_child2),
+        ports.ask_child1.handler("TIMEOUT"),
+        ports.ask_child2.handler("TIMEOUT"),
     );
     let ports = ports.clone();
     let sim = sim.clone();
     let (load_card_name, screw_name) = (n.load_card.clone(), n.screw_in_card.clone());
     ModuleSpec::new(n.load_it.clone(), LoadItState::default())
-        .order([timeout1.clone(), timeout2.clone(), n.load_it.clone()])
-        .owns(n.ask_child1.clone())
-        .owns(n.ask_child2.clone())
+        .order([
+            timeout1.clone(),
+            timeout2.clone(),
+            n.load_it.as_str().into(),
+        ])
+        .owns(&ports.ask_child1)
+        .owns(&ports.ask_child2)
         .uses_named(n.frequency.clone(), UsageKind::Send)
         .task(n.load_it.clone(), move |ctx| {
             let (ports, sim, n) = (ports.clone(), sim.clone(), n.clone());
@@ -118,24 +122,20 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
     let n = LineNames::of(line);
     let spec = ModuleSpec::new(n.load_card.clone(), LoadCardState::default())
         .order([
-            format!("{}.TIMEOUT", n.pallet_in_place),
-            format!("{}.STATUS", n.ask_child1),
-            n.load_card.clone(),
+            ports.pallet_in_place.handler("TIMEOUT"),
+            ports.ask_child1.handler("STATUS"),
+            n.load_card.as_str().into(),
         ])
         .hardware([
             format!("load robot of line {line:?}"),
             "load station freeze relay".into(),
         ])
-        .owns(n.pallet_in_place.clone())
-        .owns(n.card_in_place.clone())
-        .uses_named(n.ask_child1.clone(), UsageKind::Response);
-    // WHEN ASK_CHILD1.STATUS(RC1, NUM1, CYCLE1) ==> RC1 := 0; NUM1 := NUM_LOADED; ...
-    let status = ports
-        .ask_child1
-        .responder_named(n.load_card.clone(), |card: &LoadCardState, ()| {
+        .owns(&ports.pallet_in_place)
+        .owns(&ports.card_in_place)
+        // WHEN ASK_CHILD1.STATUS(RC1, NUM1, CYCLE1) ==> RC1 := 0; NUM1 := NUM_LOADED; ...
+        .respond(&ports.ask_child1, "STATUS", |card: &LoadCardState, ()| {
             (0, card.num_loaded, card.cycle_time)
         });
-    let spec = with_response(spec, format!("{}.STATUS", n.ask_child1), status);
     let (pallet_port, card_port) = (ports.pallet_in_place.clone(), ports.card_in_place.clone());
     let robot = sim.robot(RobotId::new(line, Role::LoadCard));
     let freeze_port = ports.pallet_in_place.clone();
@@ -205,13 +205,13 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
         }
     })
     .exception(
-        format!("{}.TIMEOUT", n.pallet_in_place),
+        ports.pallet_in_place.handler("TIMEOUT"),
         |ctx: Ctx<LoadCardState>, _| async move {
             ctx.alarm("no pallet at the load station for 30 s");
         },
     )
     .exception(
-        format!("{}.TIMEOUT", n.card_in_place),
+        ports.card_in_place.handler("TIMEOUT"),
         |ctx: Ctx<LoadCardState>, _| async move {
             ctx.alarm("SCREW_IN_CARD did not answer within 30 s");
         },
@@ -221,21 +221,17 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
 /// The SCREW_IN_CARD module of `line`: its robot screws each laid card to its pallet.
 pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()> {
     let n = LineNames::of(line);
-    let timeout = format!("{}.TIMEOUT", n.card_in_place);
+    let timeout = ports.card_in_place.handler("TIMEOUT");
     let spec = ModuleSpec::new(n.screw_in_card.clone(), ())
         .order([
             timeout.clone(),
-            format!("{}.STATUS", n.ask_child2),
-            n.screw_in_card.clone(),
+            ports.ask_child2.handler("STATUS"),
+            n.screw_in_card.as_str().into(),
         ])
         .hardware([format!("screw robot of line {line:?}")])
-        .uses_named(n.ask_child2.clone(), UsageKind::Response)
-        .uses_named(n.card_in_place.clone(), UsageKind::Receive);
-    // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
-    let status = ports
-        .ask_child2
-        .responder_named(n.screw_in_card.clone(), |_: &(), ()| 0);
-    let spec = with_response(spec, format!("{}.STATUS", n.ask_child2), status);
+        .uses(&ports.card_in_place)
+        // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
+        .respond(&ports.ask_child2, "STATUS", |_: &(), ()| 0);
     let port = ports.card_in_place.clone();
     let robot = sim.robot(RobotId::new(line, Role::ScrewInCard));
     let name = n.screw_in_card.clone();
