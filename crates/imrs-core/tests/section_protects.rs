@@ -39,6 +39,42 @@ fn responses_by_section(cell: &Cell, module: &str, task: &str) -> Vec<(Instant, 
     answered
 }
 
+/// Starts one module per time in `times`, named `ASK<time>`, that queries `port` then and
+/// hands the answer to `check`.
+fn start_askers<Rep: Send + 'static>(
+    cell: &Cell,
+    port: &Port<(), Rep, usage::Response, AnyUser, 8>,
+    times: &[u64],
+    check: fn(u64, Rep),
+) -> Vec<ModuleHandle> {
+    let mut askers = Vec::new();
+    for &asked in times {
+        let port = port.clone();
+        let asker = ModuleSpec::new(format!("ASK{asked}"), ()).task("ASK", move |ctx| {
+            let port = ctx.user(&port);
+            async move {
+                let mut port = port?;
+                ctx.delay(secs(asked)).await;
+                check(asked, ctx.query(&mut port, ()).await?);
+                Ok(())
+            }
+        });
+        askers.push(cell.start(asker).unwrap());
+    }
+    askers
+}
+
+fn all_finished(askers: &[ModuleHandle]) {
+    for asker in askers {
+        assert_eq!(
+            asker.outcome(),
+            Some(ModuleOutcome::Finished),
+            "{}",
+            asker.name()
+        );
+    }
+}
+
 #[test]
 fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_background() {
     paused_runtime().block_on(async {
@@ -78,30 +114,16 @@ fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_backg
             });
         cell.start(welder).unwrap();
 
-        let mut askers = Vec::new();
-        for asked in [3, 8, 22, 33, 40] {
-            let port = status.clone();
-            let asker = ModuleSpec::new(format!("ASK{asked}"), ()).task("ASK", move |ctx| {
-                let port = port.clone();
-                async move {
-                    let mut status = port.user_named(ctx.module().clone())?;
-                    ctx.delay(secs(asked)).await;
-                    let (started, finished) = ctx.query(&mut status, ()).await?;
-                    assert_eq!(started, finished, "asked at {asked} s: a half-done weld");
-                    Ok(())
-                }
-            });
-            askers.push(cell.start(asker).unwrap());
-        }
+        let askers = start_askers(
+            &cell,
+            &status,
+            &[3, 8, 22, 33, 40],
+            |asked, (started, finished)| {
+                assert_eq!(started, finished, "asked at {asked} s: a half-done weld");
+            },
+        );
         drive(&clock, at(60)).await;
-        for asker in &askers {
-            assert_eq!(
-                asker.outcome(),
-                Some(ModuleOutcome::Finished),
-                "{}",
-                asker.name()
-            );
-        }
+        all_finished(&askers);
         // Asked at 3 s and 33 s (background): at once. At 8 s, 22 s and 40 s (in WELD): when
         // the weld ends, at 15 s, 30 s and 45 s. Never inside WELD.
         let answered = responses_by_section(&cell, "WELDER_B", "WELDER_B");
@@ -153,29 +175,16 @@ fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_fre
             });
         cell.start(chip_it).unwrap();
 
-        let mut askers = Vec::new();
-        for asked in [5, 15, 25, 35, 45, 52] {
-            let port = share_feeder1.clone();
-            let asker = ModuleSpec::new(format!("ASK{asked}"), ()).task("ASK", move |ctx| {
-                let port = port.clone();
-                async move {
-                    let mut crit = port.user_named(ctx.module().clone())?;
-                    ctx.delay(secs(asked)).await;
-                    assert_eq!(ctx.query(&mut crit, ()).await?, 0);
-                    Ok(())
-                }
-            });
-            askers.push(cell.start(asker).unwrap());
-        }
+        let askers = start_askers(
+            &cell,
+            &share_feeder1,
+            &[5, 15, 25, 35, 45, 52],
+            |_, clear| {
+                assert_eq!(clear, 0);
+            },
+        );
         drive(&clock, at(59)).await;
-        for asker in &askers {
-            assert_eq!(
-                asker.outcome(),
-                Some(ModuleOutcome::Finished),
-                "{}",
-                asker.name()
-            );
-        }
+        all_finished(&askers);
         // Asked at 5 (background) and 15 (GRASP): at 20, when INSERT begins. At 25: at once.
         // At 35 and 45: at 50. At 52: at once.
         let answered = responses_by_section(&cell, "CHIP_IT", "CHIP_IT");
