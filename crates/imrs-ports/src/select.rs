@@ -130,23 +130,43 @@ impl<Out> Arms<Out> for () {
 }
 
 /// One arm: an alternative and what to make of its message.
-#[derive(Debug)]
-pub struct Arm<A, F> {
-    alternative: A,
+///
+/// The alternative's methods are taken as function pointers when the arm is added (where
+/// `B: Alternative` is checked), so that the `select`'s own type does not need the bound
+/// again: a misused alternative is reported once, at [`Select::or`], not again at `.await`.
+pub struct Arm<B, F, Out> {
+    alternative: B,
     then: F,
+    poll: fn(&mut B, &mut F, &mut Context<'_>) -> Poll<Out>,
+    priority: fn(&B) -> Option<Priority>,
+    closed: fn(&B) -> bool,
 }
 
-impl<Out, Rest, A, F> Arms<Out> for (Rest, Arm<A, F>)
+impl<B: fmt::Debug, F, Out> fmt::Debug for Arm<B, F, Out> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Arm")
+            .field("alternative", &self.alternative)
+            .finish_non_exhaustive()
+    }
+}
+
+fn poll_arm<B, F, Out>(alternative: &mut B, then: &mut F, cx: &mut Context<'_>) -> Poll<Out>
+where
+    B: Alternative,
+    F: FnMut(B::Output) -> Out,
+{
+    alternative.poll_ready(cx).map(then)
+}
+
+impl<Out, Rest, B, F> Arms<Out> for (Rest, Arm<B, F, Out>)
 where
     Rest: Arms<Out>,
-    A: Alternative,
-    F: FnMut(A::Output) -> Out,
 {
     const LEN: usize = Rest::LEN + 1;
 
     fn priority(&self, index: usize) -> Option<Priority> {
         if index == Rest::LEN {
-            self.1.alternative.priority()
+            (self.1.priority)(&self.1.alternative)
         } else {
             self.0.priority(index)
         }
@@ -155,7 +175,7 @@ where
     fn poll_arm(&mut self, index: usize, cx: &mut Context<'_>) -> Poll<Out> {
         if index == Rest::LEN {
             let arm = &mut self.1;
-            arm.alternative.poll_ready(cx).map(&mut arm.then)
+            (arm.poll)(&mut arm.alternative, &mut arm.then, cx)
         } else {
             self.0.poll_arm(index, cx)
         }
@@ -163,7 +183,7 @@ where
 
     fn is_closed(&self, index: usize) -> bool {
         if index == Rest::LEN {
-            self.1.alternative.is_closed()
+            (self.1.closed)(&self.1.alternative)
         } else {
             self.0.is_closed(index)
         }
@@ -188,13 +208,20 @@ pub fn select<Out>() -> Select<Out, ()> {
 impl<Out, A: Arms<Out>> Select<Out, A> {
     /// Adds an alternative, and what to make of its message. Among alternatives of equal
     /// priority, the one added first wins.
-    pub fn or<B, F>(self, alternative: B, then: F) -> Select<Out, (A, Arm<B, F>)>
+    pub fn or<B, F>(self, alternative: B, then: F) -> Select<Out, (A, Arm<B, F, Out>)>
     where
         B: Alternative,
         F: FnMut(B::Output) -> Out,
     {
+        let arm = Arm {
+            alternative,
+            then,
+            poll: poll_arm::<B, F, Out>,
+            priority: B::priority,
+            closed: B::is_closed,
+        };
         Select {
-            arms: (self.arms, Arm { alternative, then }),
+            arms: (self.arms, arm),
             _out: std::marker::PhantomData,
         }
     }

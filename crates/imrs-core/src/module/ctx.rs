@@ -5,13 +5,16 @@
 use std::collections::VecDeque;
 use std::fmt;
 use std::future::Future;
+use std::pin::Pin;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::task::{Context, Poll};
 use std::time::Duration;
 
+use imrs_ports::post::{Posting, QueryOutcome, SendOutcome};
 use imrs_ports::usage::{Plain, Queries, Receives, Sends, Usage};
 use imrs_ports::{
-    End, Instant, ModuleState, Name, Port, QueryError, ReceiveError, ReplyHandle, SendError,
+    End, Instant, ModuleState, Name, Port, QueryError, ReceiveError, Receiving, SendError,
     SharedClock, UserList, WireError,
 };
 use tracing::Instrument;
@@ -276,66 +279,55 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     }
 
     /// `SEND`: as [`End::send`], and a timeout raises `PORT.TIMEOUT` in this module.
-    pub async fn send<Req, Rep, U>(
-        &self,
-        end: &mut End<Req, Rep, U>,
+    pub fn send<'a, Req, Rep, U>(
+        &'a self,
+        end: &'a mut End<Req, Rep, U>,
         message: Req,
-    ) -> Result<Rep, SendError<Req>>
+    ) -> PortOp<'a, S, Posting<'a, Req, Rep, SendOutcome>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Sends,
     {
+        let waiting = self.wait_on(end.port(), end.peers());
         let port = end.port().clone();
-        let waiting = self.wait_on(&port, end.peers());
-        let result = end.send(message).await;
-        drop(waiting);
-        match &result {
-            Ok(_) => self.event(EventKind::Sent { port }),
-            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
-        }
-        result
+        PortOp::new(self, port, Some(waiting), end.send(message), |port| {
+            EventKind::Sent { port }
+        })
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
-    pub async fn receive<Req, Rep, U>(
-        &self,
-        end: &mut End<Req, Rep, U>,
-    ) -> Result<(Req, ReplyHandle<Rep>), ReceiveError>
+    pub fn receive<'a, Req, Rep, U>(
+        &'a self,
+        end: &'a mut End<Req, Rep, U>,
+    ) -> PortOp<'a, S, Receiving<'a, Req, Rep>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Receives,
     {
         let port = end.port().clone();
-        let result = end.receive().await;
-        match &result {
-            Ok(_) => self.event(EventKind::Received { port }),
-            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
-        }
-        result
+        PortOp::new(self, port, None, end.receive(), |port| {
+            EventKind::Received { port }
+        })
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
-    pub async fn query<Req, Rep, U>(
-        &self,
-        end: &mut End<Req, Rep, U>,
+    pub fn query<'a, Req, Rep, U>(
+        &'a self,
+        end: &'a mut End<Req, Rep, U>,
         query: Req,
-    ) -> Result<Rep, QueryError<Req>>
+    ) -> PortOp<'a, S, Posting<'a, Req, Rep, QueryOutcome>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Queries,
     {
+        let waiting = self.wait_on(end.port(), end.peers());
         let port = end.port().clone();
-        let waiting = self.wait_on(&port, end.peers());
-        let result = end.query(query).await;
-        drop(waiting);
-        match &result {
-            Ok(_) => self.event(EventKind::Queried { port }),
-            Err(error) => self.port_failed(port, error.to_string(), error.is_timeout()),
-        }
-        result
+        PortOp::new(self, port, Some(waiting), end.query(query), |port| {
+            EventKind::Queried { port }
+        })
     }
 
     /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
@@ -540,5 +532,96 @@ struct WaitGuard {
 impl Drop for WaitGuard {
     fn drop(&mut self) {
         self.cell.waits().end(&self.module, self.id);
+    }
+}
+
+/// Errors of port operations that can time out.
+pub trait PortFailure: fmt::Display {
+    /// Whether the port's timeout ran out (the seed's `PORT.TIMEOUT`).
+    fn is_timeout(&self) -> bool;
+}
+
+impl<T> PortFailure for SendError<T> {
+    fn is_timeout(&self) -> bool {
+        SendError::is_timeout(self)
+    }
+}
+
+impl<T> PortFailure for QueryError<T> {
+    fn is_timeout(&self) -> bool {
+        QueryError::is_timeout(self)
+    }
+}
+
+impl PortFailure for ReceiveError {
+    fn is_timeout(&self) -> bool {
+        ReceiveError::is_timeout(self)
+    }
+}
+
+pin_project_lite::pin_project! {
+    /// A port operation of a task, [`Ctx::send`], [`Ctx::receive`] or [`Ctx::query`]: the
+    /// end's own future, and what the module logs when it ends (the event, the timeout
+    /// exception, the end of the wait in the deadlock graph).
+    ///
+    /// A named type rather than an `async fn`, so that its type does not carry the end's
+    /// usage: a misused end is reported once, where the operation is called.
+    #[must_use = "a port operation does nothing unless awaited"]
+    pub struct PortOp<'a, S, F> {
+        ctx: &'a Ctx<S>,
+        port: Option<Name>,
+        waiting: Option<WaitGuard>,
+        done: fn(Name) -> EventKind,
+        #[pin]
+        operation: F,
+    }
+}
+
+impl<'a, S, F> PortOp<'a, S, F> {
+    fn new(
+        ctx: &'a Ctx<S>,
+        port: Name,
+        waiting: Option<WaitGuard>,
+        operation: F,
+        done: fn(Name) -> EventKind,
+    ) -> Self {
+        Self {
+            ctx,
+            port: Some(port),
+            waiting,
+            done,
+            operation,
+        }
+    }
+}
+
+impl<S, F, T, E> Future for PortOp<'_, S, F>
+where
+    S: Send + Sync + 'static,
+    F: Future<Output = Result<T, E>>,
+    E: PortFailure,
+{
+    type Output = F::Output;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<F::Output> {
+        let this = self.project();
+        let result = std::task::ready!(this.operation.poll(cx));
+        drop(this.waiting.take());
+        let port = this.port.take().expect("a port operation completes once");
+        match &result {
+            Ok(_) => this.ctx.event((this.done)(port)),
+            Err(error) => this
+                .ctx
+                .port_failed(port, error.to_string(), error.is_timeout()),
+        }
+        Poll::Ready(result)
+    }
+}
+
+impl<S, F> fmt::Debug for PortOp<'_, S, F> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("PortOp")
+            .field("port", &self.port)
+            .finish_non_exhaustive()
     }
 }
