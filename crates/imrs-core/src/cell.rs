@@ -427,8 +427,12 @@ fn supervisor<S: Send + Sync + 'static>(
 pub(crate) struct Children(Arc<Mutex<Vec<ModuleHandle>>>);
 
 impl Children {
+    /// Adds `child`, forgetting the children that have ended, so that a parent that
+    /// costarts children all its life keeps only the live ones.
     pub(crate) fn adopt(&self, child: &ModuleHandle) {
-        lock(&self.0).push(child.clone());
+        let mut children = lock(&self.0);
+        children.retain(|known| known.outcome().is_none());
+        children.push(child.clone());
     }
 
     /// Stops every child for good and waits until each has ended (and, in turn, its own

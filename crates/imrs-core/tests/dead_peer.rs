@@ -9,7 +9,7 @@ use std::future::Future;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use common::{at, paused_runtime, secs};
+use common::{at, multi_thread_runtime, paused_runtime, secs};
 
 use imrs_core::TaskError;
 use imrs_core::prelude::*;
@@ -259,11 +259,7 @@ fn a_receive_fails_when_every_sender_has_finished() {
 /// ends when its peer is gone. A guard fails the test instead of hanging it.
 #[test]
 fn on_real_time_no_wait_without_a_timeout_outlives_its_peer() {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap();
+    let runtime = multi_thread_runtime();
     runtime.block_on(async {
         let guarded = tokio::time::timeout(Duration::from_secs(60), async {
             let cell = Cell::new(Arc::new(RealClock::new()));

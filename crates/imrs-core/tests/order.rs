@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{at, paused_runtime, secs};
+use common::{CHIP_IT_ORDER, at, paused_runtime, secs};
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
@@ -17,16 +17,6 @@ fn events_of(cell: &Cell, module: &str) -> Vec<Event> {
         .filter(|event| event.module == module)
         .collect()
 }
-
-/// CHIP_IT's order, from the Appendix.
-const CHIP_IT_ORDER: [&str; 6] = [
-    "READY_TO_CHIP.TIMEOUT",
-    "SHARE_FEEDER.TIMEOUT",
-    "CHIP_IT",
-    "GRASP",
-    "SHARE_FEEDER1.CRIT_SECTION",
-    "INSERT",
-];
 
 #[test]
 fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_outrank_all() {

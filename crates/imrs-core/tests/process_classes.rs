@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{at, paused_runtime, secs};
+use common::{at, multi_thread_runtime, paused_runtime, secs};
 
 use std::sync::{Arc, Mutex};
 
@@ -164,11 +164,7 @@ fn loosely_coupled_two_robots_share_a_tool_through_a_monitor() {
 /// threads, and checks every status it gets back.
 #[test]
 fn tightly_coupled_a_parent_directs_its_child_through_a_tight_port() {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap();
+    let runtime = multi_thread_runtime();
     runtime.block_on(async {
         let cell = Cell::new(Arc::new(RealClock::new()));
         // DIRECT: owned by the child's parent ARM, USAGE=SEND, process type TIGHT.

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{at, paused_runtime, secs};
+use common::{CHIP_IT_ORDER, at, paused_runtime, secs};
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
@@ -144,14 +144,7 @@ fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_fre
             PortSpec::new("SHARE_FEEDER1", "CHIP_IT").clock(cell.clock().clone()),
         );
         let chip_it = ModuleSpec::new("CHIP_IT", ())
-            .order([
-                "READY_TO_CHIP.TIMEOUT",
-                "SHARE_FEEDER.TIMEOUT",
-                "CHIP_IT",
-                "GRASP",
-                "SHARE_FEEDER1.CRIT_SECTION",
-                "INSERT",
-            ])
+            .order(CHIP_IT_ORDER)
             .sections(["GRASP", "INSERT"])
             .owns("SHARE_FEEDER1")
             .response(

@@ -499,30 +499,29 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
 impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// One poll of the module: its threads, and the handlers their ranks admit.
     fn poll_threads(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
-        let this = self;
         let mut budget = TURN_BUDGET;
         loop {
-            let mut progress = this.admit();
+            let mut progress = self.admit();
             // Running handlers are kept in rank order, most urgent first.
             let mut index = 0;
-            while index < this.handlers.len() && budget > 0 {
+            while index < self.handlers.len() && budget > 0 {
                 budget -= 1;
-                if this.poll_handler(index, cx) {
+                if self.poll_handler(index, cx) {
                     progress = true;
                 } else {
                     index += 1;
                 }
-                progress |= this.admit();
+                progress |= self.admit();
             }
-            for index in 0..this.tasks.len() {
+            for index in 0..self.tasks.len() {
                 budget = budget.saturating_sub(1);
-                progress |= this.poll_task(index, cx);
-                progress |= this.admit();
+                progress |= self.poll_task(index, cx);
+                progress |= self.admit();
             }
-            if let Some(exit) = this.exit() {
+            if let Some(exit) = self.exit() {
                 return Poll::Ready(exit);
             }
-            if !progress && !this.park(cx) {
+            if !progress && !self.park(cx) {
                 return Poll::Pending;
             }
             if budget == 0 {

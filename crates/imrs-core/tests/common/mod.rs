@@ -23,3 +23,22 @@ pub fn paused_runtime() -> tokio::runtime::Runtime {
         .build()
         .unwrap()
 }
+
+/// A two-worker multi-thread runtime on the wall clock, for the tests that cross threads.
+pub fn multi_thread_runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+/// CHIP_IT's order, from the Appendix.
+pub const CHIP_IT_ORDER: [&str; 6] = [
+    "READY_TO_CHIP.TIMEOUT",
+    "SHARE_FEEDER.TIMEOUT",
+    "CHIP_IT",
+    "GRASP",
+    "SHARE_FEEDER1.CRIT_SECTION",
+    "INSERT",
+];
