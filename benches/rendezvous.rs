@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use imrs_benches::{Tail, benchmarking, current_thread};
 use imrs_core::Processor;
-use imrs_ports::{Port, PortSpec, ProcessType, usage};
+use imrs_ports::{Port, PortSpec, Priority, ProcessType, usage};
 use tokio::sync::{mpsc, oneshot};
 
 type Ask<const N: usize> = (Box<[u8; N]>, oneshot::Sender<u64>);
@@ -38,19 +38,42 @@ macro_rules! round_trips {
 
 /// imrs, both ends on one processor: the modules' own co-scheduling on one thread.
 fn imrs_same_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
+    imrs_on_processor::<N>(iters, tail, false)
+}
+
+/// As [`imrs_same_thread`], with the processor's message handler at work: both jobs and
+/// the port declare priorities, so every wake is lifted and every choice weighs urgency.
+fn imrs_same_thread_prioritized<const N: usize>(iters: u64) -> Duration {
+    imrs_on_processor::<N>(iters, None, true)
+}
+
+fn imrs_on_processor<const N: usize>(
+    iters: u64,
+    tail: Option<&mut Tail>,
+    prioritized: bool,
+) -> Duration {
     let keep = tail.is_some();
     let (timed, samples) = current_thread().block_on(async move {
         let processor = Processor::new("CPU1");
-        let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let (mut spec, mut server_priority, mut client_priority) = (
+            PortSpec::new("P", "SERVER"),
+            Priority::DEFAULT,
+            Priority::DEFAULT,
+        );
+        if prioritized {
+            spec = spec.priority(1);
+            (server_priority, client_priority) = (Priority::declared(3), Priority::declared(2));
+        }
+        let port = Port::<[u8; N], u64, usage::Receive>::declare(spec);
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
-        let serving = processor.spawn(async move {
+        let serving = processor.spawn_with_priority(server_priority, async move {
             for _ in 0..iters {
                 let (message, reply) = server.receive().await.unwrap();
                 reply.reply(u64::from(message[0]));
             }
         });
-        let sending = processor.spawn(async move {
+        let sending = processor.spawn_with_priority(client_priority, async move {
             let mut samples = Tail::with_capacity(if keep { iters as usize } else { 0 });
             let timed = round_trips!(
                 iters,
@@ -203,6 +226,9 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     let mut group = c.benchmark_group("rendezvous_same_thread");
     group.bench_function(BenchmarkId::new("imrs", size), |b| {
         b.iter_custom(|n| imrs_same_thread::<N>(n, None))
+    });
+    group.bench_function(BenchmarkId::new("imrs_prioritized", size), |b| {
+        b.iter_custom(imrs_same_thread_prioritized::<N>)
     });
     group.bench_function(BenchmarkId::new("imrs_two_tasks", size), |b| {
         b.iter_custom(|n| imrs_same_thread_tasks::<N>(n, None))

@@ -45,6 +45,12 @@ fn main() {
             "<= 0.25",
         ));
         rows.push((
+            format!("rendezvous_same_thread/imrs_prioritized/{size}"),
+            format!("rendezvous_same_thread/imrs/{size}"),
+            1.0,
+            "<= 1.1 (priorities on)",
+        ));
+        rows.push((
             format!("rendezvous_same_thread/imrs_two_tasks/{size}"),
             format!("rendezvous_same_thread/tokio_ask_current_thread/{size}"),
             1.0,

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example chip_cell -- [--hours H] [--seed S]
-//!     [--feeder arbiter|appendix] [--realtime] [--fault KIND[:WHICH]@TIME]...
+//!     [--feeder arbiter|appendix] [--realtime] [--tree] [--fault KIND[:WHICH]@TIME]...
 //! ```
 
 use std::process::ExitCode;
@@ -19,15 +19,22 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let report = match run(&config) {
-        Ok(record) => Report::of(&record),
+    let (report, tree) = match run(&config) {
+        Ok(record) => (
+            Report::of(&record),
+            config.show_tree.then(|| record.tree.to_string()),
+        ),
         Err(problems) => {
             eprintln!("{problems}");
             return ExitCode::FAILURE;
         }
     };
     let mut out = io::stdout().lock();
-    match print_all(&mut out, &config, &report) {
+    let printed = match tree {
+        Some(tree) => writeln!(out, "module tree (seed 000 §2):\n{tree}"),
+        None => Ok(()),
+    };
+    match printed.and_then(|()| print_all(&mut out, &config, &report)) {
         Ok(()) => {}
         // A reader that stopped reading (`| head`) is not a failure of the run.
         Err(error) if error.kind() == io::ErrorKind::BrokenPipe => {}

@@ -7,7 +7,7 @@ use crate::faults::CellFault;
 use crate::run::{CellConfig, MAX_HOURS};
 
 /// The example's usage line.
-pub const USAGE: &str = "usage: chip_cell [--hours H] [--seed S] [--feeder arbiter|appendix] [--realtime] \
+pub const USAGE: &str = "usage: chip_cell [--hours H] [--seed S] [--feeder arbiter|appendix] [--realtime] [--tree] \
                      [--fault KIND[:WHICH]@TIME]... (KIND: release, robot, feeder, jam)";
 
 /// Reads the example's flags into a [`CellConfig`]; a bad flag or value is an error that
@@ -58,6 +58,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Str
                 }
             }
             "--realtime" => config.realtime = true,
+            "--tree" => config.show_tree = true,
             "--fault" => config.faults.push(
                 value("--fault")?
                     .parse::<CellFault>()

@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::{CellErrors, Log, time::drive};
+use imrs_sim::imrs_core::{CellErrors, Log, ModuleTree, time::drive};
 use imrs_sim::{
     Fault, FaultKind, Line, PalletId, RobotId, Role, Sim, SimConfig, SimEvent, Station,
 };
@@ -33,6 +33,8 @@ pub struct CellConfig {
     pub faults: Vec<CellFault>,
     /// Show a progress bar on a terminal.
     pub progress: bool,
+    /// Print the module tree (seed 000 §2) before the report.
+    pub show_tree: bool,
     /// How many of the most recent events each log keeps in memory for the record (the
     /// report is folded from every event as it comes, whatever this is).
     pub kept_events: usize,
@@ -47,6 +49,7 @@ impl Default for CellConfig {
             realtime: false,
             faults: Vec::new(),
             progress: false,
+            show_tree: false,
             kept_events: Log::<Event>::DEFAULT_CAPACITY,
         }
     }
@@ -68,6 +71,8 @@ pub struct RunRecord {
     pub pallets_left: Vec<(Line, PalletId, [f32; 3])>,
     /// The chip robots' waits for the zone.
     pub waits: [ZoneWaits; 2],
+    /// The module tree at the end of the run, with its vertical and horizontal links.
+    pub tree: ModuleTree,
     /// Simulated time.
     pub simulated: Duration,
     /// Wall time the run took.
@@ -238,6 +243,7 @@ async fn simulate(
         cell_events: cell.events().snapshot(),
         pallets_left: sim.pallets(),
         waits,
+        tree: cell.tree(),
         simulated: total,
         wall: Duration::ZERO,
     })

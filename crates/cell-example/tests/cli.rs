@@ -88,3 +88,25 @@ fn the_example_refuses_a_non_utf8_argument_with_status_2() {
     assert_eq!(output.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("is not valid UTF-8"), "{stderr}");
 }
+
+#[test]
+fn the_example_draws_the_appendix_module_tree() {
+    let output = Command::new(chip_cell())
+        .args(["--hours", "0.01", "--tree"])
+        .output()
+        .expect("the example is built with the tests");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(0), "{stdout}");
+    // LOAD_IT costarts its two children and asks each down the tree; the children hand the
+    // card to each other across it, and the chip robots share the feeder across lines.
+    for line in [
+        "├─ LOAD_IT  [2 vertical, 0 horizontal]",
+        "│  ├─ LOAD_CARD  [1 vertical, 1 horizontal]",
+        "│  └─ SCREW_IN_CARD  [1 vertical, 1 horizontal]",
+        "ASK_CHILD1       LOAD_IT <- LOAD_CARD  vertical",
+        "CARD_IN_PLACE    LOAD_CARD <- SCREW_IN_CARD  horizontal",
+        "SHARE_FEEDER     CHIP_IT <- CHIP_IT2  horizontal",
+    ] {
+        assert!(stdout.contains(line), "{line:?} in\n{stdout}");
+    }
+}

@@ -19,19 +19,32 @@ use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
 use crate::module::spec::{ModuleDecl, ModuleSpec};
 use crate::processor::Processor;
 use crate::supervision::RestartPolicy;
+use crate::tree::{ModuleTree, Placement};
 
 pub(crate) struct CellShared {
     pub(crate) clock: SharedClock,
     pub(crate) events: EventLog,
     waits: Mutex<WaitGraph>,
     wiring: Mutex<Wiring>,
-    modules: Mutex<BTreeMap<Name, Arc<KillSwitch>>>,
+    modules: Mutex<BTreeMap<Name, Member>>,
+}
+
+/// A running module: its switch, and where it sits in the tree.
+struct Member {
+    switch: Arc<KillSwitch>,
+    placement: Placement,
 }
 
 impl CellShared {
     pub(crate) fn kill(&self, module: &str) -> bool {
-        let switch = lock(&self.modules).get(&Name::from(module)).cloned();
+        let switch = self.switch(module);
         switch.inspect(|switch| switch.kill()).is_some()
+    }
+
+    fn switch(&self, module: &str) -> Option<Arc<KillSwitch>> {
+        lock(&self.modules)
+            .get(&Name::from(module))
+            .map(|member| Arc::clone(&member.switch))
     }
 
     pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
@@ -217,10 +230,17 @@ impl Cell {
         let Some(processor) = processor else {
             return spawn_module(Arc::clone(&self.shared), None, policy, first, factory);
         };
-        let (handle, supervisor) =
-            supervisor(Arc::clone(&self.shared), None, policy, first, factory)?;
+        // Every copy runs in this one supervisor job: the first copy's priority is the job's.
+        let priority = first.priority;
+        let (handle, supervisor) = supervisor(
+            Arc::clone(&self.shared),
+            (None, Some(processor.name().clone())),
+            policy,
+            first,
+            factory,
+        )?;
         // The module handle reports how the module ends: no job handle is needed.
-        processor.place(supervisor);
+        processor.place(priority, supervisor);
         Ok(handle)
     }
 
@@ -232,8 +252,16 @@ impl Cell {
 
     /// Stops `module` for good. Returns whether a module of that name runs.
     pub fn stop(&self, module: &str) -> bool {
-        let switch = lock(&self.shared.modules).get(&Name::from(module)).cloned();
+        let switch = self.shared.switch(module);
         switch.inspect(|switch| switch.stop()).is_some()
+    }
+
+    /// The module tree as it stands: every running module under the one that costarted it,
+    /// and every port between two running modules as a vertical or horizontal link (seed
+    /// 000 §2). `Display` draws it; `println!("{}", cell.tree())`.
+    pub fn tree(&self) -> ModuleTree {
+        let modules = lock(&self.shared.modules);
+        ModuleTree::of(modules.values().map(|member| &member.placement))
     }
 }
 
@@ -309,7 +337,7 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
     first: ModuleSpec<S>,
     factory: Option<Factory<S>>,
 ) -> Result<ModuleHandle, CellError> {
-    let (handle, supervisor) = supervisor(cell, parent, policy, first, factory)?;
+    let (handle, supervisor) = supervisor(cell, (parent, None), policy, first, factory)?;
     tokio::spawn(supervisor);
     Ok(handle)
 }
@@ -320,7 +348,7 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
 /// the copy of its parent that started it.
 fn supervisor<S: Send + Sync + 'static>(
     cell: Arc<CellShared>,
-    parent: Option<Name>,
+    (parent, processor): (Option<Name>, Option<Name>),
     policy: RestartPolicy,
     first: ModuleSpec<S>,
     mut factory: Option<Factory<S>>,
@@ -332,7 +360,10 @@ fn supervisor<S: Send + Sync + 'static>(
     let kill = Arc::new(KillSwitch::default());
     match lock(&cell.modules).entry(name.clone()) {
         Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }),
-        Entry::Vacant(vacant) => vacant.insert(Arc::clone(&kill)),
+        Entry::Vacant(vacant) => vacant.insert(Member {
+            switch: Arc::clone(&kill),
+            placement: first.placement(parent.clone(), processor),
+        }),
     };
     let presence = Presence::new(name.clone());
     let (report, done) = watch::channel(None);

@@ -125,6 +125,7 @@ mod order;
 mod processor;
 mod supervision;
 pub mod time;
+mod tree;
 mod waitfor;
 mod work;
 
@@ -139,6 +140,7 @@ pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult}
 pub use order::{Order, Rank};
 pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;
+pub use tree::{Link, LinkKind, ModuleTree, TreeModule};
 pub use waitfor::{DuplicateMember, Pool, WaitFor, WaitForError};
 pub use work::{Performed, WorkSchedule};
 

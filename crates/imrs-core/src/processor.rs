@@ -14,11 +14,11 @@ use std::fmt;
 use std::future::Future;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::pin::Pin;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::task::{Context, Poll, Wake, Waker};
 
-use imrs_ports::Name;
+use imrs_ports::{Name, Priority, urgency};
 use tokio::sync::{Notify, oneshot};
 
 type Job = Pin<Box<dyn Future<Output = ()> + Send>>;
@@ -28,6 +28,30 @@ type Job = Pin<Box<dyn Future<Output = ()> + Send>>;
 const TURN_BUDGET: usize = 256;
 
 /// A handle to a processor: modules and futures placed on it share one tokio task.
+///
+/// # The message handler
+///
+/// Seed 000 §5.1 gives each processor a message handler that resumes "the most urgent thread
+/// of control", judged by task, message and channel priorities. A processor's rule is:
+///
+/// > Of its woken jobs, a processor polls next the most urgent. A job's urgency is its own
+/// > priority, lifted, for its next poll only, to the priority of the port whose message
+/// > (request or reply) woke it, if that is higher. Equals go in the order they were placed.
+/// > A job that has waited [`AGING`](Processor::AGING) polls of others goes first, oldest first.
+///
+/// Priorities are [`Priority`] values, as ports have: 1 is the most urgent, and a job or
+/// port that declares none ranks below every declared one. A module's priority is
+/// [`ModuleSpec::priority`](crate::ModuleSpec::priority); a plain future's, the one given
+/// to [`Processor::spawn_with_priority`]. So a routine module can get an emergency stop
+/// through to a safety module of low priority ahead of a busy module of higher priority, if
+/// the stop travels on a port of higher priority than that module (the seed's "crucial
+/// emergency message through a high priority port").
+///
+/// The processor is cooperative: the choice is made at each suspension point of the job
+/// that runs, never in the middle of a poll. No woken job starves: it is polled after at
+/// most `AGING + n - 1` polls of the others, `n` the number of jobs on the processor.
+/// The choice depends only on wakes and priorities, so a run on virtual time is
+/// reproducible.
 ///
 /// The processor's task ends once every handle is dropped and every job on it has finished.
 #[derive(Clone)]
@@ -46,7 +70,7 @@ struct Shared {
     /// woken job's flag, because the loop looks at every flag again before it parks.
     polling: AtomicBool,
     /// Jobs placed on the processor and not yet picked up by its task.
-    arrivals: Mutex<Vec<Job>>,
+    arrivals: Mutex<Vec<(Priority, Job)>>,
     arrived: AtomicBool,
     closed: AtomicBool,
     /// Wakes the processor's task.
@@ -64,7 +88,25 @@ impl Shared {
 /// The waker of one job: a flag, and the processor's task if it is parked.
 struct JobWake {
     ready: AtomicBool,
+    /// The most urgent port priority among the wakes since the job was last polled,
+    /// encoded by [`encode`]; 0 when none.
+    lift: AtomicU64,
     shared: Arc<Shared>,
+}
+
+/// A priority as a number that grows with urgency, 0 for [`Priority::DEFAULT`].
+fn encode(priority: Priority) -> u64 {
+    priority
+        .number()
+        .map_or(0, |n| u64::from(u32::MAX) + 1 - u64::from(n))
+}
+
+fn decode(lift: u64) -> Priority {
+    match lift {
+        0 => Priority::DEFAULT,
+        // Inverse of `encode`: 1 ..= 2^32 maps back onto u32::MAX ..= 0.
+        n => Priority::declared(u32::try_from(u64::from(u32::MAX) + 1 - n).unwrap_or(0)),
+    }
 }
 
 impl Wake for JobWake {
@@ -73,6 +115,12 @@ impl Wake for JobWake {
     }
 
     fn wake_by_ref(self: &Arc<Self>) {
+        let lift = urgency::waking();
+        if lift != Priority::DEFAULT {
+            // Published by the store of `ready` below, which the turn takes before it
+            // reads the lift.
+            self.lift.fetch_max(encode(lift), Ordering::Relaxed);
+        }
         if RUNNING.get() == Arc::as_ptr(&self.shared) {
             // A job of the processor whose turn this thread is running woke another (the
             // common case: one end of a rendezvous wakes the other). The turn reads the flag
@@ -116,9 +164,30 @@ struct Slot {
     job: Job,
     wake: Arc<JobWake>,
     waker: Waker,
+    /// The job's own priority.
+    priority: Priority,
+    /// Woken and not yet polled since. Kept here, not in the wake's flag, so that the turn
+    /// notes when it became ready.
+    ready: bool,
+    /// The poll count of the processor when the job was noted ready.
+    ready_since: u64,
+    /// Its own priority, lifted by the ports whose messages woke it.
+    urgency: Priority,
+}
+
+/// The jobs of a processor, as its task keeps them.
+#[derive(Default)]
+struct Jobs {
+    slots: Vec<Slot>,
+    /// Polls made so far: the processor's measure of waiting.
+    polls: u64,
 }
 
 impl Processor {
+    /// How many polls of other jobs a woken job may wait before it goes first, whatever its
+    /// priority: the bound on starvation.
+    pub const AGING: u64 = 64;
+
     /// A new processor named `name`, its task spawned on the current tokio runtime.
     ///
     /// # Panics
@@ -153,8 +222,18 @@ impl Processor {
         F: Future + Send + 'static,
         F::Output: Send + 'static,
     {
+        self.spawn_with_priority(Priority::DEFAULT, future)
+    }
+
+    /// [`Processor::spawn`], with a priority: among woken jobs, the processor polls the
+    /// most urgent first (see [the message handler](Processor#the-message-handler)).
+    pub fn spawn_with_priority<F>(&self, priority: Priority, future: F) -> JobHandle<F::Output>
+    where
+        F: Future + Send + 'static,
+        F::Output: Send + 'static,
+    {
         let (output, handle) = oneshot::channel();
-        self.place(async move {
+        self.place(priority, async move {
             // The handle may be gone: then nobody wants the output.
             let _ = output.send(future.await);
         });
@@ -165,13 +244,13 @@ impl Processor {
     }
 
     /// Puts `job` on the processor's list and wakes its task.
-    pub(crate) fn place(&self, job: impl Future<Output = ()> + Send + 'static) {
+    pub(crate) fn place(&self, priority: Priority, job: impl Future<Output = ()> + Send + 'static) {
         let shared = &self.owner.shared;
         shared
             .arrivals
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
-            .push(Box::pin(job));
+            .push((priority, Box::pin(job)));
         shared.arrived.store(true, Ordering::SeqCst);
         shared.wake_task();
     }
@@ -237,9 +316,9 @@ impl fmt::Debug for Processor {
     }
 }
 
-/// The processor's task: polls each woken job in turn until none is woken, then parks.
+/// The processor's task: polls the most urgent woken job until none is woken, then parks.
 async fn run(shared: Arc<Shared>) {
-    let mut slots: Vec<Slot> = Vec::new();
+    let mut jobs = Jobs::default();
     loop {
         let notified = shared.task.notified();
         tokio::pin!(notified);
@@ -247,7 +326,7 @@ async fn run(shared: Arc<Shared>) {
         // is not lost.
         notified.as_mut().enable();
         shared.polling.store(true, Ordering::SeqCst);
-        match turn(&shared, &mut slots) {
+        match turn(&shared, &mut jobs) {
             Turn::Busy => tokio::task::yield_now().await,
             Turn::Idle => notified.await,
             Turn::Done => return,
@@ -264,66 +343,131 @@ enum Turn {
     Done,
 }
 
-/// Polls woken jobs until none is woken, the budget is spent, or the processor is done.
-fn turn(shared: &Arc<Shared>, slots: &mut Vec<Slot>) -> Turn {
+impl Jobs {
+    /// Takes in the jobs placed since the last look.
+    fn admit(&mut self, shared: &Arc<Shared>) {
+        let arrivals = std::mem::take(
+            &mut *shared
+                .arrivals
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner),
+        );
+        let polls = self.polls;
+        self.slots
+            .extend(arrivals.into_iter().map(|(priority, job)| {
+                let wake = Arc::new(JobWake {
+                    ready: AtomicBool::new(false),
+                    lift: AtomicU64::new(0),
+                    shared: Arc::clone(shared),
+                });
+                let waker = Waker::from(Arc::clone(&wake));
+                Slot {
+                    job,
+                    wake,
+                    waker,
+                    priority,
+                    ready: true,
+                    ready_since: polls,
+                    urgency: priority,
+                }
+            }));
+    }
+
+    /// Notes the jobs woken since the last look, with the lifts their wakes carried.
+    fn note_wakes(&mut self) {
+        for slot in &mut self.slots {
+            if !take(&slot.wake.ready) {
+                continue;
+            }
+            if !slot.ready {
+                slot.ready = true;
+                slot.ready_since = self.polls;
+            }
+            if slot.wake.lift.load(Ordering::Relaxed) != 0 {
+                let lift = decode(slot.wake.lift.swap(0, Ordering::Relaxed));
+                slot.urgency = slot.urgency.max(lift);
+            }
+        }
+    }
+
+    /// The job to poll next, by [the rule](Processor#the-message-handler).
+    fn next(&self) -> Option<usize> {
+        let mut best: Option<(usize, &Slot)> = None;
+        for (index, slot) in self.slots.iter().enumerate() {
+            if !slot.ready {
+                continue;
+            }
+            let Some((_, chosen)) = best else {
+                best = Some((index, slot));
+                continue;
+            };
+            if self.goes_before(slot, chosen) {
+                best = Some((index, slot));
+            }
+        }
+        best.map(|(index, _)| index)
+    }
+
+    /// Whether `slot` goes before `chosen`, which comes earlier in placing order.
+    fn goes_before(&self, slot: &Slot, chosen: &Slot) -> bool {
+        let aged = |slot: &Slot| self.polls - slot.ready_since >= Processor::AGING;
+        match (aged(slot), aged(chosen)) {
+            (true, true) => slot.ready_since < chosen.ready_since,
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) => slot.urgency > chosen.urgency,
+        }
+    }
+
+    /// Polls the job at `index`; drops it if it finished or panicked.
+    fn poll(&mut self, index: usize) {
+        self.polls += 1;
+        let slot = &mut self.slots[index];
+        slot.ready = false;
+        slot.urgency = slot.priority;
+        let mut cx = Context::from_waker(&slot.waker);
+        match catch_unwind(AssertUnwindSafe(|| slot.job.as_mut().poll(&mut cx))) {
+            Ok(Poll::Pending) => {}
+            // Finished or panicked: either way it is done. `remove` keeps the others in the
+            // order they came, so that a run on virtual time is reproducible.
+            Ok(Poll::Ready(())) | Err(_) => {
+                self.slots.remove(index);
+            }
+        }
+    }
+}
+
+/// Polls woken jobs, most urgent first, until none is woken, the budget is spent, or the
+/// processor is done.
+fn turn(shared: &Arc<Shared>, jobs: &mut Jobs) -> Turn {
     let _running = Running::enter(shared);
     let mut budget = TURN_BUDGET;
     loop {
         if take(&shared.arrived) {
-            let arrivals = std::mem::take(
-                &mut *shared
-                    .arrivals
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner),
-            );
-            slots.extend(arrivals.into_iter().map(|job| {
-                let wake = Arc::new(JobWake {
-                    ready: AtomicBool::new(true),
-                    shared: Arc::clone(shared),
-                });
-                let waker = Waker::from(Arc::clone(&wake));
-                Slot { job, wake, waker }
-            }));
+            jobs.admit(shared);
         }
-        let mut polled = false;
-        let mut index = 0;
-        while index < slots.len() {
-            let slot = &mut slots[index];
-            if !take(&slot.wake.ready) {
-                index += 1;
-                continue;
-            }
+        jobs.note_wakes();
+        if let Some(index) = jobs.next() {
             if budget == 0 {
-                // Leave the flag set for the next turn.
-                slot.wake.ready.store(true, Ordering::SeqCst);
+                // The job stays noted ready for the next turn.
                 shared.polling.store(false, Ordering::SeqCst);
                 return Turn::Busy;
             }
             budget -= 1;
-            polled = true;
-            let mut cx = Context::from_waker(&slot.waker);
-            match catch_unwind(AssertUnwindSafe(|| slot.job.as_mut().poll(&mut cx))) {
-                Ok(Poll::Pending) => index += 1,
-                // Finished or panicked: either way it is done. `remove` keeps the others in
-                // the order they came, so that a run on virtual time is reproducible.
-                Ok(Poll::Ready(())) | Err(_) => {
-                    slots.remove(index);
-                }
-            }
-        }
-        if polled {
+            jobs.poll(index);
             continue;
         }
         shared.polling.store(false, Ordering::SeqCst);
         let woken = shared.arrived.load(Ordering::SeqCst)
-            || slots
+            || jobs
+                .slots
                 .iter()
                 .any(|slot| slot.wake.ready.load(Ordering::SeqCst));
         if woken {
             shared.polling.store(true, Ordering::SeqCst);
             continue;
         }
-        if slots.is_empty() && shared.closed.load(Ordering::SeqCst) {
+        if jobs.slots.is_empty() && shared.closed.load(Ordering::SeqCst) {
             return Turn::Done;
         }
         return Turn::Idle;

@@ -126,3 +126,117 @@ fn killing_a_parent_stops_its_children() {
         assert!(child_end.is_some(), "the child's end is in the log");
     });
 }
+
+/// A module that holds its ends and idles: owner of `owns`, user of `uses`.
+fn idle(
+    name: &str,
+    owns: Option<&Port<(), (), usage::Receive>>,
+    uses: Option<&Port<(), (), usage::Receive>>,
+) -> ModuleSpec<()> {
+    let mut spec = ModuleSpec::new(name, ());
+    if let Some(port) = owns {
+        spec = spec.owns(port);
+    }
+    if let Some(port) = uses {
+        spec = spec.uses(port);
+    }
+    spec.task(name, |ctx| async move {
+        loop {
+            ctx.delay(secs(1)).await;
+        }
+    })
+}
+
+#[test]
+fn the_cell_draws_its_tree_with_vertical_and_horizontal_links() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let declare = |port: &str, owner: &str| {
+            Port::<(), (), usage::Receive>::declare(
+                PortSpec::new(port, owner).clock(cell.clock().clone()),
+            )
+        };
+        // LOADER costarts two cards; each card asks LOADER (vertical), CARD2 asks CARD1, its
+        // sibling (horizontal), and GATE, another branch, asks CARD2 (horizontal).
+        let load = declare("LOAD", "LOADER");
+        let load2 = declare("LOAD2", "LOADER");
+        let share = declare("SHARE", "CARD1");
+        let pass = declare("PASS", "CARD2");
+        let (card1, card2) = (
+            idle("CARD1", Some(&share), Some(&load)),
+            idle("CARD2", Some(&pass), Some(&share)).uses(&load2),
+        );
+        let children = Arc::new(Mutex::new(Some((card1, card2))));
+        let loader =
+            ModuleSpec::new("LOADER", ())
+                .owns(&load)
+                .owns(&load2)
+                .task("LOADER", move |ctx| {
+                    let children = Arc::clone(&children);
+                    async move {
+                        let (card1, card2) =
+                            children.lock().unwrap().take().ok_or("started twice")?;
+                        ctx.costart(card1)?;
+                        ctx.costart(card2)?;
+                        loop {
+                            ctx.delay(secs(1)).await;
+                        }
+                    }
+                });
+        let processor = Processor::new("CPU1");
+        cell.start_on(&processor, loader.priority(2)).unwrap();
+        cell.start(idle("GATE", None, Some(&pass))).unwrap();
+        drive(&clock, at(1)).await;
+
+        let tree = cell.tree();
+        let kind_of = |port: &str| {
+            tree.links
+                .iter()
+                .filter(|link| link.port.as_str() == port)
+                .map(|link| (link.owner.to_string(), link.user.to_string(), link.kind))
+                .collect::<Vec<_>>()
+        };
+        use imrs_core::LinkKind::{Horizontal, Vertical};
+        assert_eq!(
+            kind_of("LOAD"),
+            [("LOADER".into(), "CARD1".into(), Vertical)]
+        );
+        assert_eq!(
+            kind_of("LOAD2"),
+            [("LOADER".into(), "CARD2".into(), Vertical)]
+        );
+        assert_eq!(
+            kind_of("SHARE"),
+            [("CARD1".into(), "CARD2".into(), Horizontal)]
+        );
+        assert_eq!(
+            kind_of("PASS"),
+            [("CARD2".into(), "GATE".into(), Horizontal)]
+        );
+        let loader = tree.module("LOADER").unwrap();
+        assert_eq!(loader.processor.as_ref().map(Name::as_str), Some("CPU1"));
+        assert_eq!(loader.priority.number(), Some(2));
+
+        let drawn = tree.to_string();
+        let expected = [
+            "cell",
+            "├─ GATE  [0 vertical, 1 horizontal]",
+            "└─ LOADER  [2 vertical, 0 horizontal, priority 2, on CPU1]",
+            "   ├─ CARD1  [1 vertical, 1 horizontal]",
+            "   └─ CARD2  [1 vertical, 2 horizontal]",
+            "links (owner <- user):",
+            "  LOAD   LOADER <- CARD1  vertical",
+            "  LOAD2  LOADER <- CARD2  vertical",
+            "  PASS   CARD2 <- GATE  horizontal",
+            "  SHARE  CARD1 <- CARD2  horizontal",
+        ];
+        assert_eq!(drawn.lines().collect::<Vec<_>>(), expected, "{drawn}");
+
+        // A module that ends leaves the tree, and its links go with it.
+        cell.stop("GATE");
+        drive(&clock, at(2)).await;
+        let tree = cell.tree();
+        assert!(tree.module("GATE").is_none());
+        assert!(tree.links.iter().all(|link| link.user.as_str() != "GATE"));
+    });
+}

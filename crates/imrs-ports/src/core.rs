@@ -12,6 +12,7 @@ use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
 use crate::slot::Slot;
+use crate::urgency::wake_at;
 
 /// Who holds, or last held, one side of a port: the module, and its presence when the end
 /// was attached inside a module.
@@ -161,11 +162,12 @@ impl<Req, Rep> Core<Req, Rep> {
     }
 
     /// Tells whoever serves the posts of `poster` that something arrived.
+    /// The wake is lifted to the port's priority (see [`crate::urgency`]).
     pub(crate) fn wake_servers_of(&self, poster: SlotId) {
-        match poster {
+        wake_at(self.meta.priority, || match poster {
             SlotId::User(_) => self.owner_waker.wake(),
             SlotId::Owner => self.users.iter().for_each(|user| user.waker.wake()),
-        }
+        });
     }
 
     pub(crate) fn attach_owner(&self) -> bool {

@@ -64,6 +64,7 @@ mod receive;
 mod response;
 pub mod select;
 mod slot;
+pub mod urgency;
 pub mod usage;
 mod user_list;
 mod wiring;

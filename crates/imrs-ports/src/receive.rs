@@ -13,6 +13,7 @@ use crate::clock::{Sleep, deadline_passed};
 use crate::core::{Core, SlotId};
 use crate::error::ReceiveError;
 use crate::meta::Name;
+use crate::urgency::wake_at;
 
 pin_project! {
     /// The future of [`End::receive`](crate::End::receive).
@@ -97,9 +98,13 @@ trait ReplyTarget<Rep>: Send + Sync {
 
 impl<Req: Send, Rep: Send> ReplyTarget<Rep> for Core<Req, Rep> {
     fn reply(&self, to: SlotId, reply: Rep) {
-        // SAFETY: a reply handle exists only for a request taken from slot `to`, and it is
-        // consumed by its first answer, so this is the one answer of the server that took it.
-        unsafe { self.slot(to).reply(reply) }
+        // A reply is a message too: its wake is lifted to the port's priority.
+        wake_at(self.meta.priority, || {
+            // SAFETY: a reply handle exists only for a request taken from slot `to`, and it
+            // is consumed by its first answer, so this is the one answer of the server that
+            // took it.
+            unsafe { self.slot(to).reply(reply) }
+        })
     }
 
     fn unreplied(&self, to: SlotId) {

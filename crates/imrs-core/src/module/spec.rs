@@ -8,11 +8,12 @@ use std::pin::Pin;
 use std::sync::Arc;
 
 use imrs_ports::usage::{Answers, Usage};
-use imrs_ports::{ModuleState, Name, Port, Respond, UsageKind, UserList, WireError};
+use imrs_ports::{ModuleState, Name, Port, Priority, Respond, UsageKind, UserList, WireError};
 
 use super::ctx::Ctx;
 use crate::exception::Exception;
 use crate::supervision::RestartPolicy;
+use crate::tree::{Placement, TreeModule};
 
 /// What a task may fail with: any error, so that `?` works on port errors.
 pub type TaskError = Box<dyn std::error::Error + Send + Sync>;
@@ -48,6 +49,8 @@ pub struct ModuleSpec<S> {
     pub(crate) responses: Vec<(Name, Box<dyn Respond<S> + Send>)>,
     pub(crate) exceptions: Vec<(Name, ExceptionHandler<S>)>,
     pub(crate) raises: Vec<Name>,
+    /// The module's priority on the processor it is placed on.
+    pub(crate) priority: Priority,
     /// Ends that could not be attached while the module was declared: reported by the
     /// wiring check, and a module that has any is refused at start.
     pub(crate) problems: Vec<WireError>,
@@ -69,6 +72,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
             responses: Vec::new(),
             exceptions: Vec::new(),
             raises: Vec::new(),
+            priority: Priority::DEFAULT,
             problems: Vec::new(),
         }
     }
@@ -95,6 +99,18 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         N: Into<Name>,
     {
         self.sections.extend(names.into_iter().map(Into::into));
+        self
+    }
+
+    /// The module's priority on its [`Processor`](crate::Processor): among the woken
+    /// modules there, the most urgent is polled first, as the processor's
+    /// [message handler](crate::Processor#the-message-handler) rule says. 1 is the most
+    /// urgent; a module that declares none ranks below every declared one. A module started
+    /// as a task of its own ([`Cell::start`](crate::Cell::start)) is scheduled by tokio,
+    /// which has no priorities: there the number only appears in the
+    /// [module tree](crate::Cell::tree).
+    pub fn priority(mut self, n: u32) -> Self {
+        self.priority = Priority::declared(n);
         self
     }
 
@@ -242,6 +258,28 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
     {
         self.raises.extend(exceptions.into_iter().map(Into::into));
         self
+    }
+
+    /// Where the module sits in the cell's tree, for [`Cell::tree`](crate::Cell::tree).
+    pub(crate) fn placement(&self, parent: Option<Name>, processor: Option<Name>) -> Placement {
+        // A response handler answers on an end the module owns or uses, so the port is
+        // already among `owns` or `uses`.
+        let filtered = self.filters.iter().map(|(port, _)| port.clone());
+        Placement {
+            module: TreeModule {
+                name: self.name.clone(),
+                parent,
+                priority: self.priority,
+                processor,
+            },
+            owns: self.owns.clone(),
+            uses: self
+                .uses
+                .iter()
+                .map(|(port, _)| port.clone())
+                .chain(filtered)
+                .collect(),
+        }
     }
 
     /// What the wiring check needs to know of this module.
