@@ -1,11 +1,12 @@
 //! Same-thread round trips in a loop, for a profiler (`valgrind --tool=callgrind`), so that
 //! the ratio table's figures can be traced to where the time goes. Both ends run on one
 //! processor, as in `rendezvous_same_thread/imrs`; with `query`, the round trips are
-//! queries into a response handler of an idle module, as in `query/responder_idle`.
+//! queries into a response handler of an idle module, as in `query/responder_idle`; with `ctx`, two modules
+//! talking through `ctx.send` and `ctx.receive`, as in `ctx_same_thread/ctx`.
 //!
 //! ```text
 //! cargo build --release -p imrs-benches --bin profile_rendezvous
-//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query]
+//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query|ctx]
 //! ```
 
 use std::hint::black_box;
@@ -19,8 +20,11 @@ fn main() {
         .nth(1)
         .and_then(|n| n.parse().ok())
         .unwrap_or(100_000);
-    if std::env::args().nth(2).is_some_and(|mode| mode == "query") {
+    let mode = std::env::args().nth(2);
+    if mode.as_deref() == Some("query") {
         queries(round_trips);
+    } else if mode.as_deref() == Some("ctx") {
+        black_box(imrs_benches::ctx_on_processor(round_trips));
     } else {
         rendezvous(round_trips);
     }

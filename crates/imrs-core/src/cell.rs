@@ -446,6 +446,7 @@ fn supervisor<S: Send + Sync + 'static>(
             cell.record(&name, EventKind::ModuleRestarted { attempt });
         };
         lock(&cell.modules).remove(&name);
+        cell.waits().forget(&name);
         // Gone for good: whoever waits on a port the module held fails now (PeerGone).
         presence.set_gone();
         report.send_replace(Some(outcome));

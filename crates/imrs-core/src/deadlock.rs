@@ -9,52 +9,105 @@ use std::collections::BTreeMap;
 
 use imrs_ports::Name;
 
-#[derive(Debug)]
+/// One wait of a module, or a free entry kept for the next (`id` 0), so that a module's
+/// waits in steady state allocate nothing: `on` keeps its capacity.
+#[derive(Debug, Default)]
 struct Wait {
     id: u64,
-    port: Name,
+    port: Option<Name>,
     on: Vec<Name>,
 }
 
 #[derive(Debug, Default)]
 pub(crate) struct WaitGraph {
     next_id: u64,
+    /// Each module's waits, live and free. A module's entry stays until the module ends
+    /// ([`WaitGraph::forget`]), so that a wait allocates only when a module has more waits
+    /// at once than it ever had.
     waits: BTreeMap<Name, Vec<Wait>>,
+    /// The path of the search in progress, reused from one search to the next.
+    path: Vec<(Name, Name)>,
 }
 
 impl WaitGraph {
-    /// Module `module` starts waiting on `on` through `port`. Returns the wait's id, and the
-    /// cycle it closes, if any, as `(module, port)` pairs starting at `module`.
+    /// Module `module` starts waiting through `port` on the modules that `peers` puts in the
+    /// list it is given. Returns the wait's id, and the cycle it closes, if any, as
+    /// `(module, port)` pairs starting at `module`.
     pub(crate) fn begin(
         &mut self,
         module: &Name,
         port: &Name,
-        on: Vec<Name>,
+        peers: impl FnOnce(&mut Vec<Name>),
     ) -> (u64, Option<Vec<(Name, Name)>>) {
         self.next_id += 1;
         let id = self.next_id;
+        let waits = match self.waits.get_mut(module) {
+            Some(waits) => waits,
+            None => self.waits.entry(module.clone()).or_default(),
+        };
+        let at = match waits.iter().position(|wait| wait.id == 0) {
+            Some(free) => free,
+            None => {
+                waits.push(Wait::default());
+                waits.len() - 1
+            }
+        };
+        let wait = &mut waits[at];
+        wait.id = id;
+        wait.port = Some(port.clone());
+        peers(&mut wait.on);
         // A wait on the module's own port is served by another thread of the module, which
         // keeps running whatever the ranks (the scheduler's priority-inversion rule).
-        let on: Vec<Name> = on.into_iter().filter(|peer| peer != module).collect();
-        let on_for_search = on.clone();
-        self.waits.entry(module.clone()).or_default().push(Wait {
-            id,
-            port: port.clone(),
-            on,
-        });
-        let cycle = on_for_search.iter().find_map(|next| {
-            let mut path = vec![(module.clone(), port.clone())];
-            self.path_to(next, module, &mut path).then_some(path)
-        });
+        wait.on.retain(|peer| peer != module);
+        // A cycle needs a peer that waits itself; in the usual case none does, and the
+        // search (which clones names into its path) is skipped.
+        let waits = &self.waits[module];
+        if !waits[at].on.iter().any(|peer| self.is_waiting(peer)) {
+            return (id, None);
+        }
+        let mut path = std::mem::take(&mut self.path);
+        let mut cycle = None;
+        for next in &waits[at].on {
+            path.clear();
+            path.push((module.clone(), port.clone()));
+            if self.path_to(next, module, &mut path) {
+                cycle = Some(path.clone());
+                break;
+            }
+        }
+        path.clear();
+        self.path = path;
         (id, cycle)
     }
 
+    /// Whether `module` has a wait in progress.
+    fn is_waiting(&self, module: &Name) -> bool {
+        self.waits
+            .get(module)
+            .is_some_and(|waits| waits.iter().any(|wait| wait.id != 0))
+    }
+
+    /// The wait `id` of `module` has ended.
     pub(crate) fn end(&mut self, module: &Name, id: u64) {
-        if let Some(waits) = self.waits.get_mut(module) {
-            waits.retain(|wait| wait.id != id);
-            if waits.is_empty() {
-                self.waits.remove(module);
-            }
+        if let Some(wait) = self
+            .waits
+            .get_mut(module)
+            .and_then(|waits| waits.iter_mut().find(|wait| wait.id == id))
+        {
+            wait.id = 0;
+            wait.port = None;
+            wait.on.clear();
+        }
+    }
+
+    /// `module` has ended for good: its entries go.
+    pub(crate) fn forget(&mut self, module: &Name) {
+        if self
+            .waits
+            .get(module)
+            .is_some_and(|waits| waits.iter().all(|wait| wait.id == 0))
+        {
+            self.waits.remove(module);
         }
     }
 
@@ -71,8 +124,11 @@ impl WaitGraph {
             return false;
         };
         for wait in waits {
+            let Some(port) = &wait.port else {
+                continue;
+            };
             for next in &wait.on {
-                path.push((from.clone(), wait.port.clone()));
+                path.push((from.clone(), port.clone()));
                 if self.path_to(next, target, path) {
                     return true;
                 }
@@ -94,17 +150,13 @@ mod tests {
     #[test]
     fn a_two_module_cycle_is_found_when_it_closes() {
         let mut graph = WaitGraph::default();
-        let (_, none) = graph.begin(
-            &name("CHIP_IT"),
-            &name("SHARE_FEEDER"),
-            vec![name("CHIP_IT2")],
-        );
+        let (_, none) = graph.begin(&name("CHIP_IT"), &name("SHARE_FEEDER"), |on| {
+            on.push(name("CHIP_IT2"))
+        });
         assert_eq!(none, None);
-        let (_, cycle) = graph.begin(
-            &name("CHIP_IT2"),
-            &name("SHARE_FEEDER1"),
-            vec![name("CHIP_IT")],
-        );
+        let (_, cycle) = graph.begin(&name("CHIP_IT2"), &name("SHARE_FEEDER1"), |on| {
+            on.push(name("CHIP_IT"))
+        });
         assert_eq!(
             cycle,
             Some(vec![
@@ -117,31 +169,45 @@ mod tests {
     #[test]
     fn a_wait_on_the_modules_own_port_is_no_cycle() {
         let mut graph = WaitGraph::default();
-        let (_, cycle) = graph.begin(
-            &name("CHIP_IT"),
-            &name("READY_TO_CHIP"),
-            vec![name("CHIP_IT")],
-        );
+        let (_, cycle) = graph.begin(&name("CHIP_IT"), &name("READY_TO_CHIP"), |on| {
+            on.push(name("CHIP_IT"))
+        });
         assert_eq!(cycle, None);
     }
 
     #[test]
     fn an_ended_wait_breaks_the_cycle() {
         let mut graph = WaitGraph::default();
-        let (first, _) = graph.begin(&name("A"), &name("P"), vec![name("B")]);
+        let (first, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
         graph.end(&name("A"), first);
-        let (_, cycle) = graph.begin(&name("B"), &name("Q"), vec![name("A")]);
+        let (_, cycle) = graph.begin(&name("B"), &name("Q"), |on| on.push(name("A")));
         assert_eq!(cycle, None);
     }
 
     #[test]
     fn a_chain_without_a_cycle_is_not_reported() {
         let mut graph = WaitGraph::default();
-        graph.begin(&name("A"), &name("P"), vec![name("B")]);
-        graph.begin(&name("B"), &name("Q"), vec![name("C")]);
-        let (_, cycle) = graph.begin(&name("C"), &name("R"), vec![name("D")]);
+        graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
+        graph.begin(&name("B"), &name("Q"), |on| on.push(name("C")));
+        let (_, cycle) = graph.begin(&name("C"), &name("R"), |on| on.push(name("D")));
         assert_eq!(cycle, None);
-        let (_, cycle) = graph.begin(&name("D"), &name("S"), vec![name("B")]);
+        let (_, cycle) = graph.begin(&name("D"), &name("S"), |on| on.push(name("B")));
         assert_eq!(cycle.map(|c| c.len()), Some(3));
+    }
+
+    #[test]
+    fn an_ended_wait_is_reused_and_a_forgotten_module_leaves_nothing() {
+        let mut graph = WaitGraph::default();
+        for _ in 0..3 {
+            let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
+            graph.end(&name("A"), id);
+        }
+        assert_eq!(graph.waits[&name("A")].len(), 1, "one entry, reused");
+        let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
+        graph.forget(&name("A"));
+        assert!(graph.waits.contains_key(&name("A")), "a live wait is kept");
+        graph.end(&name("A"), id);
+        graph.forget(&name("A"));
+        assert!(graph.waits.is_empty());
     }
 }

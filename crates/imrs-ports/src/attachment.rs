@@ -86,12 +86,19 @@ impl<Req, Rep> Attachment<Req, Rep> {
     /// The modules at the other end of the port: the owner, for a user's end; the attached
     /// users, for the owner's end.
     pub(crate) fn peers(&self) -> Vec<Name> {
+        let mut peers = Vec::new();
+        self.each_peer(|peer| peers.push(peer));
+        peers
+    }
+
+    /// [`Attachment::peers`], one at a time, allocating nothing.
+    pub(crate) fn each_peer(&self, mut visit: impl FnMut(Name)) {
         match self.at {
-            SlotId::User(_) => vec![self.core.meta.owner.clone()],
+            SlotId::User(_) => visit(self.core.meta.owner.clone()),
             SlotId::Owner => (0..self.core.capacity())
                 .filter(|&index| self.core.is_user_attached(index))
                 .filter_map(|index| self.core.user_module(index))
-                .collect(),
+                .for_each(visit),
         }
     }
 

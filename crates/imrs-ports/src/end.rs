@@ -57,6 +57,12 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         self.attachment.peers()
     }
 
+    /// Calls `visit` with each of [`End::peers`], allocating nothing: for the paths that
+    /// run at every message, such as a module's deadlock diagnosis.
+    pub fn each_peer(&self, visit: impl FnMut(Name)) {
+        self.attachment.each_peer(visit);
+    }
+
     /// The port's priority, used by [`select`](crate::select()).
     pub fn priority(&self) -> Priority {
         self.attachment.core.meta.priority

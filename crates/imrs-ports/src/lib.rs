@@ -55,6 +55,7 @@ mod error;
 pub mod filter;
 mod loom;
 mod meta;
+mod name;
 mod port;
 pub mod post;
 pub mod presence;

@@ -1,61 +1,13 @@
 //! What a port declaration says about itself, kept at run time for checks and messages.
 
-use std::fmt;
-use std::sync::Arc;
 use std::time::Duration;
 
 use crate::error::WireError;
+pub use crate::name::Name;
 
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::usage::UsageKind;
-
-/// A port's or a module's name, cheap to clone into errors.
-#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Name(Arc<str>);
-
-impl Name {
-    /// The name as text.
-    pub fn as_str(&self) -> &str {
-        &self.0
-    }
-}
-
-impl From<&str> for Name {
-    fn from(name: &str) -> Self {
-        Self(name.into())
-    }
-}
-
-impl From<String> for Name {
-    fn from(name: String) -> Self {
-        Self(name.into())
-    }
-}
-
-impl fmt::Display for Name {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl fmt::Debug for Name {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        fmt::Debug::fmt(&*self.0, f)
-    }
-}
-
-impl PartialEq<str> for Name {
-    fn eq(&self, other: &str) -> bool {
-        &*self.0 == other
-    }
-}
-
-impl PartialEq<&str> for Name {
-    fn eq(&self, other: &&str) -> bool {
-        &*self.0 == *other
-    }
-}
 
 /// A module known by type, so that user lists can be checked at compile time.
 pub trait Named {

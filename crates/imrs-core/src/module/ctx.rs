@@ -141,6 +141,11 @@ impl<S> ModuleShared<S> {
         raised.remove(position)
     }
 
+    /// Whether an exception or a restart request may be waiting: a load, no lock.
+    pub(crate) fn has_pending(&self) -> bool {
+        self.pending.load(Ordering::Acquire)
+    }
+
     /// Whether any raised exception waits for its handler.
     pub(crate) fn has_raised(&self) -> bool {
         self.pending.load(Ordering::Acquire) && !lock(&self.raised).is_empty()
@@ -289,7 +294,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Sends,
     {
-        let waiting = self.wait_on(end.port(), end.peers());
+        let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
         PortOp::new(self, port, Some(waiting), end.send(message), |port| {
             EventKind::Sent { port }
@@ -323,7 +328,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Queries,
     {
-        let waiting = self.wait_on(end.port(), end.peers());
+        let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
         PortOp::new(self, port, Some(waiting), end.query(query), |port| {
             EventKind::Queried { port }
@@ -472,9 +477,9 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         }
     }
 
-    fn wait_on(&self, port: &Name, on: Vec<Name>) -> WaitGuard {
+    fn wait_on(&self, port: &Name, peers: impl FnOnce(&mut Vec<Name>)) -> WaitGuard {
         let cell = &self.module.cell;
-        let (id, cycle) = cell.waits().begin(&self.module.name, port, on);
+        let (id, cycle) = cell.waits().begin(&self.module.name, port, peers);
         if let Some(cycle) = cycle {
             self.event(EventKind::Deadlock { cycle });
         }

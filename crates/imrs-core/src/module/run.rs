@@ -233,8 +233,19 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// registration costs atomic read-modify-writes): [`ModuleRun::park`] does, once, before
     /// the module's future returns `Pending`.
     fn admit(&mut self) -> bool {
-        let mut started = self.restart_requested();
-        loop {
+        // The usual case, after nearly every poll: nothing raised, no restart asked, no
+        // query waiting. Two loads, and no rank is computed.
+        let pending = self.shared.has_pending();
+        if !pending
+            && !self
+                .responses
+                .iter()
+                .any(|response| response.end.is_pending())
+        {
+            return false;
+        }
+        let mut started = pending && self.restart_requested();
+        while self.shared.has_pending() {
             let host = self.host_rank();
             let admissible = |rank: Rank| host.is_none_or(|host| rank.outranks(host));
             let Some(exception) = self.shared.take_raised(|exception| {

@@ -1,0 +1,152 @@
+//! Names of ports, modules, tasks and sections: interned, so that copying and comparing one
+//! costs no more than a pointer.
+//!
+//! The paths that run at every message — the event log, the deadlock diagnosis, a port's
+//! errors — copy and compare names. A reference-counted string would make each copy an
+//! atomic read-modify-write on a line shared by every thread that names the same module;
+//! an interned name is a `&'static str`, copied for free and compared by address.
+//!
+//! The cost: each distinct name is kept for the life of the process. Name modules, ports and
+//! sections by role (`CHIP_IT`, `SHARE_FEEDER`), as the seed does, not by part or time: a cell
+//! that makes a new name per pallet would keep every one.
+
+use std::cmp::Ordering;
+use std::collections::HashSet;
+use std::fmt;
+use std::hash::{Hash, Hasher};
+use std::sync::{OnceLock, PoisonError, RwLock};
+
+/// A port's or a module's name: cloned by copying a pointer, compared by address.
+#[derive(Clone)]
+pub struct Name(&'static str);
+
+/// Every name made so far.
+fn interned() -> &'static RwLock<HashSet<&'static str>> {
+    static INTERNED: OnceLock<RwLock<HashSet<&'static str>>> = OnceLock::new();
+    INTERNED.get_or_init(RwLock::default)
+}
+
+impl Name {
+    /// The name `text`, the same `Name` for the same text wherever it is made.
+    fn intern(text: &str) -> Self {
+        // Each critical section is one lookup or one insert: a panic cannot leave the set
+        // half-changed.
+        if let Some(known) = interned()
+            .read()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get(text)
+        {
+            return Self(known);
+        }
+        let mut names = interned().write().unwrap_or_else(PoisonError::into_inner);
+        if let Some(known) = names.get(text) {
+            return Self(known);
+        }
+        let kept: &'static str = Box::leak(text.into());
+        names.insert(kept);
+        Self(kept)
+    }
+
+    /// The name as text.
+    pub fn as_str(&self) -> &'static str {
+        self.0
+    }
+}
+
+impl PartialEq for Name {
+    fn eq(&self, other: &Self) -> bool {
+        // Interned: one text, one address.
+        std::ptr::eq(self.0, other.0)
+    }
+}
+
+impl Eq for Name {}
+
+impl Hash for Name {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.0.hash(state);
+    }
+}
+
+impl Ord for Name {
+    /// By text, so that whatever is sorted by name reads in the same order in every run.
+    fn cmp(&self, other: &Self) -> Ordering {
+        if self == other {
+            return Ordering::Equal;
+        }
+        self.0.cmp(other.0)
+    }
+}
+
+impl PartialOrd for Name {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl From<&str> for Name {
+    fn from(name: &str) -> Self {
+        Self::intern(name)
+    }
+}
+
+impl From<String> for Name {
+    fn from(name: String) -> Self {
+        Self::intern(&name)
+    }
+}
+
+impl fmt::Display for Name {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+impl fmt::Debug for Name {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.0, f)
+    }
+}
+
+impl PartialEq<str> for Name {
+    fn eq(&self, other: &str) -> bool {
+        self.0 == other
+    }
+}
+
+impl PartialEq<&str> for Name {
+    fn eq(&self, other: &&str) -> bool {
+        self.0 == *other
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_text_is_one_name_however_it_was_made() {
+        let made = format!("{}_{}", "SHARE", "FEEDER");
+        let a = Name::from("SHARE_FEEDER");
+        let b = Name::from(made);
+        assert_eq!(a, b);
+        assert!(std::ptr::eq(a.as_str(), b.as_str()));
+        assert_ne!(a, Name::from("SHARE_FEEDER1"));
+        let (a, b) = (Name::from("A"), Name::from("B"));
+        assert_eq!(a.cmp(&b), Ordering::Less);
+    }
+
+    #[test]
+    fn names_made_on_many_threads_at_once_agree() {
+        let names: Vec<Name> = std::thread::scope(|scope| {
+            let makers: Vec<_> = (0..8)
+                .map(|_| scope.spawn(|| Name::from(String::from("RACED_NAME"))))
+                .collect();
+            makers
+                .into_iter()
+                .map(|maker| maker.join().unwrap())
+                .collect()
+        });
+        assert!(names.windows(2).all(|pair| pair[0] == pair[1]));
+    }
+}
