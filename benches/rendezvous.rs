@@ -2,8 +2,8 @@
 //! comparison, as two tokio tasks on one thread), (b) across two
 //! threads with the receiver parked, (c) across two threads on a TIGHT port; for an 8-byte
 //! and a 1 KiB message. Baselines in the same groups: tokio mpsc + oneshot "ask" on the
-//! current-thread and the multi-thread runtime, a crossbeam ping-pong, an atomic spin
-//! ping-pong.
+//! current-thread and the multi-thread runtime, kameo's `ask` and ractor's `call!` on the
+//! same runtimes, a crossbeam ping-pong, an atomic spin ping-pong.
 
 use std::hint::black_box;
 use std::sync::Arc;
@@ -12,7 +12,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use imrs_benches::{Tail, benchmarking, current_thread};
+use imrs_benches::{Tail, benchmarking, current_thread, peers};
 use imrs_core::Processor;
 use imrs_ports::{Port, PortSpec, Priority, ProcessType, usage};
 use tokio::sync::{mpsc, oneshot};
@@ -174,6 +174,53 @@ fn tokio_ask_multi_thread<const N: usize>(iters: u64, tail: Option<&mut Tail>) -
     current_thread().block_on(async { round_trips!(iters, tail, ask(&asks)) })
 }
 
+/// kameo's `ask`, the actor on the same current-thread runtime.
+fn kameo_ask_current_thread<const N: usize>(iters: u64) -> Duration {
+    current_thread().block_on(async move {
+        let server = peers::kameo_server();
+        let timed = peers::kameo_asks::<N>(&server, iters).await;
+        server.kill();
+        timed
+    })
+}
+
+/// ractor's `call!`, the actor on the same current-thread runtime.
+fn ractor_call_current_thread<const N: usize>(iters: u64) -> Duration {
+    current_thread().block_on(async move {
+        let server = peers::ractor_server::<N>().await;
+        let timed = peers::ractor_calls::<N>(&server, iters).await;
+        server.stop(None);
+        timed
+    })
+}
+
+/// A one-worker multi-thread runtime for the server side of the cross-thread peers.
+fn server_runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+/// kameo's `ask`, the actor on a multi-thread runtime, asked from another thread.
+fn kameo_ask_multi_thread<const N: usize>(iters: u64) -> Duration {
+    let runtime = server_runtime();
+    let server = runtime.block_on(async { peers::kameo_server() });
+    let timed = current_thread().block_on(peers::kameo_asks::<N>(&server, iters));
+    server.kill();
+    timed
+}
+
+/// ractor's `call!`, the actor on a multi-thread runtime, called from another thread.
+fn ractor_call_multi_thread<const N: usize>(iters: u64) -> Duration {
+    let runtime = server_runtime();
+    let server = runtime.block_on(peers::ractor_server::<N>());
+    let timed = current_thread().block_on(peers::ractor_calls::<N>(&server, iters));
+    server.stop(None);
+    timed
+}
+
 /// crossbeam channels, ping-pong between two threads.
 fn crossbeam_ping_pong<const N: usize>(iters: u64) -> Duration {
     let (ping, pinged) = crossbeam_channel::bounded::<[u8; N]>(1);
@@ -222,6 +269,49 @@ fn atomic_spin_ping_pong(iters: u64, mut tail: Option<&mut Tail>) -> Duration {
     timed
 }
 
+/// [`atomic_spin_ping_pong`] that also moves an `N`-byte request, as a TIGHT port does: the
+/// asker writes it word by word before it hands over the turn, the server reads it all back
+/// before it answers. The fair floor for a TIGHT round trip of that size.
+fn atomic_spin_ping_pong_payload<const N: usize>(iters: u64) -> Duration {
+    let words = N.div_ceil(8);
+    let shared = Arc::new((
+        AtomicU64::new(0),
+        (0..words).map(|_| AtomicU64::new(0)).collect::<Vec<_>>(),
+    ));
+    let other = Arc::clone(&shared);
+    let serving = thread::spawn(move || {
+        let (turn, payload) = &*other;
+        let mut read = vec![0u64; payload.len()];
+        for round in 0..iters {
+            while turn.load(Ordering::Acquire) != 2 * round + 1 {
+                std::hint::spin_loop();
+            }
+            for (into, word) in read.iter_mut().zip(payload) {
+                *into = word.load(Ordering::Relaxed);
+            }
+            black_box(&read);
+            turn.store(2 * round + 2, Ordering::Release);
+        }
+    });
+    let (turn, payload) = &*shared;
+    let message = black_box([1u8; N]);
+    let start = Instant::now();
+    for round in 0..iters {
+        for (word, bytes) in payload.iter().zip(message.chunks(8)) {
+            let mut eight = [0u8; 8];
+            eight[..bytes.len()].copy_from_slice(bytes);
+            word.store(u64::from_ne_bytes(eight), Ordering::Relaxed);
+        }
+        turn.store(2 * round + 1, Ordering::Release);
+        while turn.load(Ordering::Acquire) != 2 * round + 2 {
+            std::hint::spin_loop();
+        }
+    }
+    let timed = start.elapsed();
+    serving.join().unwrap();
+    timed
+}
+
 fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     let mut group = c.benchmark_group("rendezvous_same_thread");
     group.bench_function(BenchmarkId::new("imrs", size), |b| {
@@ -236,6 +326,12 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     group.bench_function(BenchmarkId::new("tokio_ask_current_thread", size), |b| {
         b.iter_custom(tokio_ask_current_thread::<N>)
     });
+    group.bench_function(BenchmarkId::new("kameo_ask_current_thread", size), |b| {
+        b.iter_custom(kameo_ask_current_thread::<N>)
+    });
+    group.bench_function(BenchmarkId::new("ractor_call_current_thread", size), |b| {
+        b.iter_custom(ractor_call_current_thread::<N>)
+    });
     group.finish();
 
     let mut group = c.benchmark_group("rendezvous_cross_thread_cold");
@@ -244,6 +340,12 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     });
     group.bench_function(BenchmarkId::new("tokio_ask_multi_thread", size), |b| {
         b.iter_custom(|n| tokio_ask_multi_thread::<N>(n, None))
+    });
+    group.bench_function(BenchmarkId::new("kameo_ask_multi_thread", size), |b| {
+        b.iter_custom(kameo_ask_multi_thread::<N>)
+    });
+    group.bench_function(BenchmarkId::new("ractor_call_multi_thread", size), |b| {
+        b.iter_custom(ractor_call_multi_thread::<N>)
     });
     group.bench_function(BenchmarkId::new("crossbeam_ping_pong", size), |b| {
         b.iter_custom(crossbeam_ping_pong::<N>)
@@ -257,6 +359,10 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     group.bench_function(BenchmarkId::new("atomic_spin_ping_pong", size), |b| {
         b.iter_custom(|n| atomic_spin_ping_pong(n, None))
     });
+    group.bench_function(
+        BenchmarkId::new("atomic_spin_ping_pong_payload", size),
+        |b| b.iter_custom(atomic_spin_ping_pong_payload::<N>),
+    );
     group.finish();
 }
 

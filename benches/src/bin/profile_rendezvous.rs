@@ -2,11 +2,12 @@
 //! the ratio table's figures can be traced to where the time goes. Both ends run on one
 //! processor, as in `rendezvous_same_thread/imrs`; with `query`, the round trips are
 //! queries into a response handler of an idle module, as in `query/responder_idle`; with `ctx`, two modules
-//! talking through `ctx.send` and `ctx.receive`, as in `ctx_same_thread/ctx`.
+//! talking through `ctx.send` and `ctx.receive`, as in `ctx_same_thread/ctx`; with `ring`, hops
+//! around a ring of 1 000 modules on one thread, as in `ring_1000/imrs/1_threads`.
 //!
 //! ```text
 //! cargo build --release -p imrs-benches --bin profile_rendezvous
-//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query|ctx]
+//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query|ctx|ring]
 //! ```
 
 use std::hint::black_box;
@@ -23,6 +24,8 @@ fn main() {
     let mode = std::env::args().nth(2);
     if mode.as_deref() == Some("query") {
         queries(round_trips);
+    } else if mode.as_deref() == Some("ring") {
+        black_box(imrs_benches::imrs_ring(1_000, round_trips, 1));
     } else if mode.as_deref() == Some("ctx") {
         black_box(imrs_benches::ctx_on_processor(round_trips));
     } else {

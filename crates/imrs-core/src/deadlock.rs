@@ -5,7 +5,8 @@
 //! reported by module and port names. It is a diagnosis, checked when a wait begins: the
 //! cycle may still be broken, by a timeout or by a handler whose rank lets it run.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 use imrs_ports::Name;
 
@@ -18,13 +19,47 @@ struct Wait {
     on: Vec<Name>,
 }
 
+/// A module's name as the graph's key: hashed by address, which interned names make unique
+/// per text, so that a lookup neither reads nor hashes the text (a cell of a thousand
+/// modules looks up two or three of them per message). The map is never iterated, so its
+/// order, which varies from run to run, shows nowhere.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Key(Name);
+
+impl Hash for Key {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_usize(self.0.as_str().as_ptr() as usize);
+    }
+}
+
+/// Spreads an address over the hash's bits (Fibonacci hashing): addresses differ mostly in
+/// their middle bits, which the table's low bits must see.
+#[derive(Default)]
+struct AddressHasher(u64);
+
+impl Hasher for AddressHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &byte in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(byte)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+
+    fn write_usize(&mut self, n: usize) {
+        self.0 = (n as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
 #[derive(Debug, Default)]
 pub(crate) struct WaitGraph {
     next_id: u64,
     /// Each module's waits, live and free. A module's entry stays until the module ends
     /// ([`WaitGraph::forget`]), so that a wait allocates only when a module has more waits
     /// at once than it ever had.
-    waits: BTreeMap<Name, Vec<Wait>>,
+    waits: HashMap<Key, Vec<Wait>, BuildHasherDefault<AddressHasher>>,
     /// The path of the search in progress, reused from one search to the next.
     path: Vec<(Name, Name)>,
 }
@@ -41,10 +76,7 @@ impl WaitGraph {
     ) -> (u64, Option<Vec<(Name, Name)>>) {
         self.next_id += 1;
         let id = self.next_id;
-        let waits = match self.waits.get_mut(module) {
-            Some(waits) => waits,
-            None => self.waits.entry(module.clone()).or_default(),
-        };
+        let waits = self.waits.entry(Key(module.clone())).or_default();
         let at = match waits.iter().position(|wait| wait.id == 0) {
             Some(free) => free,
             None => {
@@ -61,7 +93,7 @@ impl WaitGraph {
         wait.on.retain(|peer| peer != module);
         // A cycle needs a peer that waits itself; in the usual case none does, and the
         // search (which clones names into its path) is skipped.
-        let waits = &self.waits[module];
+        let waits = &self.waits[&Key(module.clone())];
         if !waits[at].on.iter().any(|peer| self.is_waiting(peer)) {
             return (id, None);
         }
@@ -83,7 +115,7 @@ impl WaitGraph {
     /// Whether `module` has a wait in progress.
     fn is_waiting(&self, module: &Name) -> bool {
         self.waits
-            .get(module)
+            .get(&Key(module.clone()))
             .is_some_and(|waits| waits.iter().any(|wait| wait.id != 0))
     }
 
@@ -91,7 +123,7 @@ impl WaitGraph {
     pub(crate) fn end(&mut self, module: &Name, id: u64) {
         if let Some(wait) = self
             .waits
-            .get_mut(module)
+            .get_mut(&Key(module.clone()))
             .and_then(|waits| waits.iter_mut().find(|wait| wait.id == id))
         {
             wait.id = 0;
@@ -102,12 +134,13 @@ impl WaitGraph {
 
     /// `module` has ended for good: its entries go.
     pub(crate) fn forget(&mut self, module: &Name) {
+        let key = Key(module.clone());
         if self
             .waits
-            .get(module)
+            .get(&key)
             .is_some_and(|waits| waits.iter().all(|wait| wait.id == 0))
         {
-            self.waits.remove(module);
+            self.waits.remove(&key);
         }
     }
 
@@ -120,7 +153,7 @@ impl WaitGraph {
         if path.iter().any(|(module, _)| module == from) {
             return false;
         }
-        let Some(waits) = self.waits.get(from) else {
+        let Some(waits) = self.waits.get(&Key(from.clone())) else {
             return false;
         };
         for wait in waits {
@@ -202,10 +235,13 @@ mod tests {
             let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
             graph.end(&name("A"), id);
         }
-        assert_eq!(graph.waits[&name("A")].len(), 1, "one entry, reused");
+        assert_eq!(graph.waits[&Key(name("A"))].len(), 1, "one entry, reused");
         let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
         graph.forget(&name("A"));
-        assert!(graph.waits.contains_key(&name("A")), "a live wait is kept");
+        assert!(
+            graph.waits.contains_key(&Key(name("A"))),
+            "a live wait is kept"
+        );
         graph.end(&name("A"), id);
         graph.forget(&name("A"));
         assert!(graph.waits.is_empty());
