@@ -10,13 +10,13 @@ use imrs_ports::{
     End, FilteredPort, Instant, Name, Port, Presence, SharedClock, UserList, VirtualClock,
     WireError, Wiring,
 };
-use tokio::sync::watch;
 
 use crate::check::{CellError, CellErrors, check};
 use crate::deadlock::WaitGraph;
 use crate::event::{Event, EventKind, EventLog};
 use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
 use crate::module::spec::{ModuleDecl, ModuleSpec};
+use crate::outcome::{Outcome, Teller};
 use crate::processor::Processor;
 use crate::supervision::RestartPolicy;
 use crate::tree::{ModuleTree, Placement};
@@ -293,7 +293,7 @@ pub enum ModuleOutcome {
 pub struct ModuleHandle {
     name: Name,
     kill: Arc<KillSwitch>,
-    done: watch::Receiver<Option<ModuleOutcome>>,
+    done: Arc<Outcome>,
 }
 
 impl ModuleHandle {
@@ -314,16 +314,13 @@ impl ModuleHandle {
 
     /// How the module ended, if it has.
     pub fn outcome(&self) -> Option<ModuleOutcome> {
-        self.done.borrow().clone()
+        self.done.get()
     }
 
     /// Waits until the module has ended for good.
     pub async fn finished(&mut self) -> ModuleOutcome {
-        match self.done.wait_for(Option::is_some).await {
-            Ok(outcome) => outcome.clone().expect("waited for an outcome"),
-            // The supervisor is gone without a word: its runtime shut down.
-            Err(_) => ModuleOutcome::Killed,
-        }
+        // A supervisor dropped without a word (its runtime shut down) tells `Killed`.
+        self.done.wait().await
     }
 }
 
@@ -366,7 +363,8 @@ fn supervisor<S: Send + Sync + 'static>(
         }),
     };
     let presence = Presence::new(name.clone());
-    let (report, done) = watch::channel(None);
+    let done = Arc::new(Outcome::default());
+    let report = Teller(Arc::clone(&done));
     let handle = ModuleHandle {
         name: name.clone(),
         kill: Arc::clone(&kill),
@@ -378,13 +376,15 @@ fn supervisor<S: Send + Sync + 'static>(
             parent: parent.clone(),
         },
     );
+    // Boxed: what an async block captures stays in its task for the task's whole life, and
+    // a spec is large beside a running module's needs.
+    let first = Box::new(first);
     let supervisor = async move {
         let mut next = Some(first);
         let mut attempt = 0;
         let outcome = loop {
-            let Some(spec) = next.take() else {
-                unreachable!("a copy is made before every run");
-            };
+            // In one statement, so that the emptied box is freed before the copy runs.
+            let spec = *next.take().expect("a copy is made before every run");
             let children = Children::default();
             let copy = ModuleRun::new(
                 spec,
@@ -398,7 +398,9 @@ fn supervisor<S: Send + Sync + 'static>(
             // The kill that ended this copy is spent; one that comes later is for the next.
             // (Rearming before a copy starts would lose a kill made before its first poll.)
             kill.rearm();
-            children.stop_all().await;
+            // Boxed, as the restart delay below: awaited once per copy, they would otherwise
+            // take room in every idle module's task for its whole life.
+            Box::pin(children.stop_all()).await;
             let outcome = match exit {
                 ModuleExit::Finished => {
                     cell.record(&name, EventKind::ModuleFinished);
@@ -426,7 +428,7 @@ fn supervisor<S: Send + Sync + 'static>(
             if kill.is_stopped() {
                 break outcome;
             }
-            cell.clock.sleep(delay).await;
+            Box::pin(cell.clock.sleep(delay)).await;
             if kill.is_stopped() {
                 break outcome;
             }
@@ -442,14 +444,14 @@ fn supervisor<S: Send + Sync + 'static>(
                 );
                 break ModuleOutcome::Failed(reason);
             }
-            next = Some(copy);
+            next = Some(Box::new(copy));
             cell.record(&name, EventKind::ModuleRestarted { attempt });
         };
         lock(&cell.modules).remove(&name);
         cell.waits().forget(&name);
         // Gone for good: whoever waits on a port the module held fails now (PeerGone).
         presence.set_gone();
-        report.send_replace(Some(outcome));
+        report.tell(outcome);
     };
     Ok((handle, supervisor))
 }

@@ -122,6 +122,7 @@ mod exception;
 mod log;
 mod module;
 mod order;
+mod outcome;
 mod processor;
 mod supervision;
 pub mod time;
