@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use imrs_core::imrs_ports::Instant;
-use rapier3d::prelude::{ColliderHandle, RigidBodyHandle};
+use rapier3d::prelude::ColliderHandle;
 
 use super::physics::Physics;
 use crate::ids::RobotId;
@@ -58,7 +58,6 @@ pub(crate) struct Arm {
     tool: [f32; 2],
     motion: Option<Motion>,
     pub(crate) holding: Option<Held>,
-    links: [RigidBodyHandle; 2],
     pub(crate) colliders: [ColliderHandle; 2],
     /// Whether the links were placed since the world last measured them: an arm that has not
     /// moved cannot have entered the zone or touched another unmoved arm.
@@ -73,8 +72,7 @@ impl Arm {
         side: Elbow,
         physics: &mut Physics,
     ) -> Self {
-        let (link1, collider1) = physics.add_link(LINK_1);
-        let (link2, collider2) = physics.add_link(LINK_2);
+        let (collider1, collider2) = (physics.add_link(LINK_1), physics.add_link(LINK_2));
         let mut arm = Self {
             id,
             base,
@@ -83,7 +81,6 @@ impl Arm {
             tool: home,
             motion: None,
             holding: None,
-            links: [link1, link2],
             colliders: [collider1, collider2],
             moved: true,
         };
@@ -145,8 +142,8 @@ impl Arm {
         // Both ends of a move are within reach; a straight path between them that grazes
         // the dead zone around the base keeps the last placement for that step.
         if let Some(elbow) = elbow(self.base, tool, LINK_1, LINK_2, self.side) {
-            physics.place_link(self.links[0], self.base, elbow);
-            physics.place_link(self.links[1], elbow, tool);
+            physics.place_link(self.colliders[0], self.base, elbow);
+            physics.place_link(self.colliders[1], elbow, tool);
         }
     }
 }

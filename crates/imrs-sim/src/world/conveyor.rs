@@ -2,7 +2,7 @@
 //! stations' freeze relays and by the pallet ahead.
 
 use imrs_core::imrs_ports::Instant;
-use rapier3d::prelude::RigidBodyHandle;
+use rapier3d::prelude::ColliderHandle;
 
 use super::physics::Physics;
 use crate::event::{SimEvent, SimEventKind};
@@ -31,7 +31,7 @@ pub(crate) struct Pallet {
     pub(crate) card: bool,
     pub(crate) screwed: bool,
     pub(crate) chips: u32,
-    body: RigidBodyHandle,
+    body: ColliderHandle,
 }
 
 pub(crate) struct Conveyor {
@@ -107,7 +107,7 @@ impl Conveyor {
             .iter()
             .position(|pallet| pallet.state == PalletState::Jammed(station))?;
         let pallet = self.pallets.remove(index);
-        physics.remove_body(pallet.body);
+        physics.remove_pallet(pallet.body);
         Some(pallet.id)
     }
 
@@ -157,7 +157,7 @@ impl Conveyor {
         }
         for index in done.into_iter().rev() {
             let pallet = self.pallets.remove(index);
-            physics.remove_body(pallet.body);
+            physics.remove_pallet(pallet.body);
             events.push(SimEvent {
                 at: now,
                 kind: SimEventKind::PalletDone {

@@ -177,7 +177,12 @@ impl World {
         for arm in &mut self.arms {
             arm.update(now, &mut self.physics);
         }
-        self.physics.detect();
+        // Only arm links take part in collisions and in the zone: while no arm moved, rapier
+        // would find exactly what it found last step, so the step is skipped (pallets placed
+        // meanwhile are in the world all the same; they collide with nothing).
+        if self.arms.iter().any(|arm| arm.moved) {
+            self.physics.detect();
+        }
         self.measure(now, &mut events);
         events
     }

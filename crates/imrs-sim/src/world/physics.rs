@@ -1,4 +1,4 @@
-//! The rapier world: kinematic arm links and pallets, and the fixed feeder-zone sensor.
+//! The rapier world: kinematic arm links, pallets, and the fixed feeder-zone sensor.
 //!
 //! Nothing here is dynamic: every body is placed by the simulation, and rapier's broad and
 //! narrow phases say what overlaps what.
@@ -21,6 +21,12 @@ impl Physics {
         let mut world = PhysicsWorld::new();
         // For `detect`: nothing falls, and contacts are exact.
         world.gravity = Vector::ZERO;
+        // The broad phase's tree holds a dozen leaves (the arm links and the zone): its
+        // incremental re-balancing, which keeps queries fast in trees of thousands, cost
+        // more here than every query it could speed up. Without it the tree stays exact,
+        // only less balanced.
+        world.broad_phase =
+            BroadPhaseBvh::with_optimization_strategy(BvhOptimizationStrategy::None);
         world.integration_parameters.normalized_prediction_distance = 0.0;
         let zone = world.colliders.insert(
             ColliderBuilder::cuboid(ZONE_HALF[0], ZONE_HALF[1], ZONE_HALF[2])
@@ -29,77 +35,73 @@ impl Physics {
                 .collision_groups(InteractionGroups::new(ZONE, ARMS, InteractionTestMode::And))
                 .active_events(ActiveEvents::COLLISION_EVENTS)
                 .active_collision_types(
-                    ActiveCollisionTypes::default() | ActiveCollisionTypes::KINEMATIC_FIXED,
+                    ActiveCollisionTypes::default() | ActiveCollisionTypes::FIXED_FIXED,
                 ),
         );
         Self { world, zone }
     }
 
-    /// A kinematic capsule of length `length` lying along its body's x axis.
-    pub(crate) fn add_link(&mut self, length: f32) -> (RigidBodyHandle, ColliderHandle) {
-        let body = self
-            .world
-            .bodies
-            .insert(RigidBodyBuilder::kinematic_position_based().can_sleep(true));
-        let collider = ColliderBuilder::capsule_x(length / 2.0, LINK_RADIUS)
-            .collision_groups(InteractionGroups::new(
-                ARMS,
-                ARMS | ZONE,
-                InteractionTestMode::And,
-            ))
-            .active_collision_types(
-                ActiveCollisionTypes::default()
-                    | ActiveCollisionTypes::KINEMATIC_KINEMATIC
-                    | ActiveCollisionTypes::KINEMATIC_FIXED,
-            );
-        let collider =
-            self.world
-                .colliders
-                .insert_with_parent(collider, body, &mut self.world.bodies);
-        (body, collider)
+    /// A capsule of length `length` lying along its x axis: one link of an arm.
+    ///
+    /// A collider with no body, placed by [`Physics::place_link`]: nothing here is dynamic,
+    /// so a body would only give rapier's solver work (integrating its velocity from each
+    /// new pose) that the detection does not use. Parentless colliders count as fixed, so
+    /// the fixed-fixed pairs are switched on for the links.
+    pub(crate) fn add_link(&mut self, length: f32) -> ColliderHandle {
+        self.world.colliders.insert(
+            ColliderBuilder::capsule_x(length / 2.0, LINK_RADIUS)
+                .collision_groups(InteractionGroups::new(
+                    ARMS,
+                    ARMS | ZONE,
+                    InteractionTestMode::And,
+                ))
+                .active_collision_types(
+                    ActiveCollisionTypes::default() | ActiveCollisionTypes::FIXED_FIXED,
+                ),
+        )
     }
 
-    /// A kinematic pallet, which takes part in no collision.
-    pub(crate) fn add_pallet(&mut self, at: [f32; 3]) -> RigidBodyHandle {
-        let body = self.world.bodies.insert(
-            RigidBodyBuilder::kinematic_position_based()
-                .translation(Vector::new(at[0], at[1], at[2])),
-        );
-        let collider = ColliderBuilder::cuboid(PALLET_HALF[0], PALLET_HALF[1], PALLET_HALF[2])
-            .collision_groups(InteractionGroups::none());
-        self.world
-            .colliders
-            .insert_with_parent(collider, body, &mut self.world.bodies);
-        body
+    /// A pallet: a collider of its own, with no body, which takes part in no collision.
+    ///
+    /// Not a kinematic body, and disabled: the pallets outnumber the arm links several times,
+    /// and as moving bodies (integrated by the solver) or enabled colliders (refitted in the
+    /// broad phase at every step) they made most of the chip cell's simulation time, for
+    /// pairs the collision groups then threw away. A disabled collider stays in the world
+    /// with its shape and pose, for whoever draws the scene, and costs the steps nothing.
+    pub(crate) fn add_pallet(&mut self, at: [f32; 3]) -> ColliderHandle {
+        self.world.colliders.insert(
+            ColliderBuilder::cuboid(PALLET_HALF[0], PALLET_HALF[1], PALLET_HALF[2])
+                .translation(Vector::new(at[0], at[1], at[2]))
+                .collision_groups(InteractionGroups::none())
+                .enabled(false),
+        )
     }
 
-    pub(crate) fn remove_body(&mut self, body: RigidBodyHandle) {
+    pub(crate) fn remove_pallet(&mut self, pallet: ColliderHandle) {
         let world = &mut self.world;
-        world.bodies.remove(
-            body,
+        world.colliders.remove(
+            pallet,
             &mut world.islands,
-            &mut world.colliders,
-            &mut world.impulse_joints,
-            &mut world.multibody_joints,
+            &mut world.bodies,
             &mut world.soft_bodies,
-            true,
+            false,
         );
     }
 
     /// Places a link between two points of the arms' plane.
-    pub(crate) fn place_link(&mut self, body: RigidBodyHandle, from: [f32; 2], to: [f32; 2]) {
+    pub(crate) fn place_link(&mut self, link: ColliderHandle, from: [f32; 2], to: [f32; 2]) {
         let middle = Vector::new((from[0] + to[0]) / 2.0, (from[1] + to[1]) / 2.0, ARM_Z);
         let angle = (to[1] - from[1]).atan2(to[0] - from[0]);
         let pose = Pose::from_parts(middle, Rotation::from_rotation_z(angle));
-        self.world.bodies[body].set_position(pose, true);
+        self.world.colliders[link].set_position(pose);
     }
 
-    pub(crate) fn place_pallet(&mut self, body: RigidBodyHandle, at: [f32; 3]) {
-        self.world.bodies[body].set_translation(Vector::new(at[0], at[1], at[2]), true);
+    pub(crate) fn place_pallet(&mut self, pallet: ColliderHandle, at: [f32; 3]) {
+        self.world.colliders[pallet].set_translation(Vector::new(at[0], at[1], at[2]));
     }
 
-    pub(crate) fn position_of(&self, body: RigidBodyHandle) -> [f32; 3] {
-        let at = self.world.bodies[body].translation();
+    pub(crate) fn position_of(&self, pallet: ColliderHandle) -> [f32; 3] {
+        let at = self.world.colliders[pallet].translation();
         [at.x, at.y, at.z]
     }
 
