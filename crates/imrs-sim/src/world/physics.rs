@@ -105,16 +105,14 @@ impl Physics {
         [at.x, at.y, at.z]
     }
 
-    /// Runs collision detection for the bodies as they are placed now.
+    /// Runs collision detection for the colliders as they are placed now.
     ///
     /// Through the physics pipeline, not the collision-only one: rapier 0.36's collision-only
     /// pipeline appends the contact pairs of every moved collider to a list that only the
     /// physics pipeline's graph maintenance drains (about 2 MB per simulated hour of the chip
-    /// cell, for ever), and mixing the two pipelines leaves bodies added in between outside
-    /// rapier's islands. With only kinematic bodies placed by `set_position` (which sets
-    /// their next pose too), no gravity and a zero prediction distance, a physics step moves
-    /// nothing and detects exactly what the collision-only step did (the chip cell's reports
-    /// are byte for byte the same), at about twice the wall time per step.
+    /// cell, for ever). The world holds no bodies, only colliders placed by `set_position`,
+    /// so a physics step moves nothing: it runs the broad and narrow phases, as the
+    /// collision-only step did (the chip cell's reports are byte for byte the same).
     pub(crate) fn detect(&mut self) {
         self.world.step();
     }
