@@ -1,4 +1,6 @@
-//! The n-way rendezvous `waitfor`, for n = 2, 4, 16 and 64 tasks: the time of one round.
+//! The n-way rendezvous `waitfor`, for n = 2, 4, 16, 64 and 256 tasks: the time of one round;
+//! beside each, a round of tokio's `Barrier` for as many tasks, which shows what the runtime
+//! itself adds as n grows (more tasks woken per round, more task state to go through).
 //!
 //! Each task's combining function reads one message (`getmess`), so that the figure is the
 //! rendezvous' own cost: a function that folds over the whole pool makes every round O(n²)
@@ -41,11 +43,36 @@ fn rounds(n: usize, rounds: u64) -> Duration {
     })
 }
 
+/// `rounds` rounds of a tokio `Barrier` of `n` tasks, timed the same way.
+fn barrier_rounds(n: usize, rounds: u64) -> Duration {
+    current_thread().block_on(async move {
+        let barrier = Arc::new(tokio::sync::Barrier::new(n));
+        let start = Instant::now();
+        let tasks: Vec<_> = (0..n)
+            .map(|_| {
+                let barrier = Arc::clone(&barrier);
+                tokio::spawn(async move {
+                    for _ in 0..rounds {
+                        std::hint::black_box(barrier.wait().await.is_leader());
+                    }
+                })
+            })
+            .collect();
+        for task in tasks {
+            task.await.unwrap();
+        }
+        start.elapsed()
+    })
+}
+
 fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("waitfor");
-    for n in [2, 4, 16, 64] {
+    for n in [2, 4, 16, 64, 256] {
         group.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter_custom(|iters| rounds(n, iters))
+        });
+        group.bench_function(BenchmarkId::new("tokio_barrier", n), |b| {
+            b.iter_custom(|iters| barrier_rounds(n, iters))
         });
     }
     group.finish();

@@ -325,7 +325,11 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             if let Some(pool) = round.pool_after(generation) {
                 return Poll::Ready(Ok(pool));
             }
-            round.wakers[index] = Some(cx.waker().clone());
+            match &mut round.wakers[index] {
+                // Polled again by the same task: no clone (a reference count written).
+                Some(waker) if waker.will_wake(cx.waker()) => {}
+                slot => *slot = Some(cx.waker().clone()),
+            }
             drop(round);
             let timed_out = deadline
                 .as_mut()
