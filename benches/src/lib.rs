@@ -4,6 +4,7 @@
 //! the same run (`cargo run -p imrs-benches --bin ratio_table` prints the table).
 
 pub mod peers;
+pub mod rendezvous;
 
 use std::hint::black_box;
 use std::path::PathBuf;

@@ -37,81 +37,159 @@ fn main() {
         std::process::exit(1);
     }
     let mut rows: Vec<(String, String, f64, &str)> = Vec::new();
-    for size in ["8B", "1KiB"] {
-        rows.push((
-            format!("rendezvous_same_thread/imrs/{size}"),
-            format!("rendezvous_same_thread/tokio_ask_current_thread/{size}"),
+    let mut row = |case: &str, baseline: &str, scale: f64, target: &'static str| {
+        rows.push((case.to_owned(), baseline.to_owned(), scale, target));
+    };
+    for (size, same_thread_target, tight_target) in
+        [("8B", "<= 0.25", "<= 1.2"), ("1KiB", "<= 0.5", "-")]
+    {
+        let same = |who: &str| format!("rendezvous_same_thread/{who}/{size}");
+        let cold = |who: &str| format!("rendezvous_cross_thread_cold/{who}/{size}");
+        let tight = |who: &str| format!("rendezvous_tight/{who}/{size}");
+        row(
+            &same("imrs"),
+            &same("tokio_ask_current_thread"),
             1.0,
-            "<= 0.25",
-        ));
-        rows.push((
-            format!("rendezvous_same_thread/imrs_prioritized/{size}"),
-            format!("rendezvous_same_thread/imrs/{size}"),
+            same_thread_target,
+        );
+        row(
+            &same("imrs"),
+            &same("kameo_ask_current_thread"),
+            1.0,
+            "(vs kameo)",
+        );
+        row(
+            &same("imrs"),
+            &same("ractor_call_current_thread"),
+            1.0,
+            "(vs ractor)",
+        );
+        row(
+            &same("imrs_prioritized"),
+            &same("imrs"),
             1.0,
             "<= 1.1 (priorities on)",
-        ));
-        rows.push((
-            format!("rendezvous_same_thread/imrs_two_tasks/{size}"),
-            format!("rendezvous_same_thread/tokio_ask_current_thread/{size}"),
+        );
+        row(
+            &same("imrs_two_tasks"),
+            &same("tokio_ask_current_thread"),
             1.0,
             "(one task per end)",
-        ));
-        rows.push((
-            format!("rendezvous_cross_thread_cold/imrs/{size}"),
-            format!("rendezvous_cross_thread_cold/tokio_ask_multi_thread/{size}"),
+        );
+        row(
+            &cold("imrs"),
+            &cold("tokio_ask_multi_thread"),
             1.0,
-            "<= 0.8",
-        ));
-        rows.push((
-            format!("rendezvous_cross_thread_cold/crossbeam_ping_pong/{size}"),
-            format!("rendezvous_cross_thread_cold/tokio_ask_multi_thread/{size}"),
+            "<= 0.8 (see cross_thread_runs)",
+        );
+        row(
+            &cold("imrs"),
+            &cold("kameo_ask_multi_thread"),
+            1.0,
+            "(vs kameo)",
+        );
+        row(
+            &cold("imrs"),
+            &cold("ractor_call_multi_thread"),
+            1.0,
+            "(vs ractor)",
+        );
+        row(
+            &cold("crossbeam_ping_pong"),
+            &cold("tokio_ask_multi_thread"),
             1.0,
             "(baseline)",
-        ));
-        rows.push((
-            format!("rendezvous_tight/imrs/{size}"),
-            format!("rendezvous_tight/atomic_spin_ping_pong/{size}"),
+        );
+        row(
+            &tight("imrs"),
+            &tight("atomic_spin_ping_pong"),
             1.0,
-            "<= 1.2",
-        ));
+            tight_target,
+        );
+        let payload_target = if size == "8B" { "-" } else { "<= 2" };
+        row(
+            &tight("imrs"),
+            &tight("atomic_spin_ping_pong_payload"),
+            1.0,
+            payload_target,
+        );
     }
-    rows.push((
-        "query/responder_idle".into(),
-        "query/same_thread_rendezvous".into(),
+    row(
+        "ctx_same_thread/ctx",
+        "ctx_same_thread/raw_end",
+        1.0,
+        "<= 1.3",
+    );
+    row(
+        "ctx_multi_thread/ctx",
+        "ctx_multi_thread/raw_end",
+        1.0,
+        "<= 1.3",
+    );
+    row(
+        "query/responder_idle",
+        "query/same_thread_rendezvous",
         1.0,
         "<= 1.5",
-    ));
-    rows.push((
-        "query/responder_in_lower_section".into(),
-        "query/same_thread_rendezvous".into(),
+    );
+    row(
+        "query/responder_in_lower_section",
+        "query/same_thread_rendezvous",
         1.0,
         "-",
-    ));
-    // Linear growth means the 64-task round costs at most 32 times the 2-task one.
-    rows.push((
-        "waitfor/64".into(),
-        "waitfor/2".into(),
+    );
+    // Per task: linear growth means the n-task round costs n/2 times the 2-task one.
+    row("waitfor/16", "waitfor/2", 8.0, "-");
+    row(
+        "waitfor/64",
+        "waitfor/2",
         32.0,
-        "<= 1 (linear in n)",
-    ));
-    rows.push((
-        "waitfor/16".into(),
-        "waitfor/2".into(),
-        8.0,
-        "<= 1 (linear in n)",
-    ));
-    rows.push((
-        "select/8_ports_all_ready".into(),
-        "select/8_ports_one_ready".into(),
+        "<= 1.05 (per task, vs n = 2)",
+    );
+    row(
+        "waitfor/256",
+        "waitfor/2",
+        128.0,
+        "<= 1.05 (per task, vs n = 2)",
+    );
+    row(
+        "waitfor/tokio_barrier/64",
+        "waitfor/tokio_barrier/2",
+        32.0,
+        "(tokio's own growth)",
+    );
+    row(
+        "waitfor/tokio_barrier/256",
+        "waitfor/tokio_barrier/2",
+        128.0,
+        "(tokio's own growth)",
+    );
+    row(
+        "waitfor/64",
+        "waitfor/tokio_barrier/64",
+        1.0,
+        "(vs tokio Barrier)",
+    );
+    row(
+        "select/8_ports_all_ready",
+        "select/8_ports_one_ready",
         1.0,
         "-",
-    ));
-    rows.push((
-        "filter/bounded_buffer".into(),
-        "filter/tokio_mpsc".into(),
+    );
+    row("filter/bounded_buffer", "filter/tokio_mpsc", 1.0, "<= 3");
+    row(
+        "filter/bounded_buffer_on_processor",
+        "filter/tokio_mpsc",
         1.0,
-        "-",
-    ));
+        "<= 3",
+    );
+    let cores = std::thread::available_parallelism().map_or(2, usize::from);
+    let mut threads = vec![1, 2, cores];
+    threads.dedup();
+    for n in threads {
+        let ring = |who: &str| format!("ring_1000/{who}/{n}_threads");
+        row(&ring("imrs"), &ring("tokio"), 1.0, "(time per hop)");
+    }
 
     println!(
         "{:<58} {:>10} {:>10} {:>7}  target",
@@ -129,6 +207,23 @@ fn main() {
             show(b)
         );
         println!("  vs {baseline}");
+    }
+    let tail = |case: &str| -> Option<f64> {
+        let text = std::fs::read_to_string(root.join("tail").join(format!("{case}.txt"))).ok()?;
+        text.split_whitespace().nth(2)?.parse().ok()
+    };
+    let (imrs, tokio) = (
+        tail("rendezvous_cross_thread_cold_imrs_8B"),
+        tail("rendezvous_cross_thread_cold_tokio_ask_multi_thread_8B"),
+    );
+    if let (Some(imrs), Some(tokio)) = (imrs, tokio) {
+        println!(
+            "{:<58} {:>10} {:>10} {:>7.2}  <= 1 (p99.9 vs tokio's)",
+            "rendezvous_cross_thread_cold/imrs/8B p99.9",
+            show(Some(imrs)),
+            show(Some(tokio)),
+            imrs / tokio
+        );
     }
     if let Some(minute) = median(&root, "sim_speed/busy_cell_minute") {
         println!(
