@@ -4,10 +4,32 @@
 //! ```text
 //! cargo run -p imrs-benches --bin ratio_table
 //! ```
+//!
+//! It also saves the run's ratios to `<criterion>/ratios.tsv`. One run on a shared machine
+//! says little: `benches/runs.sh N` runs the benches N times, keeps each run's ratios, and
+//! ends with `ratio_table --runs DIR`, which prints each row's median and spread over them.
 
 use std::path::Path;
 
 use imrs_benches::criterion_dir;
+
+/// Appends a line to the output, printed whole at the end: a reader that stops early
+/// (`| head`) then costs nothing but the rest of the text.
+macro_rules! say {
+    ($out:expr) => {
+        $out.push('\n')
+    };
+    ($out:expr, $($arg:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($out, $($arg)*);
+    }};
+}
+
+/// Prints `out`; a closed pipe is no error of the table's.
+fn emit(out: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().lock().write_all(out.as_bytes());
+}
 
 /// The median of a case, in nanoseconds, from `<criterion>/<case>/new/estimates.json`.
 fn median(root: &Path, case: &str) -> Option<f64> {
@@ -28,6 +50,16 @@ fn show(nanos: Option<f64>) -> String {
 }
 
 fn main() {
+    let mut args = std::env::args().skip(1);
+    if args.next().as_deref() == Some("--runs") {
+        let Some(dir) = args.next() else {
+            eprintln!("usage: ratio_table [--runs DIR]");
+            std::process::exit(2);
+        };
+        summarize(Path::new(&dir));
+        return;
+    }
+    let mut out = String::new();
     let root = criterion_dir();
     if !root.exists() {
         eprintln!(
@@ -191,22 +223,32 @@ fn main() {
         row(&ring("imrs"), &ring("tokio"), 1.0, "(time per hop)");
     }
 
-    println!(
+    say!(
+        out,
         "{:<58} {:>10} {:>10} {:>7}  target",
-        "case (baseline below)", "median", "baseline", "ratio"
+        "case (baseline below)",
+        "median",
+        "baseline",
+        "ratio"
     );
+    let mut saved = String::new();
     for (case, baseline, scale, target) in rows {
         let (a, b) = (median(&root, &case), median(&root, &baseline));
         let ratio = match (a, b) {
             (Some(a), Some(b)) if b > 0.0 => format!("{:.2}", a / (b * scale)),
             _ => "-".into(),
         };
-        println!(
+        saved.push_str(&format!("{case}\t{baseline}\t{ratio}\t{target}\n"));
+        say!(
+            out,
             "{case:<58} {:>10} {:>10} {ratio:>7}  {target}",
             show(a),
             show(b)
         );
-        println!("  vs {baseline}");
+        say!(out, "  vs {baseline}");
+    }
+    if let Err(error) = std::fs::write(root.join("ratios.tsv"), saved) {
+        eprintln!("cannot save this run's ratios: {error}");
     }
     let tail = |case: &str| -> Option<f64> {
         let text = std::fs::read_to_string(root.join("tail").join(format!("{case}.txt"))).ok()?;
@@ -217,7 +259,8 @@ fn main() {
         tail("rendezvous_cross_thread_cold_tokio_ask_multi_thread_8B"),
     );
     if let (Some(imrs), Some(tokio)) = (imrs, tokio) {
-        println!(
+        say!(
+            out,
             "{:<58} {:>10} {:>10} {:>7.2}  <= 1 (p99.9 vs tokio's)",
             "rendezvous_cross_thread_cold/imrs/8B p99.9",
             show(Some(imrs)),
@@ -226,13 +269,17 @@ fn main() {
         );
     }
     if let Some(minute) = median(&root, "sim_speed/busy_cell_minute") {
-        println!(
+        say!(
+            out,
             "sim_speed: {:.0} simulated seconds per wall second (busy two-line cell)",
             60.0 / (minute / 1e9)
         );
     }
-    println!();
-    println!("tail latency of single round trips (p50 / p99 / p99.9):");
+    say!(out);
+    say!(
+        out,
+        "tail latency of single round trips (p50 / p99 / p99.9):"
+    );
     let mut tails: Vec<_> = std::fs::read_dir(root.join("tail"))
         .map(|dir| {
             dir.filter_map(Result::ok)
@@ -249,7 +296,8 @@ fn main() {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         if let [p50, p99, p999] = values[..] {
-            println!(
+            say!(
+                out,
                 "  {name:<56} {} / {} / {}",
                 show(p50),
                 show(p99),
@@ -257,4 +305,71 @@ fn main() {
             );
         }
     }
+    emit(&out);
+}
+
+/// Each row's median ratio and spread over the runs saved in `dir` (one `.tsv` a run).
+fn summarize(dir: &Path) {
+    let mut out = String::new();
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(Result::ok)
+                .map(|entry| entry.path())
+                .filter(|path| path.extension().is_some_and(|ext| ext == "tsv"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    if files.is_empty() {
+        eprintln!("no saved runs (*.tsv) in {}", dir.display());
+        std::process::exit(1);
+    }
+    // Rows in the order of the first run; ratios of every run, by (case, baseline).
+    let mut order: Vec<(String, String, String)> = Vec::new();
+    let mut ratios: std::collections::HashMap<(String, String), Vec<f64>> = Default::default();
+    for file in &files {
+        for line in std::fs::read_to_string(file).unwrap_or_default().lines() {
+            let fields: Vec<&str> = line.split('\t').collect();
+            let [case, baseline, ratio, target] = fields[..] else {
+                continue;
+            };
+            let key = (case.to_owned(), baseline.to_owned());
+            if !ratios.contains_key(&key) {
+                order.push((key.0.clone(), key.1.clone(), target.to_owned()));
+            }
+            let entry = ratios.entry(key).or_default();
+            if let Ok(ratio) = ratio.parse() {
+                entry.push(ratio);
+            }
+        }
+    }
+    say!(
+        out,
+        "{} runs; each row: the median ratio over them, and its spread (lowest to highest)\n",
+        files.len()
+    );
+    say!(
+        out,
+        "{:<58} {:>6} {:>13}  target",
+        "case (baseline below)",
+        "median",
+        "spread"
+    );
+    for (case, baseline, target) in order {
+        let mut values = ratios
+            .remove(&(case.clone(), baseline.clone()))
+            .unwrap_or_default();
+        values.sort_by(f64::total_cmp);
+        let (median, spread) = match values.as_slice() {
+            [] => ("-".to_owned(), "-".to_owned()),
+            all => (
+                format!("{:.2}", all[all.len() / 2]),
+                format!("{:.2} to {:.2}", all[0], all[all.len() - 1]),
+            ),
+        };
+        say!(out, "{case:<58} {median:>6} {spread:>13}  {target}");
+        say!(out, "  vs {baseline}");
+    }
+    emit(&out);
 }

@@ -43,6 +43,26 @@
 //! its [`ModuleSpec`], belongs to the module; a costarted child belongs to the copy of its
 //! parent that started it and is stopped with it.
 //!
+//! # The message-handler rule
+//!
+//! **Of the woken modules (and jobs) on one [`Processor`], the most urgent is polled next: a
+//! module's urgency is its own priority ([`ModuleSpec::priority`]), lifted for its next poll
+//! to the priority of the port whose message — request or reply — woke it, if that is higher;
+//! equals go in the order they were placed, and one that has waited [`Processor::AGING`] polls
+//! of others goes first.** Task and port priorities are one scale (1 is the most urgent; none
+//! declared ranks below every declared one), so a routine module's emergency stop on a port of
+//! priority 1 is served before the routine work of a module of priority 2, and a waiting
+//! module is polled within `AGING + n - 1` polls of the others. Between modules on different
+//! processors, or started with [`Cell::start`], tokio schedules and priorities do not apply.
+//!
+//! # Names
+//!
+//! Module, port, task and section names are interned: each distinct name is kept for the life
+//! of the process, so that the paths that run at every message copy and compare a pointer.
+//! Name things by role, as the seed does (`CHIP_IT`, `SHARE_FEEDER`), not by part or time.
+//! [`Cell::tree`] draws the modules as the seed's tree, each port a vertical or a horizontal
+//! link.
+//!
 //! # What the types do not stop
 //!
 //! - **Read-only handlers can still write through interior mutability.** A response handler
