@@ -20,7 +20,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::pin::Pin;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::task::{Context, Poll};
+use std::task::{Context, Poll, Waker};
 
 use atomic_waker::AtomicWaker;
 use imrs_ports::clock::Sleep;
@@ -39,8 +39,8 @@ use crate::supervision::RestartPolicy;
 pub(crate) struct KillSwitch {
     killed: AtomicBool,
     stopped: AtomicBool,
-    /// Polled at every poll of the module: registering the same waker again is two
-    /// compare-and-swaps, no lock and no clone.
+    /// Woken by the kill that ends a copy: once per copy at most, which is what lets a copy
+    /// register its waker only when the waker changes ([`ModuleRun`]'s `kill_waker`).
     waker: AtomicWaker,
 }
 
@@ -65,11 +65,21 @@ impl KillSwitch {
         self.killed.store(false, Ordering::Release);
     }
 
-    fn poll_killed(&self, cx: &mut Context<'_>) -> bool {
+    /// Whether the copy is killed; if not, `cx`'s waker is registered for the kill, unless
+    /// `registered` (the waker this copy registered last) will wake the same task. A kill
+    /// ends the copy, so the waker registered is taken by a wake only once per copy, and
+    /// skipping the registration (two compare-and-swaps at every poll) loses no kill.
+    fn poll_killed(&self, cx: &mut Context<'_>, registered: &mut Option<Waker>) -> bool {
         if self.killed.load(Ordering::Acquire) {
             return true;
         }
-        self.waker.register(cx.waker());
+        if !registered
+            .as_ref()
+            .is_some_and(|waker| waker.will_wake(cx.waker()))
+        {
+            self.waker.register(cx.waker());
+            *registered = Some(cx.waker().clone());
+        }
         self.killed.load(Ordering::Acquire)
     }
 }
@@ -122,6 +132,8 @@ pub(crate) struct ModuleRun<S> {
     responses: Vec<ResponseRun<S>>,
     exception_handlers: Vec<(Name, Rank, ExceptionHandler<S>)>,
     kill: Arc<KillSwitch>,
+    /// The waker last registered with `kill`.
+    kill_waker: Option<Waker>,
     /// The module's presence, entered around every poll so that the ends its threads attach
     /// are known as the module's (taken out while it is entered).
     presence: Option<Arc<Presence>>,
@@ -196,6 +208,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             responses,
             exception_handlers,
             kill,
+            kill_waker: None,
             presence: entered.leave(),
             span,
         }
@@ -497,7 +510,7 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
         let this = self.get_mut();
         let span = this.span.clone();
         let _entered = span.enter();
-        if this.kill.poll_killed(cx) {
+        if this.kill.poll_killed(cx, &mut this.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
         let entered = Presence::enter(this.presence.take());
