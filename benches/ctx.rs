@@ -6,12 +6,12 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use imrs_benches::{Timed, ctx_modules, ctx_on_processor, current_thread, new_cell};
+use imrs_benches::{Timed, ctx_modules, ctx_on_processor, current_thread, new_cell, runtime};
 use imrs_core::prelude::*;
 
 /// Two modules, each a task of its own on a two-worker runtime, talking through `ctx`.
 fn ctx_multi_thread(iters: u64) -> Duration {
-    two_workers().block_on(async move {
+    runtime(2).block_on(async move {
         let cell = new_cell();
         let timed = Timed::default();
         let (server, client) = ctx_modules(&cell, iters, &timed);
@@ -56,21 +56,13 @@ fn raw_on_processor(iters: u64) -> Duration {
 }
 
 fn raw_multi_thread(iters: u64) -> Duration {
-    two_workers().block_on(async move {
+    runtime(2).block_on(async move {
         let (serving, sending) = raw_ends(iters);
         let serving = tokio::spawn(serving);
         let timed = tokio::spawn(sending).await.unwrap();
         serving.await.unwrap();
         timed
     })
-}
-
-fn two_workers() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .expect("a runtime starts")
 }
 
 fn ctx(c: &mut Criterion) {
