@@ -258,3 +258,33 @@ fn a_kill_made_before_the_module_first_runs_is_not_lost() {
         assert_eq!(module.finished().await, ModuleOutcome::Killed);
     });
 }
+
+#[test]
+fn a_module_whose_runtime_shuts_down_counts_as_killed_for_whoever_waits_on_it() {
+    let runtime = paused_runtime();
+    let mut handle = runtime.block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        let forever = ModuleSpec::new("WAITER", ()).task("WAITER", |ctx| async move {
+            loop {
+                ctx.delay(secs(60)).await;
+            }
+        });
+        cell.start(forever).unwrap()
+    });
+    assert_eq!(handle.outcome(), None, "it runs while its runtime does");
+    // Someone waits for it on a thread and runtime of their own: whether the wait has begun
+    // when the runtime goes or begins after, it ends with the outcome.
+    let mut waiting = handle.clone();
+    let waiter = std::thread::spawn(move || {
+        tokio::runtime::Builder::new_current_thread()
+            .build()
+            .unwrap()
+            .block_on(waiting.finished())
+    });
+    // The runtime goes, and the module's task with it, before the module could end.
+    drop(runtime);
+    assert_eq!(waiter.join().unwrap(), ModuleOutcome::Killed);
+    assert_eq!(handle.outcome(), Some(ModuleOutcome::Killed));
+    let waited = paused_runtime().block_on(handle.finished());
+    assert_eq!(waited, ModuleOutcome::Killed);
+}
