@@ -13,7 +13,7 @@
 //! | number of active users | const generic `N`, buffers sized once; a user beyond `N` is a [`WireError`] |
 //! | filter | [`FilteredPort`]; the [`BoundedBuffer`] of the seed's Appendix ships ready |
 //! | timeout | run time, on the framework [`Clock`]: a typed timeout error |
-//! | priority | run time: [`select()`] serves the highest-priority ready port, FIFO within a port |
+//! | priority | run time: [`select()`] serves the highest-priority ready port, FIFO within a port; a message's wake carries its port's priority ([`urgency`]), which a processor uses to lift the module it wakes |
 //! | process type | [`ProcessType::Tight`] ports spin briefly before parking |
 //!
 //! A send, a receive and a reply between two tasks:
