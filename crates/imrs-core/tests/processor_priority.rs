@@ -197,23 +197,29 @@ fn the_emergency_stop_runs_the_same_way_every_time() {
     assert_eq!(emergency_stop(spec()), emergency_stop(spec()));
 }
 
-#[test]
-fn a_ready_job_of_low_priority_is_polled_within_the_aging_bound() {
+/// `hogs` jobs of the highest priority that are always ready, and one of no priority that
+/// waits five times for a wake of its own: how many polls of the hogs each wait lasted.
+fn waits_behind_hogs(hogs: usize) -> Vec<u64> {
     paused_runtime().block_on(async {
         let processor = Processor::new("CPU1");
         let hog_polls = Arc::new(AtomicU64::new(0));
         let done = Arc::new(AtomicBool::new(false));
-        let (polls, stop) = (Arc::clone(&hog_polls), Arc::clone(&done));
-        // Always ready, and as urgent as a job can be.
-        let hog = processor.spawn_with_priority(Priority::declared(1), async move {
-            while !stop.load(Ordering::SeqCst) {
-                polls.fetch_add(1, Ordering::SeqCst);
-                step().await;
-            }
-        });
+        let running: Vec<_> = (0..hogs)
+            .map(|_| {
+                let (polls, stop) = (Arc::clone(&hog_polls), Arc::clone(&done));
+                // Always ready, and as urgent as a job can be.
+                processor.spawn_with_priority(Priority::declared(1), async move {
+                    // Bounded, so that a processor that starved the low job would show it in
+                    // the waits below rather than hang the test.
+                    while !stop.load(Ordering::SeqCst) && polls.load(Ordering::SeqCst) < 100_000 {
+                        polls.fetch_add(1, Ordering::SeqCst);
+                        step().await;
+                    }
+                })
+            })
+            .collect();
         let (polls, stop) = (Arc::clone(&hog_polls), Arc::clone(&done));
         let low = processor.spawn(async move {
-            // How many polls of the hog each wait of this job lasted.
             let mut waits = Vec::new();
             for _ in 0..5 {
                 let before = polls.load(Ordering::SeqCst);
@@ -224,16 +230,26 @@ fn a_ready_job_of_low_priority_is_polled_within_the_aging_bound() {
             waits
         });
         let waits = low.await.unwrap();
-        hog.await.unwrap();
-        // Two jobs: the bound is AGING + 2 - 1 polls of the other.
-        let bound = Processor::AGING + 1;
+        for hog in running {
+            hog.await.unwrap();
+        }
+        waits
+    })
+}
+
+#[test]
+fn a_ready_job_of_low_priority_is_polled_within_the_aging_bound() {
+    for hogs in [1, 3, 7] {
+        let waits = waits_behind_hogs(hogs);
+        // n jobs on the processor: the bound is AGING + n - 1 polls of the others.
+        let bound = Processor::AGING + hogs as u64;
         assert!(
             waits.iter().all(|&wait| wait <= bound),
-            "waits {waits:?} within {bound}"
+            "{hogs} hogs: waits {waits:?} within {bound}"
         );
         assert!(
             waits.iter().all(|&wait| wait >= Processor::AGING - 1),
-            "the hog, more urgent, went first each time: {waits:?}"
+            "{hogs} hogs, more urgent, went first each time: {waits:?}"
         );
-    });
+    }
 }
