@@ -108,7 +108,8 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
     /// urgent; a module that declares none ranks below every declared one. A module started
     /// as a task of its own ([`Cell::start`](crate::Cell::start)) is scheduled by tokio,
     /// which has no priorities: there the number only appears in the
-    /// [module tree](crate::Cell::tree).
+    /// [module tree](crate::Cell::tree). Every copy of a supervised module runs in the one
+    /// job its first copy was placed in, at the first copy's priority.
     pub fn priority(mut self, n: u32) -> Self {
         self.priority = Priority::declared(n);
         self
