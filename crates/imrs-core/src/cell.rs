@@ -364,7 +364,7 @@ fn supervisor<S: Send + Sync + 'static>(
     };
     let presence = Presence::new(name.clone());
     let done = Arc::new(Outcome::default());
-    let report = Teller(Arc::clone(&done));
+    let report = Teller::new(&done);
     let handle = ModuleHandle {
         name: name.clone(),
         kill: Arc::clone(&kill),

@@ -10,13 +10,20 @@ use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 use imrs_ports::Name;
 
-/// One wait of a module, or a free entry kept for the next (`id` 0), so that a module's
-/// waits in steady state allocate nothing: `on` keeps its capacity.
-#[derive(Debug, Default)]
+/// One wait of a module, or a free entry kept for the next (`id` 0; `port` then names the
+/// last wait's port and means nothing), so that a module's waits in steady state allocate
+/// nothing: `on` keeps its capacity.
+#[derive(Debug)]
 struct Wait {
     id: u64,
-    port: Option<Name>,
+    port: Name,
     on: Vec<Name>,
+}
+
+impl Wait {
+    fn is_live(&self) -> bool {
+        self.id != 0
+    }
 }
 
 /// A module's name as the graph's key: hashed by address, which interned names make unique
@@ -77,16 +84,20 @@ impl WaitGraph {
         self.next_id += 1;
         let id = self.next_id;
         let waits = self.waits.entry(Key(module.clone())).or_default();
-        let at = match waits.iter().position(|wait| wait.id == 0) {
+        let at = match waits.iter().position(|wait| !wait.is_live()) {
             Some(free) => free,
             None => {
-                waits.push(Wait::default());
+                waits.push(Wait {
+                    id: 0,
+                    port: port.clone(),
+                    on: Vec::new(),
+                });
                 waits.len() - 1
             }
         };
         let wait = &mut waits[at];
         wait.id = id;
-        wait.port = Some(port.clone());
+        wait.port = port.clone();
         peers(&mut wait.on);
         // A wait on the module's own port is served by another thread of the module, which
         // keeps running whatever the ranks (the scheduler's priority-inversion rule).
@@ -116,7 +127,7 @@ impl WaitGraph {
     fn is_waiting(&self, module: &Name) -> bool {
         self.waits
             .get(&Key(module.clone()))
-            .is_some_and(|waits| waits.iter().any(|wait| wait.id != 0))
+            .is_some_and(|waits| waits.iter().any(Wait::is_live))
     }
 
     /// The wait `id` of `module` has ended.
@@ -127,7 +138,6 @@ impl WaitGraph {
             .and_then(|waits| waits.iter_mut().find(|wait| wait.id == id))
         {
             wait.id = 0;
-            wait.port = None;
             wait.on.clear();
         }
     }
@@ -138,7 +148,7 @@ impl WaitGraph {
         if self
             .waits
             .get(&key)
-            .is_some_and(|waits| waits.iter().all(|wait| wait.id == 0))
+            .is_some_and(|waits| !waits.iter().any(Wait::is_live))
         {
             self.waits.remove(&key);
         }
@@ -156,12 +166,9 @@ impl WaitGraph {
         let Some(waits) = self.waits.get(&Key(from.clone())) else {
             return false;
         };
-        for wait in waits {
-            let Some(port) = &wait.port else {
-                continue;
-            };
+        for wait in waits.iter().filter(|wait| wait.is_live()) {
             for next in &wait.on {
-                path.push((from.clone(), port.clone()));
+                path.push((from.clone(), wait.port.clone()));
                 if self.path_to(next, target, path) {
                     return true;
                 }

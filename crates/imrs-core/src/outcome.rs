@@ -55,16 +55,24 @@ impl Outcome {
 /// The supervisor's side: tells the outcome once; if the supervisor is dropped without
 /// telling (its runtime shut down), the module counts as killed.
 #[derive(Debug)]
-pub(crate) struct Teller(pub(crate) Arc<Outcome>);
+pub(crate) struct Teller(Option<Arc<Outcome>>);
 
 impl Teller {
-    pub(crate) fn tell(self, outcome: ModuleOutcome) {
-        self.0.tell(outcome);
+    pub(crate) fn new(outcome: &Arc<Outcome>) -> Self {
+        Self(Some(Arc::clone(outcome)))
+    }
+
+    pub(crate) fn tell(mut self, outcome: ModuleOutcome) {
+        if let Some(cell) = self.0.take() {
+            cell.tell(outcome);
+        }
     }
 }
 
 impl Drop for Teller {
     fn drop(&mut self) {
-        self.0.tell(ModuleOutcome::Killed);
+        if let Some(cell) = self.0.take() {
+            cell.tell(ModuleOutcome::Killed);
+        }
     }
 }

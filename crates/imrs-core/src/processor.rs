@@ -392,20 +392,18 @@ impl Jobs {
 
     /// The job to poll next, by [the rule](Processor#the-message-handler).
     fn next(&self) -> Option<usize> {
-        let mut best: Option<(usize, &Slot)> = None;
-        for (index, slot) in self.slots.iter().enumerate() {
-            if !slot.ready {
-                continue;
-            }
-            let Some((_, chosen)) = best else {
-                best = Some((index, slot));
-                continue;
-            };
-            if self.goes_before(slot, chosen) {
-                best = Some((index, slot));
-            }
-        }
-        best.map(|(index, _)| index)
+        self.slots
+            .iter()
+            .enumerate()
+            .filter(|(_, slot)| slot.ready)
+            .reduce(|chosen, slot| {
+                if self.goes_before(slot.1, chosen.1) {
+                    slot
+                } else {
+                    chosen
+                }
+            })
+            .map(|(index, _)| index)
     }
 
     /// Whether `slot` goes before `chosen`, which comes earlier in placing order.

@@ -57,8 +57,8 @@ pub(crate) enum SlotId {
 /// Keeps a value on a cache line of its own, so that threads writing their own fields do not
 /// steal each other's lines: on a TIGHT port both ends spin, and every stolen line is a
 /// cross-core round trip. One 64-byte line, not the pair that adjacent-line prefetchers
-/// fetch: 128 bytes measured no faster on the TIGHT benches and made every port (and so
-/// every idle module) half a kilobyte larger.
+/// fetch: with 128 the TIGHT benches were no faster beyond their run-to-run noise, and every
+/// port (so every idle module) was half a kilobyte larger.
 #[repr(align(64))]
 pub(crate) struct Padded<T>(T);
 
