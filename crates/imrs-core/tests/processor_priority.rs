@@ -253,3 +253,72 @@ fn a_ready_job_of_low_priority_is_polled_within_the_aging_bound() {
         );
     }
 }
+
+/// Two idle jobs on a processor: ROUTINE (priority 2) receiving on ROUTINE_IN (no priority)
+/// and SAFETY (priority 4) receiving on `estop`. Another thread, with the processor held
+/// still, posts to ROUTINE first and then to SAFETY, so that both are woken from outside the
+/// processor's thread before it looks. Returns the order in which they received.
+fn served_after_wakes_from_another_thread(estop: PortSpec) -> Vec<&'static str> {
+    paused_runtime().block_on(async move {
+        let processor = Processor::new("CPU1");
+        let routine_in =
+            Port::<u8, (), usage::Receive>::declare(PortSpec::new("ROUTINE_IN", "ROUTINE"));
+        let estop = Port::<u8, (), usage::Receive>::declare(estop);
+        let served: Arc<Mutex<Vec<&'static str>>> = Arc::default();
+        let mut jobs = Vec::new();
+        for (name, priority, port) in [("ROUTINE", 2, &routine_in), ("SAFETY", 4, &estop)] {
+            let (mut owner, served) = (port.owner().unwrap(), Arc::clone(&served));
+            jobs.push(
+                processor.spawn_with_priority(Priority::declared(priority), async move {
+                    let (_, reply) = owner.receive().await.unwrap();
+                    served.lock().unwrap().push(name);
+                    reply.reply(());
+                }),
+            );
+        }
+        // Both jobs run once and park in their receive.
+        for _ in 0..4 {
+            tokio::task::yield_now().await;
+        }
+        assert!(served.lock().unwrap().is_empty());
+        let (mut to_routine, mut to_safety) = (
+            routine_in.user_named("CONVEYOR").unwrap(),
+            estop.user_named("CONVEYOR").unwrap(),
+        );
+        let (posted, both_posted) = std::sync::mpsc::channel();
+        let sender = std::thread::spawn(move || {
+            tokio::runtime::Builder::new_current_thread()
+                .build()
+                .unwrap()
+                .block_on(async move {
+                    let routine = tokio::spawn(async move { to_routine.send(1).await });
+                    let safety = tokio::spawn(async move { to_safety.send(2).await });
+                    // One yield: each send has run once, posted, and woken its receiver.
+                    tokio::task::yield_now().await;
+                    posted.send(()).unwrap();
+                    routine.await.unwrap().unwrap();
+                    safety.await.unwrap().unwrap();
+                });
+        });
+        // Held still (this thread runs the processor) until both wakes have come in.
+        both_posted.recv().unwrap();
+        for job in jobs {
+            job.await.unwrap();
+        }
+        sender.join().unwrap();
+        served.lock().unwrap().clone()
+    })
+}
+
+#[test]
+fn a_lift_carried_by_a_wake_from_another_thread_is_honoured() {
+    let order =
+        served_after_wakes_from_another_thread(PortSpec::new("ESTOP", "SAFETY").priority(1));
+    assert_eq!(order, ["SAFETY", "ROUTINE"]);
+}
+
+#[test]
+fn without_the_lift_the_more_urgent_job_goes_first_whoever_was_woken_first() {
+    let order = served_after_wakes_from_another_thread(PortSpec::new("ESTOP", "SAFETY"));
+    assert_eq!(order, ["ROUTINE", "SAFETY"]);
+}
