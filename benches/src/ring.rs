@@ -17,14 +17,14 @@ type Shared = Arc<Mutex<Lap>>;
 
 /// A runtime of `threads` threads: current-thread for one.
 pub fn runtime(threads: usize) -> tokio::runtime::Runtime {
-    let mut builder = if threads == 1 {
-        tokio::runtime::Builder::new_current_thread()
-    } else {
-        let mut builder = tokio::runtime::Builder::new_multi_thread();
-        builder.worker_threads(threads);
-        builder
-    };
-    builder.enable_all().build().expect("a runtime starts")
+    if threads == 1 {
+        return crate::current_thread();
+    }
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(threads)
+        .enable_all()
+        .build()
+        .expect("a runtime starts")
 }
 
 /// Module `i` of a ring of `size`: receives the token on its own port, answers, and passes it
