@@ -3,20 +3,35 @@
 //! ```text
 //! cargo run --release --example chip_cell -- [--hours H] [--seed S]
 //!     [--feeder arbiter|appendix] [--realtime] [--tree] [--fault KIND[:WHICH]@TIME]...
+//!     [--record FILE.mcap] [--timeline FILE.svg [--timeline-from S] [--timeline-span S]]
 //! ```
+//!
+//! `--help` lists every flag. `RUST_LOG=imrs=debug` shows the events and spans the core
+//! emits, on stderr.
 
 use std::process::ExitCode;
 
 use std::io::{self, Write};
 
 use cell_example::{CellConfig, FeederPolicy, Report, parse, run, speed_line};
+use tracing_subscriber::EnvFilter;
 
 fn main() -> ExitCode {
+    // Silent unless RUST_LOG asks: the report is the example's output.
+    let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("error"));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(io::stderr)
+        .init();
     let config = match parse(std::env::args_os().skip(1)) {
         Ok(config) => config,
-        Err(message) => {
-            eprintln!("{message}");
-            return ExitCode::from(2);
+        Err(refused) if refused.status == 0 => {
+            print!("{refused}");
+            return ExitCode::SUCCESS;
+        }
+        Err(refused) => {
+            eprint!("{refused}");
+            return ExitCode::from(refused.status);
         }
     };
     let (report, tree) = match run(&config) {
@@ -29,6 +44,17 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    if let Some(path) = &config.record {
+        eprintln!(
+            "recording written to {}: open it in Foxglove (Open local file), or sum it up with \
+             `cargo run --example mcap_summary -- {}`",
+            path.display(),
+            path.display()
+        );
+    }
+    if let Some(timeline) = &config.timeline {
+        eprintln!("timeline drawn in {}", timeline.path.display());
+    }
     let mut out = io::stdout().lock();
     let printed = match tree {
         Some(tree) => writeln!(out, "module tree (seed 000 §2):\n{tree}"),
@@ -60,6 +86,8 @@ fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::
             FeederPolicy::Appendix => FeederPolicy::Arbiter,
         },
         progress: false,
+        record: None,
+        timeline: None,
         ..config.clone()
     };
     match run(&other) {

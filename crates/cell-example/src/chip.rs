@@ -6,14 +6,17 @@ use std::time::Duration;
 
 use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::{DeviceError, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target};
+use imrs_sim::{
+    DeviceError, FEEDER_CHIPS, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target,
+};
 
+use crate::alarms::{AlarmKind, alarm};
 use crate::help::{drive_relay, insisted, retried};
 use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
 use crate::ports::{CellPorts, ZonePort};
 
 /// How the two chip robots share the feeder zone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum FeederPolicy {
     /// The Appendix's scheme: query the twin's CRIT_SECTION, as CHIP_IT's order allows, with
     /// asymmetric timeout handlers to break the deadlock it admits (note 6).
@@ -29,6 +32,13 @@ pub struct ChipStep {
     pub feeder: FeederId,
     /// Where on the card, in millimetres from its corner.
     pub at: (u32, u32),
+}
+
+impl ChipStep {
+    /// The step's place on the card, in metres from its corner.
+    pub fn place(&self) -> [f32; 2] {
+        [self.at.0 as f32 / 1000.0, self.at.1 as f32 / 1000.0]
+    }
 }
 
 /// CHIP_IT's work schedule: four chips, all of priority 1, so any order will do.
@@ -62,6 +72,20 @@ pub fn work_schedule() -> WorkSchedule<ChipStep> {
                 at: (60, 70),
             },
         )
+}
+
+/// How many chips a good card carries: one per step of the work schedule.
+pub fn chips_per_card() -> u32 {
+    work_schedule().more() as u32
+}
+
+/// Where the work schedule puts chip number `chip` on the card, in metres from its corner.
+pub fn place_of_chip(chip: u32) -> Option<[f32; 2]> {
+    let schedule = work_schedule();
+    (0..)
+        .map_while(|index| schedule.get(index))
+        .find(|step| FEEDER_CHIPS.get(usize::from(step.feeder.0)) == Some(&chip))
+        .map(ChipStep::place)
 }
 
 /// What the chip robots measured of their own waiting for the zone.
@@ -267,7 +291,11 @@ pub fn chip_it(
         .exception(
             line_ports.ready_to_chip.handler("TIMEOUT"),
             |ctx: Ctx<ChipItState>, _| async move {
-                ctx.alarm("no card at the chip station for 60 s");
+                alarm(
+                    &ctx,
+                    AlarmKind::Starved,
+                    "no card at the chip station for 60 s",
+                );
             },
         )
 }
@@ -297,9 +325,10 @@ async fn chip_step(
                 retried(ctx, "grasping a chip", || robot.grasp(step.feeder)).await
             }
             .await;
-            // Out of the zone before anything else, whatever happened in it.
+            // Out of the zone before anything else, whatever happened in it: to the step's
+            // place on the card, INSERT(X, Y, Z).
             insisted(ctx, "leaving the feeder zone", || {
-                robot.move_to(Target::Card)
+                robot.move_to(Target::OnCard(step.place()))
             })
             .await;
             access.left(ctx).await;
@@ -308,7 +337,11 @@ async fn chip_step(
         .await;
     if let Err(error) = grasped {
         // Note 5: an empty feeder is reported, and the other steps still run.
-        ctx.alarm(format!("{error}: skipping this chip"));
+        alarm(
+            ctx,
+            AlarmKind::of_error(&error),
+            format!("{error}: skipping this chip"),
+        );
         return Err(error);
     }
     ctx.section("INSERT", async {

@@ -1,72 +1,130 @@
-//! The flags of `cargo run --example chip_cell`, read into a [`CellConfig`].
+//! The flags of `cargo run --example chip_cell`, read into a [`CellConfig`] by clap: `--help`
+//! lists every flag with its meaning and default, and a bad value is refused naming its flag.
 
 use std::ffi::OsString;
+use std::fmt;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Parser;
 
 use crate::chip::FeederPolicy;
 use crate::faults::CellFault;
-use crate::run::{CellConfig, MAX_HOURS};
+use crate::run::{CellConfig, MAX_HOURS, TimelineConfig};
 
-/// The example's usage line.
-pub const USAGE: &str = "usage: chip_cell [--hours H] [--seed S] [--feeder arbiter|appendix] [--realtime] [--tree] \
-                     [--fault KIND[:WHICH]@TIME]... (KIND: release, robot, feeder, jam)";
+/// The chip-insertion cell of Shin (1985), Appendix, on two lines, with a report.
+#[derive(Debug, Parser)]
+#[command(name = "chip_cell", version, about, long_about = None)]
+struct Flags {
+    /// Simulated hours to run (above 0, at most a year).
+    #[arg(long, value_name = "H", default_value_t = 1.0, value_parser = hours, allow_negative_numbers = true)]
+    hours: f64,
+    /// Seeds every random choice: the same seed and flags give the same report.
+    #[arg(long, value_name = "S", default_value_t = 1985)]
+    seed: u64,
+    /// How the chip robots share the feeder zone: the Appendix's query/order scheme, or an
+    /// arbiter module.
+    #[arg(long, value_enum, default_value_t = FeederPolicy::Arbiter)]
+    feeder: FeederPolicy,
+    /// Run on the wall clock instead of virtual time.
+    #[arg(long)]
+    realtime: bool,
+    /// Print the module tree (seed 000 §2) before the report.
+    #[arg(long)]
+    tree: bool,
+    /// Inject a fault: KIND one of release, robot, feeder, jam; WHICH a line A or B, or a
+    /// feeder 0 to 3; TIME in seconds, or with s, m or h (e.g. robot:B@15m). Repeatable.
+    #[arg(long = "fault", value_name = "KIND[:WHICH]@TIME", value_parser = fault)]
+    faults: Vec<CellFault>,
+    /// Record the run into an MCAP file that Foxglove opens as a 3D cell with its messages.
+    #[arg(long, value_name = "FILE.mcap")]
+    record: Option<PathBuf>,
+    /// Draw a timeline of a window of the run (sections, waits, zone occupancy, deadlocks)
+    /// as an SVG picture.
+    #[arg(long, value_name = "FILE.svg")]
+    timeline: Option<PathBuf>,
+    /// Where the timeline's window starts, in simulated seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, value_parser = seconds, allow_negative_numbers = true)]
+    timeline_from: f64,
+    /// How long the timeline's window is, in simulated seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0, value_parser = seconds, allow_negative_numbers = true)]
+    timeline_span: f64,
+    /// Show no progress bar (it is shown only on a terminal anyway).
+    #[arg(long)]
+    no_progress: bool,
+}
 
-/// Reads the example's flags into a [`CellConfig`]; a bad flag or value is an error that
-/// says what was wrong, never a panic (also for an argument that is not UTF-8).
-pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, String> {
-    let mut config = CellConfig {
-        progress: true,
-        ..CellConfig::default()
-    };
-    let mut args = args.into_iter().map(|arg| {
-        arg.into_string().map_err(|arg| {
-            format!(
-                "argument {:?} is not valid UTF-8\n{USAGE}",
-                arg.to_string_lossy()
-            )
-        })
-    });
-    while let Some(flag) = args.next() {
-        let flag = flag?;
-        let mut value = |name: &str| {
-            args.next()
-                .ok_or_else(|| format!("{name} needs a value\n{USAGE}"))?
-        };
-        match flag.as_str() {
-            "--hours" => {
-                let text = value("--hours")?;
-                config.hours = text
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|hours| hours.is_finite() && *hours > 0.0 && *hours <= MAX_HOURS)
-                    .ok_or_else(|| {
-                        format!("--hours {text:?}: expected a number of hours above 0, at most {MAX_HOURS}")
-                    })?;
-            }
-            "--seed" => {
-                let text = value("--seed")?;
-                config.seed = text
-                    .parse()
-                    .map_err(|_| format!("--seed {text:?}: expected a whole number"))?;
-            }
-            "--feeder" => {
-                config.feeder = match value("--feeder")?.as_str() {
-                    "arbiter" => FeederPolicy::Arbiter,
-                    "appendix" => FeederPolicy::Appendix,
-                    other => {
-                        return Err(format!("--feeder {other:?}: expected arbiter or appendix"));
-                    }
-                }
-            }
-            "--realtime" => config.realtime = true,
-            "--tree" => config.show_tree = true,
-            "--fault" => config.faults.push(
-                value("--fault")?
-                    .parse::<CellFault>()
-                    .map_err(|e| e.to_string())?,
-            ),
-            "--help" | "-h" => return Err(USAGE.into()),
-            other => return Err(format!("unknown argument {other:?}\n{USAGE}")),
-        }
+fn hours(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|hours| hours.is_finite() && *hours > 0.0 && *hours <= MAX_HOURS)
+        .ok_or_else(|| format!("expected a number of hours above 0, at most {MAX_HOURS}"))
+}
+
+fn seconds(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|seconds| seconds.is_finite() && (0.0..=MAX_HOURS * 3600.0).contains(seconds))
+        .ok_or_else(|| "expected a number of seconds, 0 or more, within a year".into())
+}
+
+fn fault(text: &str) -> Result<CellFault, String> {
+    text.parse::<CellFault>().map_err(|error| error.reason())
+}
+
+/// Why the flags gave no configuration: a mistake (status 2), or `--help` and `--version`,
+/// whose text is the answer (status 0).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CliError {
+    /// What to print.
+    pub message: String,
+    /// The exit status: 0 for help and version, 2 for a mistake.
+    pub status: u8,
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
     }
-    Ok(config)
+}
+
+impl std::error::Error for CliError {}
+
+/// Reads the example's flags (without the program's name) into a [`CellConfig`]; a bad flag
+/// or value is an error that names it, never a panic (also for an argument that is not
+/// UTF-8).
+pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, CliError> {
+    let mut checked = vec![String::from("chip_cell")];
+    for arg in args {
+        // Named here: clap would only say that some argument was not UTF-8.
+        let arg = arg.into_string().map_err(|arg| CliError {
+            message: format!(
+                "error: argument {:?} is not valid UTF-8",
+                arg.to_string_lossy()
+            ),
+            status: 2,
+        })?;
+        checked.push(arg);
+    }
+    let flags = Flags::try_parse_from(checked).map_err(|error| CliError {
+        message: error.render().to_string(),
+        status: if error.use_stderr() { 2 } else { 0 },
+    })?;
+    let timeline = flags.timeline.map(|path| TimelineConfig {
+        path,
+        from: Duration::from_secs_f64(flags.timeline_from),
+        span: Duration::from_secs_f64(flags.timeline_span),
+    });
+    Ok(CellConfig {
+        hours: flags.hours,
+        seed: flags.seed,
+        feeder: flags.feeder,
+        realtime: flags.realtime,
+        faults: flags.faults,
+        progress: !flags.no_progress,
+        show_tree: flags.tree,
+        record: flags.record,
+        timeline,
+        ..CellConfig::default()
+    })
 }

@@ -46,6 +46,16 @@ impl fmt::Display for FaultParseError {
     }
 }
 
+impl FaultParseError {
+    /// What was wrong and the syntax expected, without the flag and the value (for a parser
+    /// that names them itself).
+    pub fn reason(&self) -> String {
+        let full = self.to_string();
+        let prefix = format!("--fault {:?}: ", self.value);
+        full.strip_prefix(&prefix).unwrap_or(&full).to_string()
+    }
+}
+
 impl std::error::Error for FaultParseError {}
 
 /// The latest time a fault may be set for: a year.

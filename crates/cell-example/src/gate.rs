@@ -8,6 +8,7 @@ use imrs_sim::imrs_core::imrs_ports::{BoundedBuffer, Instant};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, Sim};
 
+use crate::alarms::{AlarmKind, alarm};
 use crate::names::LineNames;
 use crate::ports::LinePorts;
 
@@ -27,12 +28,51 @@ pub struct GateState {
 /// When RELEASE is to die (the `--fault release@T` injection), taken by the copy it kills.
 pub type ReleaseDeath = Arc<Mutex<Option<Instant>>>;
 
+/// The history of a GATE's CYCLE_TIME, kept for the report: its first and latest values,
+/// its range, how often it changed, and the most recent changes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CycleTimeHistory {
+    /// The value it started with, in seconds.
+    pub first: Option<f64>,
+    /// Its value now.
+    pub now: Option<f64>,
+    /// The least and the greatest value it took.
+    pub range: Option<(f64, f64)>,
+    /// How often it changed.
+    pub changes: u32,
+    /// The most recent changes: when (simulated seconds) and to what.
+    pub recent: Vec<(f64, f64)>,
+}
+
+impl CycleTimeHistory {
+    /// How many recent changes are kept.
+    pub const RECENT: usize = 8;
+
+    fn set(&mut self, at: f64, value: f64) {
+        self.first.get_or_insert(value);
+        let (low, high) = self.range.unwrap_or((value, value));
+        self.range = Some((low.min(value), high.max(value)));
+        if self.now.is_some_and(|now| now != value) {
+            self.changes += 1;
+            if self.recent.len() == Self::RECENT {
+                self.recent.remove(0);
+            }
+            self.recent.push((at, value));
+        }
+        self.now = Some(value);
+    }
+}
+
+/// A line's GATE's CYCLE_TIME history, shared with the run that reports it.
+pub type SharedCycleTimes = Arc<Mutex<CycleTimeHistory>>;
+
 /// The GATE module of `line`.
 pub fn gate(
     line: Line,
     ports: &LinePorts,
     sim: &Sim,
     death: ReleaseDeath,
+    history: SharedCycleTimes,
 ) -> ModuleSpec<GateState> {
     let n = LineNames::of(line);
     let timeout = ports.let_1_go.handler("TIMEOUT");
@@ -52,9 +92,12 @@ pub fn gate(
         .filters(n.frequency.clone(), UsageKind::Receive)
         .task(n.gate.clone(), move |ctx| {
             let (let_1_go, frequency) = (let_1_go.clone(), frequency.clone());
+            let history = Arc::clone(&history);
             async move {
                 let mut let_1_go = let_1_go.owner()?;
                 let mut frequency = frequency.owner()?;
+                let first = ctx.state().read(|gate| gate.cycle_time);
+                record(&history, ctx.now(), first);
                 loop {
                     let cycle = ctx.state().read(|gate| gate.cycle_time);
                     ctx.delay(Duration::from_secs_f64(cycle)).await;
@@ -69,25 +112,33 @@ pub fn gate(
                                 gate.backed_up
                             });
                             if cycles % 10 == 0 {
-                                ctx.alarm(format!(
-                                    "line backed up to the gate for {cycles} cycles"
-                                ));
+                                alarm(
+                                    &ctx,
+                                    AlarmKind::BackedUp,
+                                    format!("line backed up to the gate for {cycles} cycles"),
+                                );
                             }
                         }
                         // A timeout is the handler's business; a RELEASE that died holding
                         // the message is restarted here.
                         Err(error) if !error.is_timeout() => {
-                            ctx.alarm(format!("RELEASE failed: {error}; restarting it"));
+                            alarm(
+                                &ctx,
+                                AlarmKind::TaskFailed,
+                                format!("RELEASE failed: {error}; restarting it"),
+                            );
                             ctx.restart_task("RELEASE");
                         }
                         Err(_) => {}
                     }
                     // SEND FREQUENCY(TASK_NUM, TEMP_TIME): the buffer's oldest report, if any.
                     if let Ok(Some((task_num, time))) = ctx.send(&mut frequency, ()).await {
-                        ctx.state().update(|gate| {
+                        let cycle = ctx.state().update(|gate| {
                             gate.speeds[task_num as usize] = time;
                             gate.cycle_time = gate.speeds[0].min(gate.speeds[1]) / 2.0;
+                            gate.cycle_time
                         });
+                        record(&history, ctx.now(), cycle);
                     }
                 }
             }
@@ -129,14 +180,29 @@ pub fn gate(
         })
         .exception(timeout, |ctx: Ctx<GateState>, _| async move {
             // {Signal for help. Perhaps reset timer, perhaps kill and restart RELEASE}
-            ctx.alarm("RELEASE did not answer within 2 s: killing it and starting a new copy");
+            alarm(
+                &ctx,
+                AlarmKind::NoAnswer,
+                "RELEASE did not answer within 2 s: killing it and starting a new copy",
+            );
             ctx.restart_task("RELEASE");
         })
         .exception(
             "RELEASE.FAILED",
             |ctx: Ctx<GateState>, exception| async move {
                 // The next LET_1_GO times out and restarts it (the Appendix's note 2).
-                ctx.alarm(format!("RELEASE failed: {}", exception.detail));
+                alarm(
+                    &ctx,
+                    AlarmKind::TaskFailed,
+                    format!("RELEASE failed: {}", exception.detail),
+                );
             },
         )
+}
+
+fn record(history: &SharedCycleTimes, at: Instant, cycle: f64) {
+    history
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .set(at.since_start().as_secs_f64(), cycle);
 }

@@ -7,6 +7,8 @@ use imrs_sim::imrs_core::Ctx;
 use imrs_sim::imrs_core::imrs_ports::{End, usage};
 use imrs_sim::{DeviceError, PalletId, Relay};
 
+use crate::alarms::{AlarmKind, alarm};
+
 /// How long an operator takes to reset a faulted robot.
 pub const RESET_TIME: Duration = Duration::from_secs(1);
 
@@ -24,9 +26,11 @@ where
 {
     match operation().await {
         Err(DeviceError::RobotFault { robot }) => {
-            ctx.alarm(format!(
-                "{robot} faulted while {what}: reset by the operator, retrying"
-            ));
+            alarm(
+                ctx,
+                AlarmKind::RobotFault,
+                format!("{robot} faulted while {what}: reset by the operator, retrying"),
+            );
             ctx.delay(RESET_TIME).await;
             operation().await
         }
@@ -43,9 +47,11 @@ where
     Fut: Future<Output = Result<(), DeviceError>>,
 {
     while let Err(error) = operation().await {
-        ctx.alarm(format!(
-            "{error} while {what}: reset by the operator, retrying"
-        ));
+        alarm(
+            ctx,
+            AlarmKind::of_error(&error),
+            format!("{error} while {what}: reset by the operator, retrying"),
+        );
         ctx.delay(RESET_TIME).await;
     }
 }
@@ -66,16 +72,28 @@ where
             Ok(pallet) => {
                 // Hold the pallet until the module (or a new copy of it) lets it go.
                 while let Err(error) = ctx.send(port, pallet).await {
-                    ctx.alarm(format!("{pallet}: {error}; asking again"));
+                    alarm(
+                        ctx,
+                        AlarmKind::NoAnswer,
+                        format!("{pallet}: {error}; asking again"),
+                    );
                     ctx.delay(RESET_TIME).await;
                 }
                 if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
-                    ctx.alarm(format!("{error}: taking the pallet off the line"));
+                    alarm(
+                        ctx,
+                        AlarmKind::Jam,
+                        format!("{error}: taking the pallet off the line"),
+                    );
                     relay.clear_jam();
                 }
             }
             Err(error @ DeviceError::Jam { .. }) => {
-                ctx.alarm(format!("{error}: taking the pallet off the line"));
+                alarm(
+                    ctx,
+                    AlarmKind::Jam,
+                    format!("{error}: taking the pallet off the line"),
+                );
                 relay.clear_jam();
             }
             Err(error) => return Err(error),

@@ -13,6 +13,7 @@
 //! arbiter (the monitor task the paper's conclusion points to). The [`report`] sets them side
 //! by side, with what rapier measured.
 
+pub mod alarms;
 pub mod chip;
 pub mod cli;
 pub mod faults;
@@ -26,8 +27,8 @@ pub mod run;
 pub mod tally;
 
 pub use chip::FeederPolicy;
-pub use cli::{USAGE, parse};
+pub use cli::{CliError, parse};
 pub use faults::{CellFault, CellFaultKind};
 pub use report::{Report, speed_line};
-pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, run};
+pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, TimelineConfig, run};
 pub use tally::Tally;

@@ -6,6 +6,7 @@ use std::time::Duration;
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, RobotId, Role, Sim, Station, Target};
 
+use crate::alarms::{AlarmKind, alarm};
 use crate::help::{drive_relay, insisted, retried};
 use crate::names::LineNames;
 use crate::ports::LinePorts;
@@ -69,7 +70,8 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
                     // QUERY ASK_CHILD1.STATUS(RC, NUM_LOADED, CYCLE_TIME): is LOAD_CARD ok?
                     if let Ok((rc, num_loaded, cycle_time)) = ctx.query(&mut ask_child1, ()).await {
                         if rc != 0 {
-                            ctx.alarm(format!("{} reports RC={rc}", n.load_card));
+                            let report = format!("{} reports RC={rc}", n.load_card);
+                            alarm(&ctx, AlarmKind::StepFailed, report);
                         }
                         ctx.state().update(|load_it| {
                             load_it.num_loaded = num_loaded;
@@ -82,7 +84,8 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
                     if let Ok(rc) = ctx.query(&mut ask_child2, ()).await
                         && rc != 0
                     {
-                        ctx.alarm(format!("{} reports RC={rc}", n.screw_in_card));
+                        let report = format!("{} reports RC={rc}", n.screw_in_card);
+                        alarm(&ctx, AlarmKind::StepFailed, report);
                     }
                     // Average many cycle times, and once in a while SEND FREQUENCY(0, CYCLE_TIME).
                     let average = ctx.state().update(|load_it| {
@@ -100,18 +103,22 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
         .exception(timeout1, move |ctx: Ctx<LoadItState>, _| {
             let child = load_card_name.clone();
             async move {
-                ctx.alarm(format!(
-                    "{child} does not answer: killing it and starting a new copy"
-                ));
+                alarm(
+                    &ctx,
+                    AlarmKind::NoAnswer,
+                    format!("{child} does not answer: killing it and starting a new copy"),
+                );
                 ctx.kill(&child);
             }
         })
         .exception(timeout2, move |ctx: Ctx<LoadItState>, _| {
             let child = screw_name.clone();
             async move {
-                ctx.alarm(format!(
-                    "{child} does not answer: killing it and starting a new copy"
-                ));
+                alarm(
+                    &ctx,
+                    AlarmKind::NoAnswer,
+                    format!("{child} does not answer: killing it and starting a new copy"),
+                );
                 ctx.kill(&child);
             }
         })
@@ -175,7 +182,12 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
                 .await;
                 insisted(&ctx, "clearing the pallet", || robot.move_to(Target::Home)).await;
                 if let Err(error) = placed {
-                    ctx.alarm(format!("{pallet}: no card laid ({error}); letting it go"));
+                    let kind = AlarmKind::of_error(&error);
+                    alarm(
+                        &ctx,
+                        kind,
+                        format!("{pallet}: no card laid ({error}); letting it go"),
+                    );
                     task_id.reply(());
                     continue;
                 }
@@ -188,8 +200,12 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
                             card.num_loaded += 1;
                         });
                     }
-                    Ok(rc) => ctx.alarm(format!("{pallet}: the card was not screwed (RC={rc})")),
-                    Err(error) => ctx.alarm(format!("{pallet}: {error}")),
+                    Ok(rc) => alarm(
+                        &ctx,
+                        AlarmKind::StepFailed,
+                        format!("{pallet}: the card was not screwed (RC={rc})"),
+                    ),
+                    Err(error) => alarm(&ctx, AlarmKind::NoAnswer, format!("{pallet}: {error}")),
                 }
                 // REPLY PALLET_IN_PLACE(TASK_ID): release the pallet.
                 task_id.reply(());
@@ -207,13 +223,21 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
     .exception(
         ports.pallet_in_place.handler("TIMEOUT"),
         |ctx: Ctx<LoadCardState>, _| async move {
-            ctx.alarm("no pallet at the load station for 30 s");
+            alarm(
+                &ctx,
+                AlarmKind::Starved,
+                "no pallet at the load station for 30 s",
+            );
         },
     )
     .exception(
         ports.card_in_place.handler("TIMEOUT"),
         |ctx: Ctx<LoadCardState>, _| async move {
-            ctx.alarm("SCREW_IN_CARD did not answer within 30 s");
+            alarm(
+                &ctx,
+                AlarmKind::NoAnswer,
+                "SCREW_IN_CARD did not answer within 30 s",
+            );
         },
     )
 }
@@ -257,7 +281,11 @@ pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()>
                 let rc = match screwed {
                     Ok(()) => 0,
                     Err(error) => {
-                        ctx.alarm(format!("{pallet}: {error}"));
+                        alarm(
+                            &ctx,
+                            AlarmKind::of_error(&error),
+                            format!("{pallet}: {error}"),
+                        );
                         1
                     }
                 };
@@ -266,6 +294,6 @@ pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()>
         }
     })
     .exception(timeout, |ctx: Ctx<()>, _| async move {
-        ctx.alarm("no card to screw for 30 s");
+        alarm(&ctx, AlarmKind::Starved, "no card to screw for 30 s");
     })
 }

@@ -1,19 +1,22 @@
 //! Running the cell: on virtual time (the default) or on the wall clock.
 
-use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
+use imrs_record::{RecordError, Recorder, Timeline};
 use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::{CellErrors, Log, ModuleTree, time::drive};
+use imrs_sim::imrs_core::{CellError, CellErrors, Log, ModuleTree, time::drive};
 use imrs_sim::{
-    Fault, FaultKind, Line, PalletId, RobotId, Role, Sim, SimConfig, SimEvent, Station,
+    Fault, FaultKind, FeederId, Line, PalletId, RobotId, RobotTimes, Role, Sim, SimConfig,
+    SimEvent, Station,
 };
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, chip_it, feeder_monitor};
 use crate::faults::{CellFault, CellFaultKind};
-use crate::gate::{ReleaseDeath, gate};
+use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes, gate};
 use crate::load::{load_card, load_it, screw_in_card};
 use crate::ports::CellPorts;
 use crate::tally::Tally;
@@ -38,6 +41,21 @@ pub struct CellConfig {
     /// How many of the most recent events each log keeps in memory for the record (the
     /// report is folded from every event as it comes, whatever this is).
     pub kept_events: usize,
+    /// Record the run into this MCAP file.
+    pub record: Option<PathBuf>,
+    /// Draw a timeline of a window of the run.
+    pub timeline: Option<TimelineConfig>,
+}
+
+/// Where to draw a timeline, and of which window of the run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimelineConfig {
+    /// The SVG file.
+    pub path: PathBuf,
+    /// Where the window starts, from the start of the run.
+    pub from: Duration,
+    /// How long it is.
+    pub span: Duration,
 }
 
 impl Default for CellConfig {
@@ -51,6 +69,8 @@ impl Default for CellConfig {
             progress: false,
             show_tree: false,
             kept_events: Log::<Event>::DEFAULT_CAPACITY,
+            record: None,
+            timeline: None,
         }
     }
 }
@@ -73,6 +93,12 @@ pub struct RunRecord {
     pub waits: [ZoneWaits; 2],
     /// The module tree at the end of the run, with its vertical and horizontal links.
     pub tree: ModuleTree,
+    /// Each feeder at the end: its id, chip number and stock.
+    pub feeders: Vec<(FeederId, u32, u32)>,
+    /// How each robot spent its time, measured by the simulation.
+    pub robot_times: Vec<(RobotId, RobotTimes)>,
+    /// Each line's GATE's CYCLE_TIME over the run.
+    pub cycle_times: [CycleTimeHistory; 2],
     /// Simulated time.
     pub simulated: Duration,
     /// Wall time the run took.
@@ -89,6 +115,13 @@ pub enum RunError {
     Wiring(CellErrors),
     /// The simulated hours are not a number above 0 and at most [`MAX_HOURS`].
     Hours(f64),
+    /// The recording or the timeline could not be written.
+    Output {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        error: String,
+    },
     /// A fault is set for after the run's end, so it would never fire.
     FaultAfterEnd {
         /// The fault, as `--fault` writes it.
@@ -108,6 +141,9 @@ impl std::fmt::Display for RunError {
                     "{hours} hours: expected a number of hours above 0, at most {MAX_HOURS}"
                 )
             }
+            Self::Output { path, error } => {
+                write!(f, "{}: cannot be written: {error}", path.display())
+            }
             Self::FaultAfterEnd { fault, hours } => write!(
                 f,
                 "--fault {fault}: set for after the run's end ({hours} h), so it would never fire; \
@@ -118,6 +154,25 @@ impl std::fmt::Display for RunError {
 }
 
 impl std::error::Error for RunError {}
+
+impl From<CellErrors> for RunError {
+    fn from(problems: CellErrors) -> Self {
+        Self::Wiring(problems)
+    }
+}
+
+impl From<CellError> for RunError {
+    fn from(problem: CellError) -> Self {
+        Self::Wiring(problem.into())
+    }
+}
+
+fn output(path: &Path, error: RecordError) -> RunError {
+    RunError::Output {
+        path: path.to_path_buf(),
+        error: error.to_string(),
+    }
+}
 
 /// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.
 pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
@@ -138,9 +193,7 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
             .enable_all()
             .build()
             .expect("a tokio runtime starts");
-        runtime
-            .block_on(simulate(config, Arc::new(RealClock::new()), None))
-            .map_err(RunError::Wiring)
+        runtime.block_on(simulate(config, Arc::new(RealClock::new()), None))
     } else {
         let runtime = tokio::runtime::Builder::new_current_thread()
             .enable_all()
@@ -148,9 +201,7 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
             .build()
             .expect("a tokio runtime starts");
         let clock = VirtualClock::new();
-        runtime
-            .block_on(simulate(config, Arc::new(clock.clone()), Some(clock)))
-            .map_err(RunError::Wiring)
+        runtime.block_on(simulate(config, Arc::new(clock.clone()), Some(clock)))
     }?;
     record.wall = wall.elapsed();
     Ok(record)
@@ -160,9 +211,25 @@ async fn simulate(
     config: &CellConfig,
     clock: SharedClock,
     driver: Option<VirtualClock>,
-) -> Result<RunRecord, CellErrors> {
+) -> Result<RunRecord, RunError> {
     let cell = Cell::new(clock.clone());
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
+    // Off unless asked for: with neither, nothing subscribes and nothing is paid.
+    let recorder = match &config.record {
+        Some(path) => {
+            let recorder = Recorder::create(path).map_err(|error| output(path, error))?;
+            recorder.record_cell(cell.events());
+            recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
+            Some(recorder)
+        }
+        None => None,
+    };
+    let timeline = config.timeline.as_ref().map(|window| {
+        let timeline = Timeline::new(window.from, window.from + window.span);
+        timeline.record_cell(cell.events());
+        timeline.record_sim(sim.log());
+        (timeline, &window.path)
+    });
     cell.events().set_capacity(config.kept_events);
     sim.log().set_capacity(config.kept_events);
     let tally = Arc::new(Mutex::new(Tally::default()));
@@ -171,8 +238,10 @@ async fn simulate(
         .subscribe(move |event| lock(&folded).cell(event));
     let folded = Arc::clone(&tally);
     sim.log().subscribe(move |event| lock(&folded).sim(event));
-    let ports = CellPorts::declare(&cell, config.feeder == FeederPolicy::Arbiter)?;
+    let ports = CellPorts::declare(&cell, config.feeder == FeederPolicy::Arbiter)
+        .map_err(CellErrors::from)?;
     let deaths: [ReleaseDeath; 2] = Default::default();
+    let cycle_times: [SharedCycleTimes; 2] = Default::default();
     let waits: SharedWaits = Arc::default();
     inject(config, &sim, &deaths);
 
@@ -180,7 +249,9 @@ async fn simulate(
     let mut declarations = Vec::new();
     for line in Line::ALL {
         let lines = &ports.lines[line.index()];
-        declarations.push(gate(line, lines, &sim, Arc::clone(&deaths[line.index()])).declaration());
+        let (death, history) = (&deaths[line.index()], &cycle_times[line.index()]);
+        declarations
+            .push(gate(line, lines, &sim, Arc::clone(death), Arc::clone(history)).declaration());
         declarations.push(load_it(line, lines, &sim).declaration());
         declarations.push(load_card(line, lines, &sim).declaration());
         declarations.push(screw_in_card(line, lines, &sim).declaration());
@@ -200,9 +271,16 @@ async fn simulate(
     for line in Line::ALL {
         let (lines, sim) = (ports.lines[line.index()].clone(), sim.clone());
         let death = Arc::clone(&deaths[line.index()]);
+        let history = Arc::clone(&cycle_times[line.index()]);
         let (gate_lines, gate_sim) = (lines.clone(), sim.clone());
         cell.supervise(policy, move || {
-            gate(line, &gate_lines, &gate_sim, Arc::clone(&death))
+            gate(
+                line,
+                &gate_lines,
+                &gate_sim,
+                Arc::clone(&death),
+                Arc::clone(&history),
+            )
         })?;
         cell.start(load_it(line, &lines, &sim))?;
         let (all_ports, chip_sim, chip_waits, feeder) = (
@@ -221,19 +299,25 @@ async fn simulate(
     match driver {
         Some(virtual_clock) => {
             let chunk = Duration::from_secs(60);
-            let show = config.progress && std::io::stderr().is_terminal();
+            let bar = progress_bar(config.progress, total);
             let mut reached = Instant::ZERO;
             while reached < end {
                 reached = drive(&virtual_clock, (reached + chunk).min(end)).await;
-                if show {
-                    progress(reached, end);
-                }
+                bar.set_position(reached.since_start().as_secs());
             }
-            if show {
-                eprintln!();
-            }
+            bar.finish_and_clear();
         }
         None => tokio::time::sleep(total).await,
+    }
+    if let Some(recorder) = &recorder {
+        recorder
+            .finish()
+            .map_err(|error| output(recorder.path(), error))?;
+    }
+    if let Some((timeline, path)) = &timeline {
+        timeline
+            .render_svg(path)
+            .map_err(|error| output(path, error))?;
     }
     let waits = *waits.lock().unwrap_or_else(PoisonError::into_inner);
     Ok(RunRecord {
@@ -244,6 +328,14 @@ async fn simulate(
         pallets_left: sim.pallets(),
         waits,
         tree: cell.tree(),
+        feeders: sim.feeders(),
+        robot_times: sim.robot_times(),
+        cycle_times: cycle_times.each_ref().map(|history| {
+            history
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .clone()
+        }),
         simulated: total,
         wall: Duration::ZERO,
     })
@@ -267,16 +359,21 @@ fn inject(config: &CellConfig, sim: &Sim, deaths: &[ReleaseDeath; 2]) {
     }
 }
 
-fn progress(reached: Instant, end: Instant) {
-    let share = reached.since_start().as_secs_f64() / end.since_start().as_secs_f64().max(1e-9);
-    let filled = (share * 40.0).round() as usize;
-    eprint!(
-        "\r[{}{}] {:>5.1}% of the simulated run",
-        "#".repeat(filled),
-        ".".repeat(40 - filled.min(40)),
-        share * 100.0
-    );
-    let _ = std::io::stderr().flush();
+/// A bar of simulated seconds with its rate and the time left, drawn on stderr only when it
+/// is a terminal (indicatif hides it otherwise) and the run asked for one.
+fn progress_bar(wanted: bool, total: Duration) -> ProgressBar {
+    let target = if wanted {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(total.as_secs()), target);
+    if let Ok(style) =
+        ProgressStyle::with_template("{bar:40} {pos}/{len} simulated s, {per_sec}, {eta} left")
+    {
+        bar.set_style(style);
+    }
+    bar
 }
 
 fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {

@@ -4,10 +4,16 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use imrs_sim::imrs_core::imrs_ports::Name;
 use imrs_sim::imrs_core::{Event, EventKind};
-use imrs_sim::{Line, PalletId, RobotId, SimEvent, SimEventKind};
+use imrs_sim::{Line, PalletId, RobotId, SimEvent, SimEventKind, Station};
 
+use crate::alarms::AlarmKind;
+use crate::chip::{chips_per_card, place_of_chip};
 use crate::report::LineFigures;
+
+/// How far a chip may lie from its work-schedule place, in metres.
+pub const PLACE_TOLERANCE: f32 = 0.001;
 
 /// At most this many offending pallets are named per broken invariant; the rest are counted
 /// in the invariant's verdict all the same.
@@ -16,7 +22,7 @@ const NAMED_OFFENDERS: usize = 16;
 /// The gaps between completed pallets of one line: their sum (added gap by gap, in order),
 /// their number and the worst.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Cycles {
+pub struct Cycles {
     last_done: Option<f64>,
     sum: f64,
     count: u32,
@@ -35,7 +41,7 @@ impl Cycles {
     }
 
     /// The mean and worst gap, once there is one.
-    pub(crate) fn mean_and_worst(&self) -> Option<(f64, f64)> {
+    pub fn mean_and_worst(&self) -> Option<(f64, f64)> {
         (self.count > 0).then(|| (self.sum / f64::from(self.count), self.worst))
     }
 }
@@ -61,8 +67,25 @@ pub struct Tally {
     pub(crate) timeouts: BTreeMap<String, u32>,
     pub(crate) restarts: u32,
     pub(crate) alarms: u32,
+    /// Alarms per kind; `None` for an alarm raised without one (by the core itself).
+    pub(crate) alarm_kinds: BTreeMap<Option<AlarmKind>, u32>,
     pub(crate) deadlocks: u32,
     pub(crate) last_deadlock: Option<f64>,
+    /// The (module, port) waits of the deadlocks not yet broken.
+    stuck: Vec<(Name, Name)>,
+    /// Robot-seconds the members of deadlocks spent blocked in them.
+    pub(crate) deadlock_lost: f64,
+    /// Per line and station, the gaps between pallets held in place.
+    pub(crate) stations: [[Cycles; 2]; 2],
+    /// Chips whose place on the card was checked, the worst distance from the work
+    /// schedule's place (metres), and the pallets with a chip beyond the tolerance.
+    pub(crate) chips_checked: u32,
+    pub(crate) worst_place: f32,
+    pub(crate) misplaced: u32,
+    pub(crate) misplaced_on: Vec<PalletId>,
+    /// Per feeder, how often it was found empty and refilled.
+    pub(crate) feeder_empties: [u32; 4],
+    pub(crate) feeder_refills: [u32; 4],
 }
 
 fn name(offenders: &mut Vec<PalletId>, pallet: PalletId) {
@@ -86,6 +109,12 @@ impl Tally {
                 let figures = &mut self.lines[line.index()];
                 figures.completed += 1;
                 figures.chips += chips;
+                // Note 5: a card that missed a step leaves all the same, short.
+                if *chips >= chips_per_card() {
+                    figures.good += 1;
+                } else {
+                    figures.short += 1;
+                }
                 self.cycles[line.index()].done(at);
                 self.left_the_line(*line, *pallet);
             }
@@ -102,9 +131,23 @@ impl Tally {
                 }
                 self.screwed.insert((*line, *pallet));
             }
-            SimEventKind::ChipInserted { line, pallet, .. } => {
+            SimEventKind::ChipInserted {
+                line,
+                pallet,
+                chip,
+                on_card,
+            } => {
                 if !self.screwed.contains(&(*line, *pallet)) {
                     name(&mut self.early_chip, *pallet);
+                }
+                self.chips_checked += 1;
+                let off = place_of_chip(*chip).map_or(f32::INFINITY, |place| {
+                    ((on_card[0] - place[0]).powi(2) + (on_card[1] - place[1]).powi(2)).sqrt()
+                });
+                self.worst_place = self.worst_place.max(off);
+                if off > PLACE_TOLERANCE {
+                    self.misplaced += 1;
+                    name(&mut self.misplaced_on, *pallet);
                 }
                 self.chips_inserted_after[line.index()] = Some(at);
             }
@@ -123,6 +166,23 @@ impl Tally {
                 }
             }
             SimEventKind::Collision { .. } => self.collisions += 1,
+            SimEventKind::PalletInPlace { line, station, .. } => {
+                let index = match station {
+                    Station::Load => 0,
+                    Station::Chip => 1,
+                };
+                self.stations[line.index()][index].done(at);
+            }
+            SimEventKind::FeederEmptied { feeder } => {
+                if let Some(count) = self.feeder_empties.get_mut(usize::from(feeder.0)) {
+                    *count += 1;
+                }
+            }
+            SimEventKind::FeederRefilled { feeder, .. } => {
+                if let Some(count) = self.feeder_refills.get_mut(usize::from(feeder.0)) {
+                    *count += 1;
+                }
+            }
             _ => {}
         }
     }
@@ -138,10 +198,25 @@ impl Tally {
             EventKind::TaskRestarted { .. } | EventKind::ModuleRestarted { .. } => {
                 self.restarts += 1;
             }
-            EventKind::Alarm { .. } => self.alarms += 1,
-            EventKind::Deadlock { .. } => {
+            EventKind::Alarm { message } => {
+                self.alarms += 1;
+                *self.alarm_kinds.entry(AlarmKind::of(message)).or_insert(0) += 1;
+            }
+            EventKind::Deadlock { cycle } => {
                 self.deadlocks += 1;
                 self.last_deadlock = Some(event.at.since_start().as_secs_f64());
+                self.stuck.extend(cycle.iter().cloned());
+            }
+            // A member of a deadlock is freed when its wait ends, by a reply or a timeout:
+            // the whole wait was lost to the deadlock.
+            EventKind::Sent { port, waited }
+            | EventKind::Queried { port, waited }
+            | EventKind::PortError { port, waited, .. } => {
+                let member = (event.module.clone(), port.clone());
+                if let Some(index) = self.stuck.iter().position(|stuck| *stuck == member) {
+                    self.stuck.swap_remove(index);
+                    self.deadlock_lost += waited.as_secs_f64();
+                }
             }
             _ => {}
         }

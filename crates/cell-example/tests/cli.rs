@@ -16,8 +16,11 @@ fn args(list: &[&str]) -> Vec<OsString> {
 fn an_argument_that_is_not_utf8_is_refused_by_name() {
     let bad = OsString::from_vec(vec![b'-', b'-', b'h', 0xff, b'u']);
     let refused = parse([OsString::from("--hours"), bad]).unwrap_err();
+    assert_eq!(refused.status, 2);
     assert!(
-        refused.starts_with("argument \"--h\u{fffd}u\" is not valid UTF-8"),
+        refused
+            .message
+            .starts_with("error: argument \"--h\u{fffd}u\" is not valid UTF-8"),
         "{refused}"
     );
 }
@@ -33,7 +36,64 @@ fn flags_parse_into_a_config() {
         (2.0, 7, FeederPolicy::Appendix)
     );
     let refused = parse(args(&["--hours"])).unwrap_err();
-    assert!(refused.starts_with("--hours needs a value"), "{refused}");
+    assert_eq!(refused.status, 2);
+    assert!(
+        refused
+            .message
+            .starts_with("error: a value is required for '--hours <H>'"),
+        "{refused}"
+    );
+}
+
+#[test]
+fn a_bad_value_is_refused_naming_its_flag_and_what_was_expected() {
+    for (flags, expected) in [
+        (
+            &["--hours", "-3"][..],
+            "invalid value '-3' for '--hours <H>': expected a number of hours above 0",
+        ),
+        (
+            &["--feeder", "monitor"][..],
+            "invalid value 'monitor' for '--feeder <FEEDER>'",
+        ),
+        (
+            &["--fault", "robot:C@10"][..],
+            "invalid value 'robot:C@10' for '--fault <KIND[:WHICH]@TIME>': the line must be A or B",
+        ),
+        (
+            &["--timeline-span", "soon"][..],
+            "invalid value 'soon' for '--timeline-span <SECONDS>'",
+        ),
+        (&["--speed", "2"][..], "unexpected argument '--speed'"),
+    ] {
+        let refused = parse(args(flags)).unwrap_err();
+        assert_eq!(refused.status, 2, "{flags:?}");
+        assert!(refused.message.contains(expected), "{flags:?}: {refused}");
+    }
+}
+
+#[test]
+fn help_lists_every_flag_with_its_meaning_and_default() {
+    let help = parse(args(&["--help"])).unwrap_err();
+    assert_eq!(help.status, 0, "{help}");
+    for flag in [
+        "--hours <H>",
+        "[default: 1]",
+        "--seed <S>",
+        "[default: 1985]",
+        "--feeder <FEEDER>",
+        "[default: arbiter]",
+        "--realtime",
+        "--tree",
+        "--fault <KIND[:WHICH]@TIME>",
+        "--record <FILE.mcap>",
+        "--timeline <FILE.svg>",
+        "--timeline-from <SECONDS>",
+        "--timeline-span <SECONDS>",
+        "--no-progress",
+    ] {
+        assert!(help.message.contains(flag), "{flag:?} in\n{help}");
+    }
 }
 
 #[test]

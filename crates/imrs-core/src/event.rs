@@ -7,6 +7,7 @@
 //! [`EventLog::subscribe`].
 
 use std::fmt;
+use std::time::Duration;
 
 use imrs_ports::{Instant, Name};
 
@@ -23,6 +24,38 @@ pub struct Event {
     pub task: Option<Name>,
     /// What.
     pub kind: EventKind,
+}
+
+/// A primitive of a module's tasks on a port or a rendezvous.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Primitive {
+    /// `SEND`: waits for the reply.
+    Send,
+    /// `RECEIVE`: waits for a message.
+    Receive,
+    /// `QUERY`: waits for the answer.
+    Query,
+    /// `waitfor`: waits for every member.
+    WaitFor,
+}
+
+impl Primitive {
+    /// Whether the module waits on a peer's answer (a send or a query), rather than for
+    /// work to come (a receive) or for a rendezvous.
+    pub fn awaits_a_peer(self) -> bool {
+        matches!(self, Primitive::Send | Primitive::Query)
+    }
+}
+
+impl fmt::Display for Primitive {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Primitive::Send => "send",
+            Primitive::Receive => "receive",
+            Primitive::Query => "query",
+            Primitive::WaitFor => "waitfor",
+        })
+    }
 }
 
 /// What happened.
@@ -76,16 +109,22 @@ pub enum EventKind {
     Sent {
         /// The port.
         port: Name,
+        /// How long the send waited for its reply.
+        waited: Duration,
     },
     /// A message was received.
     Received {
         /// The port.
         port: Name,
+        /// How long the receive waited for a message.
+        waited: Duration,
     },
     /// A query was answered.
     Queried {
         /// The port.
         port: Name,
+        /// How long the query waited for its answer.
+        waited: Duration,
     },
     /// A primitive failed.
     PortError {
@@ -93,6 +132,10 @@ pub enum EventKind {
         port: Name,
         /// The error.
         error: String,
+        /// How long the primitive waited before it failed.
+        waited: Duration,
+        /// Which primitive failed.
+        primitive: Primitive,
     },
     /// A response handler answered a query.
     Responded {
@@ -168,10 +211,10 @@ impl fmt::Display for Event {
             EventKind::TaskRestarted { attempt } => write!(f, "task restarted (#{attempt})"),
             EventKind::SectionEntered { section } => write!(f, "entered {section}"),
             EventKind::SectionLeft { section } => write!(f, "left {section}"),
-            EventKind::Sent { port } => write!(f, "sent on {port}"),
-            EventKind::Received { port } => write!(f, "received on {port}"),
-            EventKind::Queried { port } => write!(f, "queried {port}"),
-            EventKind::PortError { port, error } => write!(f, "{port}: {error}"),
+            EventKind::Sent { port, .. } => write!(f, "sent on {port}"),
+            EventKind::Received { port, .. } => write!(f, "received on {port}"),
+            EventKind::Queried { port, .. } => write!(f, "queried {port}"),
+            EventKind::PortError { port, error, .. } => write!(f, "{port}: {error}"),
             EventKind::Responded { handler } => write!(f, "responded {handler}"),
             EventKind::ExceptionRaised { exception } => write!(f, "raised {exception}"),
             EventKind::ExceptionHandled { exception } => write!(f, "handling {exception}"),

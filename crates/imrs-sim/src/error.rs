@@ -19,6 +19,13 @@ pub enum DeviceError {
         /// The target, in metres.
         target: [i32; 2],
     },
+    /// A place on the card that lies off the card.
+    OffCard {
+        /// The robot.
+        robot: RobotId,
+        /// The place asked for, in millimetres from the card's corner.
+        at: [i32; 2],
+    },
     /// No feeder has that number.
     UnknownFeeder {
         /// The feeder asked for.
@@ -77,6 +84,11 @@ impl fmt::Display for DeviceError {
                     target[0], target[1]
                 )
             }
+            Self::OffCard { robot, at } => write!(
+                f,
+                "{robot} was sent to ({} mm, {} mm) on the card, which lies off the card",
+                at[0], at[1]
+            ),
             Self::UnknownFeeder { feeder } => write!(f, "there is no {feeder}"),
             Self::EmptyFeeder { feeder, chip } => write!(f, "{feeder} (chip {chip}) is empty"),
             Self::NotThere { robot, at } => write!(f, "{robot} is not at the {at}"),

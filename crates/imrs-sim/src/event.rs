@@ -103,6 +103,14 @@ pub enum SimEventKind {
         pallet: PalletId,
         /// The chip number.
         chip: u32,
+        /// Where on the card it went: metres from the card's corner, along the conveyor and
+        /// across it, measured from the tool against the pallet's pose in rapier.
+        on_card: [f32; 2],
+    },
+    /// A robot found a feeder empty, and the operator was called to refill it.
+    FeederEmptied {
+        /// The feeder.
+        feeder: crate::ids::FeederId,
     },
     /// The operator refilled an empty feeder.
     FeederRefilled {
@@ -156,8 +164,19 @@ impl fmt::Display for SimEvent {
             SimEventKind::CardScrewed { line, pallet } => {
                 write!(f, "line {line:?}: card screwed on {pallet}")
             }
-            SimEventKind::ChipInserted { line, pallet, chip } => {
-                write!(f, "line {line:?}: chip {chip} inserted on {pallet}")
+            SimEventKind::ChipInserted {
+                line,
+                pallet,
+                chip,
+                on_card,
+            } => write!(
+                f,
+                "line {line:?}: chip {chip} inserted on {pallet} at ({:.0} mm, {:.0} mm)",
+                on_card[0] * 1000.0,
+                on_card[1] * 1000.0
+            ),
+            SimEventKind::FeederEmptied { feeder } => {
+                write!(f, "{feeder} found empty: the operator is called")
             }
             SimEventKind::FeederRefilled { feeder, chips } => {
                 write!(f, "{feeder} refilled with {chips} chips")

@@ -26,6 +26,10 @@ pub const PALLET_PITCH: f32 = 0.35;
 /// A pallet's half extents.
 pub const PALLET_HALF: [f32; 3] = [0.15, 0.1, 0.02];
 
+/// A card's size: along the conveyor, then across it. The card lies centred on its pallet;
+/// places on it are measured from its corner nearest the gate and line A.
+pub const CARD_SIZE: [f32; 2] = [0.08, 0.10];
+
 /// The two links of every arm.
 pub const LINK_1: f32 = 0.4;
 /// The second link, to the tool.

@@ -48,6 +48,7 @@ pub mod layout;
 pub mod profile;
 mod rng;
 pub mod scara;
+mod scene;
 mod sim;
 mod world;
 
@@ -58,5 +59,6 @@ pub use fault::{Fault, FaultKind};
 pub use ids::{FeederId, Line, PalletId, RobotId, Role, Station};
 pub use imrs_core;
 pub use rng::Rng;
+pub use scene::{ArmPose, BoxPose, FeederView, LinkPose, PalletPose, Scene};
 pub use sim::{Sim, SimConfig};
-pub use world::{FEEDER_CHIPS, Target};
+pub use world::{FEEDER_CHIPS, RobotTimes, Target};

@@ -3,6 +3,7 @@
 
 use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
 
 use imrs_core::imrs_ports::{Instant, SharedClock};
 use tokio::sync::Notify;
@@ -13,7 +14,8 @@ use crate::event::{SimEvent, SimLog};
 use crate::fault::Fault;
 use crate::ids::{FeederId, Line, PalletId, RobotId, Station};
 use crate::layout::STEP;
-use crate::world::{World, next_step_after};
+use crate::scene::Scene;
+use crate::world::{RobotTimes, World, next_step_after};
 
 /// How the cell is set up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,6 +47,14 @@ struct Shared {
     /// channel: its waiters are woken in a random order, and runs must be reproducible.)
     stepped: Notify,
     log: SimLog,
+    watchers: Mutex<Vec<Watcher>>,
+}
+
+/// Someone who draws the scene, at most once per `period` of the clock.
+struct Watcher {
+    period: Duration,
+    next: Instant,
+    see: Box<dyn FnMut(&Scene) + Send>,
 }
 
 impl Sim {
@@ -57,6 +67,7 @@ impl Sim {
                 activity: Notify::new(),
                 stepped: Notify::new(),
                 log: SimLog::default(),
+                watchers: Mutex::new(Vec::new()),
             }),
         }
     }
@@ -78,7 +89,40 @@ impl Sim {
             events
                 .into_iter()
                 .for_each(|event| self.shared.log.record(event));
+            self.tell_watchers(next);
             self.shared.stepped.notify_waiters();
+        }
+    }
+
+    /// The cell as rapier has it now.
+    pub fn scene(&self) -> Scene {
+        let now = self.now();
+        self.world().scene(now)
+    }
+
+    /// Calls `see` with the scene now, then after steps of the world, at most once per
+    /// `period` of the clock (a zero period: after every step). The world steps only while
+    /// something moves, so a still cell costs its watchers nothing: the last scene they saw
+    /// is still true.
+    pub fn watch(&self, period: Duration, mut see: impl FnMut(&Scene) + Send + 'static) {
+        let scene = self.scene();
+        see(&scene);
+        lock(&self.shared.watchers).push(Watcher {
+            period,
+            next: scene.at + period,
+            see: Box::new(see),
+        });
+    }
+
+    fn tell_watchers(&self, now: Instant) {
+        let mut watchers = lock(&self.shared.watchers);
+        if watchers.iter().all(|watcher| watcher.next > now) {
+            return;
+        }
+        let scene = self.world().scene(now);
+        for watcher in watchers.iter_mut().filter(|watcher| watcher.next <= now) {
+            (watcher.see)(&scene);
+            watcher.next = now + watcher.period;
         }
     }
 
@@ -128,6 +172,11 @@ impl Sim {
         self.world().pallet_positions()
     }
 
+    /// How each robot spent its time so far, as measured by the simulation.
+    pub fn robot_times(&self) -> Vec<(RobotId, RobotTimes)> {
+        self.world().robot_times()
+    }
+
     /// Each feeder's chip number and the chips it has left.
     pub fn feeders(&self) -> Vec<(FeederId, u32, u32)> {
         self.world()
@@ -172,6 +221,11 @@ impl Sim {
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
     }
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // A watcher that panicked leaves the list as it was: still whole.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 impl fmt::Debug for Sim {

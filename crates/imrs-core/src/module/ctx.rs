@@ -22,7 +22,7 @@ use tracing::Instrument;
 use super::spec::ModuleSpec;
 use crate::cell::{CellShared, Children, ModuleHandle, spawn_module};
 use crate::check::CellError;
-use crate::event::{Event, EventKind};
+use crate::event::{Event, EventKind, Primitive};
 use crate::exception::Exception;
 use crate::order::{Order, Rank};
 use crate::supervision::RestartPolicy;
@@ -296,9 +296,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
-        PortOp::new(self, port, Some(waiting), end.send(message), |port| {
-            EventKind::Sent { port }
-        })
+        PortOp::new(
+            self,
+            port,
+            Some(waiting),
+            end.send(message),
+            Primitive::Send,
+            |port, waited| EventKind::Sent { port, waited },
+        )
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -312,9 +317,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         U: Receives,
     {
         let port = end.port().clone();
-        PortOp::new(self, port, None, end.receive(), |port| {
-            EventKind::Received { port }
-        })
+        PortOp::new(
+            self,
+            port,
+            None,
+            end.receive(),
+            Primitive::Receive,
+            |port, waited| EventKind::Received { port, waited },
+        )
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -330,9 +340,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
-        PortOp::new(self, port, Some(waiting), end.query(query), |port| {
-            EventKind::Queried { port }
-        })
+        PortOp::new(
+            self,
+            port,
+            Some(waiting),
+            end.query(query),
+            Primitive::Query,
+            |port, waited| EventKind::Queried { port, waited },
+        )
     }
 
     /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
@@ -347,6 +362,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     where
         M: Send + Sync + 'static,
     {
+        let since = self.now();
         let result = barrier
             .waitfor(self.task.as_str(), message, combine, timeout)
             .await;
@@ -356,7 +372,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
             }),
             Err(error) => {
                 let timed_out = matches!(error, WaitForError::Timeout { .. });
-                self.port_failed(barrier.name().clone(), error.to_string(), timed_out);
+                let waited = self.now().saturating_duration_since(since);
+                self.port_failed(
+                    barrier.name().clone(),
+                    Primitive::WaitFor,
+                    error.to_string(),
+                    waited,
+                    timed_out,
+                );
             }
         }
         result
@@ -463,10 +486,19 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         self.module.event(Some(&self.task), kind);
     }
 
-    fn port_failed(&self, port: Name, error: String, timed_out: bool) {
+    fn port_failed(
+        &self,
+        port: Name,
+        primitive: Primitive,
+        error: String,
+        waited: Duration,
+        timed_out: bool,
+    ) {
         self.event(EventKind::PortError {
             port: port.clone(),
             error: error.clone(),
+            waited,
+            primitive,
         });
         if timed_out {
             self.module.raise(Exception {
@@ -576,7 +608,9 @@ pin_project_lite::pin_project! {
         ctx: &'a Ctx<S>,
         port: Option<Name>,
         waiting: Option<WaitGuard>,
-        done: fn(Name) -> EventKind,
+        since: Instant,
+        primitive: Primitive,
+        done: fn(Name, Duration) -> EventKind,
         #[pin]
         operation: F,
     }
@@ -588,12 +622,15 @@ impl<'a, S, F> PortOp<'a, S, F> {
         port: Name,
         waiting: Option<WaitGuard>,
         operation: F,
-        done: fn(Name) -> EventKind,
+        primitive: Primitive,
+        done: fn(Name, Duration) -> EventKind,
     ) -> Self {
         Self {
             ctx,
             port: Some(port),
             waiting,
+            since: ctx.module.cell.clock.now(),
+            primitive,
             done,
             operation,
         }
@@ -613,11 +650,16 @@ where
         let result = std::task::ready!(this.operation.poll(cx));
         drop(this.waiting.take());
         let port = this.port.take().expect("a port operation completes once");
+        let waited = this.ctx.now().saturating_duration_since(*this.since);
         match &result {
-            Ok(_) => this.ctx.event((this.done)(port)),
-            Err(error) => this
-                .ctx
-                .port_failed(port, error.to_string(), error.is_timeout()),
+            Ok(_) => this.ctx.event((this.done)(port, waited)),
+            Err(error) => this.ctx.port_failed(
+                port,
+                *this.primitive,
+                error.to_string(),
+                waited,
+                error.is_timeout(),
+            ),
         }
         Poll::Ready(result)
     }

@@ -41,7 +41,7 @@ impl Robot {
             Ok(world.arm(robot).start_move(now, to))
         })?;
         self.sim.wake_stepper();
-        let outcome = self.busy(duration).await;
+        let outcome = self.spend(duration, true).await;
         self.sim.with(|world, now| {
             let (arm, physics) = world.arm_and_physics(robot);
             arm.stop(now, physics);
@@ -53,7 +53,7 @@ impl Robot {
     /// calls the operator: it is refilled [`REFILL_DELAY`](crate::layout::REFILL_DELAY) later.
     pub async fn grasp(&self, feeder: FeederId) -> Result<u32, DeviceError> {
         self.require_at(Target::Feeder(feeder), "feeder")?;
-        self.busy(GRASP_TIME).await?;
+        self.spend_working(GRASP_TIME).await?;
         let robot = self.id;
         self.sim.with(|world, now| {
             let feeder = world
@@ -71,15 +71,25 @@ impl Robot {
         })
     }
 
-    /// Inserts the chip it holds into the card on the pallet its station holds.
+    /// Inserts the chip it holds into the card on the pallet its station holds, where the
+    /// tool is over the card (the simulation records the place, measured against the
+    /// pallet's pose).
     pub async fn insert(&self) -> Result<u32, DeviceError> {
         let robot = self.id;
-        self.require_at(Target::Card, "card")?;
+        let over_card = self
+            .sim
+            .with(|world, now| world.tool_on_card(robot, now).is_some());
+        if !over_card {
+            return Err(DeviceError::NotThere { robot, at: "card" });
+        }
         let Some(Held::Chip(chip)) = self.sim.with(|world, _| world.arm(robot).holding) else {
             return Err(DeviceError::NothingHeld { robot });
         };
-        self.busy(INSERT_TIME).await?;
+        self.spend_working(INSERT_TIME).await?;
         self.on_pallet(Station::Chip, |world, pallet_line, now| {
+            let on_card = world
+                .tool_on_card(robot, now)
+                .ok_or(DeviceError::NotThere { robot, at: "card" })?;
             let pallet = world.held_pallet(pallet_line, Station::Chip)?;
             if !pallet.screwed {
                 return Err(DeviceError::NotReady {
@@ -96,6 +106,7 @@ impl Robot {
                     line: pallet_line,
                     pallet,
                     chip,
+                    on_card,
                 },
             })
         })?;
@@ -105,7 +116,7 @@ impl Robot {
     /// Picks a blank card from the magazine, where the tool must be.
     pub async fn pick_card(&self) -> Result<(), DeviceError> {
         self.require_at(Target::Magazine, "magazine")?;
-        self.busy(PICK_CARD_TIME).await?;
+        self.spend_working(PICK_CARD_TIME).await?;
         let robot = self.id;
         self.sim
             .with(|world, _| world.arm(robot).holding = Some(Held::Card));
@@ -119,7 +130,7 @@ impl Robot {
         if self.sim.with(|world, _| world.arm(robot).holding) != Some(Held::Card) {
             return Err(DeviceError::NothingHeld { robot });
         }
-        self.busy(PLACE_CARD_TIME).await?;
+        self.spend_working(PLACE_CARD_TIME).await?;
         self.on_pallet(Station::Load, |world, line, now| {
             let pallet = world.held_pallet(line, Station::Load)?;
             if pallet.card {
@@ -141,7 +152,7 @@ impl Robot {
     /// Screws the card on the pallet its station holds to the pallet.
     pub async fn screw(&self) -> Result<(), DeviceError> {
         self.require_at(Target::Card, "card")?;
-        self.busy(SCREW_TIME).await?;
+        self.spend_working(SCREW_TIME).await?;
         self.on_pallet(Station::Load, |world, line, now| {
             let pallet = world.held_pallet(line, Station::Load)?;
             if !pallet.card {
@@ -189,7 +200,23 @@ impl Robot {
         Ok(())
     }
 
-    /// Spends `duration` working, unless an injected fault strikes first.
+    /// Spends `duration` working at a place, counted as working time.
+    async fn spend_working(&self, duration: Duration) -> Result<(), DeviceError> {
+        self.spend(duration, false).await
+    }
+
+    /// Spends `duration` moving or working, unless an injected fault strikes first; the time
+    /// actually spent is counted either way.
+    async fn spend(&self, duration: Duration, moving: bool) -> Result<(), DeviceError> {
+        let start = self.sim.now();
+        let outcome = self.busy(duration).await;
+        let spent = self.sim.now().saturating_duration_since(start);
+        let robot = self.id;
+        self.sim.with(|world, _| world.spend(robot, spent, moving));
+        outcome
+    }
+
+    /// Spends `duration`, unless an injected fault strikes first.
     async fn busy(&self, duration: Duration) -> Result<(), DeviceError> {
         let robot = self.id;
         let (start, fault) = self

@@ -170,10 +170,22 @@ impl Conveyor {
     }
 
     /// Every pallet on the line with its position, as rapier has it.
+    /// The pallets on the line, front first.
+    pub(crate) fn pallets(&self) -> impl Iterator<Item = &Pallet> {
+        self.pallets.iter()
+    }
+
     pub(crate) fn positions(&self, physics: &Physics) -> Vec<(PalletId, [f32; 3])> {
         self.pallets
             .iter()
             .map(|pallet| (pallet.id, physics.position_of(pallet.body)))
             .collect()
+    }
+}
+
+impl Pallet {
+    /// The pallet's collider, which rapier places.
+    pub(crate) fn body(&self) -> ColliderHandle {
+        self.body
     }
 }

@@ -18,10 +18,12 @@ use crate::event::{SimEvent, SimEventKind};
 use crate::fault::{Fault, FaultKind};
 use crate::ids::{FeederId, Line, PalletId, RobotId, Role, Station};
 use crate::layout::{
-    CHIP_X, FEEDER_X, LOAD_X, REACH_TOLERANCE, REFILL_CHIPS, REFILL_DELAY, ZONE_CENTRE, line_y,
+    CARD_SIZE, CHIP_X, FEEDER_X, LOAD_X, PALLET_HALF, REACH_TOLERANCE, REFILL_CHIPS, REFILL_DELAY,
+    ZONE_CENTRE, line_y,
 };
 use crate::rng::Rng;
 use crate::scara::Elbow;
+use crate::scene::{ArmPose, BoxPose, FeederView, PalletPose, Scene};
 
 pub(crate) use self::conveyor::Pallet;
 
@@ -32,8 +34,11 @@ pub enum Target {
     Home,
     /// Above a feeder of the shared zone.
     Feeder(FeederId),
-    /// Above the card on the pallet its station holds.
+    /// Above the centre of the card on the pallet its station holds.
     Card,
+    /// Above a place on that card: metres from the card's corner nearest the gate and line
+    /// A, along the conveyor and across it (see [`CARD_SIZE`](crate::layout::CARD_SIZE)).
+    OnCard([f32; 2]),
     /// Above the magazine of blank cards (for the card-loading robot).
     Magazine,
     /// Any point of the working plane, in metres.
@@ -66,6 +71,16 @@ pub(crate) struct World {
     next_pallet: u32,
     pending: Vec<SimEvent>,
     rng: Rng,
+    times: Vec<RobotTimes>,
+}
+
+/// How a robot spent its time, as the simulation measured it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RobotTimes {
+    /// Moving its tool.
+    pub moving: Duration,
+    /// Working at a place: grasping, inserting, picking, placing, screwing.
+    pub working: Duration,
 }
 
 /// Where each robot stands: its base, its resting tool position, its elbow side, and (for the
@@ -152,6 +167,7 @@ impl World {
             next_pallet: 0,
             pending: Vec::new(),
             rng,
+            times: vec![RobotTimes::default(); RobotId::ALL.len()],
         };
         world.physics.detect();
         world
@@ -249,9 +265,33 @@ impl World {
 
     /// Calls the operator to a feeder found empty; it will be refilled after a while.
     pub(crate) fn report_empty(&mut self, feeder: FeederId, now: Instant) {
-        if let Some(feeder) = self.feeders.iter_mut().find(|f| f.id == feeder) {
-            feeder.refill_at.get_or_insert(now + REFILL_DELAY);
+        if let Some(feeder) = self.feeders.iter_mut().find(|f| f.id == feeder)
+            && feeder.refill_at.is_none()
+        {
+            feeder.refill_at = Some(now + REFILL_DELAY);
+            self.pending.push(SimEvent {
+                at: now,
+                kind: SimEventKind::FeederEmptied { feeder: feeder.id },
+            });
         }
+    }
+
+    /// Adds time a robot spent moving or working.
+    pub(crate) fn spend(&mut self, robot: RobotId, spent: Duration, moving: bool) {
+        let times = &mut self.times[robot.index()];
+        if moving {
+            times.moving += spent;
+        } else {
+            times.working += spent;
+        }
+    }
+
+    /// How each robot spent its time so far.
+    pub(crate) fn robot_times(&self) -> Vec<(RobotId, RobotTimes)> {
+        RobotId::ALL
+            .iter()
+            .map(|&robot| (robot, self.times[robot.index()]))
+            .collect()
     }
 
     fn refill_due(&mut self, now: Instant) {
@@ -356,7 +396,6 @@ impl World {
     /// The point a robot's target names: an unknown feeder, or a point that is no point, is
     /// an error.
     pub(crate) fn point_of(&self, robot: RobotId, target: Target) -> Result<[f32; 2], DeviceError> {
-        let y = line_y(robot.line.index());
         match target {
             Target::Home => Ok(self.arms[robot.index()].home),
             Target::Feeder(feeder) => self
@@ -365,10 +404,24 @@ impl World {
                 .find(|f| f.id == feeder)
                 .map(|f| f.at)
                 .ok_or(DeviceError::UnknownFeeder { feeder }),
-            Target::Card => Ok(match robot.role {
-                Role::LoadCard | Role::ScrewInCard => [LOAD_X, y],
-                Role::ChipIt => [CHIP_X, y],
-            }),
+            Target::Card => Ok(Self::card_centre(robot)),
+            Target::OnCard(place) => {
+                let on_card = place
+                    .iter()
+                    .zip(CARD_SIZE)
+                    .all(|(&at, size)| (0.0..=size).contains(&at));
+                if !on_card {
+                    return Err(DeviceError::OffCard {
+                        robot,
+                        at: place.map(|metres| (metres * 1000.0).round() as i32),
+                    });
+                }
+                let centre = Self::card_centre(robot);
+                Ok([
+                    centre[0] - CARD_SIZE[0] / 2.0 + place[0],
+                    centre[1] - CARD_SIZE[1] / 2.0 + place[1],
+                ])
+            }
             Target::Magazine => Ok(magazine(robot.line)),
             Target::Point(point) if point.iter().all(|c| c.is_finite()) => Ok(point),
             Target::Point(_) => Err(DeviceError::OutOfReach {
@@ -376,6 +429,34 @@ impl World {
                 target: [i32::MAX, i32::MAX],
             }),
         }
+    }
+
+    /// Where the card at `robot`'s station lies when its pallet is held: centred on it.
+    fn card_centre(robot: RobotId) -> [f32; 2] {
+        let y = line_y(robot.line.index());
+        match robot.role {
+            Role::LoadCard | Role::ScrewInCard => [LOAD_X, y],
+            Role::ChipIt => [CHIP_X, y],
+        }
+    }
+
+    /// Where `robot`'s tool is on the card of the pallet its station holds, in metres from
+    /// the card's corner, measured against the pallet's pose in rapier; `None` unless the
+    /// tool is over the card.
+    pub(crate) fn tool_on_card(&mut self, robot: RobotId, now: Instant) -> Option<[f32; 2]> {
+        let tool = self.arms[robot.index()].tool_at(now);
+        let station = Self::station_of(robot);
+        let pallet = self.lines[robot.line.index()].at_station(station)?.body();
+        let centre = self.physics.position_of(pallet);
+        let place = [
+            tool[0] - (centre[0] - CARD_SIZE[0] / 2.0),
+            tool[1] - (centre[1] - CARD_SIZE[1] / 2.0),
+        ];
+        let over = place
+            .iter()
+            .zip(CARD_SIZE)
+            .all(|(&at, size)| (-REACH_TOLERANCE..=size + REACH_TOLERANCE).contains(&at));
+        over.then_some(place)
     }
 
     /// Whether `robot`'s tool is (now) at `target`.
@@ -428,6 +509,55 @@ impl World {
 
     pub(crate) fn scrap(&mut self, line: Line, station: Station) -> Option<PalletId> {
         self.lines[line.index()].scrap(station, &mut self.physics)
+    }
+
+    /// The cell as rapier has it now.
+    pub(crate) fn scene(&self, at: Instant) -> Scene {
+        let arms = self
+            .arms
+            .iter()
+            .zip(&self.in_zone)
+            .map(|(arm, &in_zone)| ArmPose {
+                robot: arm.id,
+                links: arm.colliders.map(|link| self.physics.link_pose(link)),
+                in_zone,
+            })
+            .collect();
+        let pallets = Line::ALL
+            .iter()
+            .flat_map(|&line| {
+                self.lines[line.index()]
+                    .pallets()
+                    .map(move |pallet| (line, pallet))
+            })
+            .map(|(line, pallet)| PalletPose {
+                line,
+                pallet: pallet.id,
+                pose: BoxPose {
+                    centre: self.physics.position_of(pallet.body()),
+                    half: PALLET_HALF,
+                },
+                card: pallet.card,
+                chips: pallet.chips,
+            })
+            .collect();
+        let feeders = self
+            .feeders
+            .iter()
+            .map(|feeder| FeederView {
+                id: feeder.id,
+                chip: feeder.chip,
+                stock: feeder.stock,
+                at: [feeder.at[0], feeder.at[1], 0.0],
+            })
+            .collect();
+        Scene {
+            at,
+            arms,
+            pallets,
+            feeders,
+            zone: self.physics.zone_box(),
+        }
     }
 
     pub(crate) fn pallet_positions(&self) -> Vec<(Line, PalletId, [f32; 3])> {

@@ -6,6 +6,7 @@
 use rapier3d::prelude::*;
 
 use crate::layout::{ARM_Z, LINK_RADIUS, PALLET_HALF, ZONE_CENTRE, ZONE_HALF};
+use crate::scene::{BoxPose, LinkPose};
 
 /// Arm links collide with each other and are seen by the zone sensor; pallets with nothing.
 const ARMS: Group = Group::GROUP_1;
@@ -98,6 +99,37 @@ impl Physics {
 
     pub(crate) fn place_pallet(&mut self, pallet: ColliderHandle, at: [f32; 3]) {
         self.world.colliders[pallet].set_translation(Vector::new(at[0], at[1], at[2]));
+    }
+
+    /// Where rapier has a link: its pose and its capsule.
+    pub(crate) fn link_pose(&self, link: ColliderHandle) -> LinkPose {
+        let collider = &self.world.colliders[link];
+        let (at, rotation) = (collider.translation(), collider.rotation());
+        // A link turns only about z: its x axis, rotated, gives the turn.
+        let axis = rotation * Vector::X;
+        let (half, radius) = collider.shape().as_capsule().map_or((0.0, 0.0), |capsule| {
+            (capsule.half_height(), capsule.radius)
+        });
+        LinkPose {
+            centre: [at.x, at.y, at.z],
+            yaw: axis.y.atan2(axis.x),
+            length: 2.0 * half,
+            radius,
+        }
+    }
+
+    /// The feeder zone's box, as the sensor has it.
+    pub(crate) fn zone_box(&self) -> BoxPose {
+        let zone = &self.world.colliders[self.zone];
+        let at = zone.translation();
+        let half = zone
+            .shape()
+            .as_cuboid()
+            .map_or(Vector::ZERO, |cuboid| cuboid.half_extents);
+        BoxPose {
+            centre: [at.x, at.y, at.z],
+            half: [half.x, half.y, half.z],
+        }
     }
 
     pub(crate) fn position_of(&self, pallet: ColliderHandle) -> [f32; 3] {

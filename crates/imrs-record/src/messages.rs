@@ -1,0 +1,257 @@
+//! How the cell's events become messages: which channel each goes to, its JSON, and the JSON
+//! schemas that let Foxglove show the fields.
+
+use foxglove::messages::{Log, log::Level};
+use imrs_sim::imrs_core::{Event, EventKind};
+use imrs_sim::{SimEvent, SimEventKind};
+use serde_json::{Value, json};
+
+use crate::time::stamp;
+
+/// The schema of the messages on a port's channel, `/ports/PORT`.
+pub(crate) const PORT_SCHEMA: &str = r#"{
+  "title": "imrs.PortEvent",
+  "description": "One primitive on a port, as the module that used it logged it",
+  "type": "object",
+  "properties": {
+    "op": {"type": "string", "enum": ["send", "receive", "query", "response", "error"]},
+    "module": {"type": "string"},
+    "task": {"type": "string"},
+    "waited_s": {"type": "number", "description": "how long the primitive waited"},
+    "handler": {"type": "string"},
+    "primitive": {"type": "string", "description": "the primitive that failed"},
+    "error": {"type": "string"}
+  },
+  "required": ["op", "module"]
+}"#;
+
+/// The schema of the messages on a module's channel, `/modules/MODULE`.
+pub(crate) const MODULE_SCHEMA: &str = r#"{
+  "title": "imrs.ModuleEvent",
+  "description": "A module's life: tasks, sections entered and left, exceptions, steps, alarms",
+  "type": "object",
+  "properties": {
+    "event": {"type": "string"},
+    "task": {"type": "string"},
+    "section": {"type": "string"},
+    "detail": {"type": "string"},
+    "text": {"type": "string"}
+  },
+  "required": ["event", "text"]
+}"#;
+
+/// The schema of the simulation's measured facts, `/sim/events`.
+pub(crate) const SIM_SCHEMA: &str = r#"{
+  "title": "imrs.SimEvent",
+  "description": "A fact measured by the simulation",
+  "type": "object",
+  "properties": {
+    "kind": {"type": "string"},
+    "robot": {"type": "string"},
+    "line": {"type": "string"},
+    "pallet": {"type": "integer"},
+    "chip": {"type": "integer"},
+    "chips": {"type": "integer"},
+    "feeder": {"type": "integer"},
+    "on_card_mm": {"type": "array", "items": {"type": "number"}},
+    "point": {"type": "array", "items": {"type": "number"}},
+    "text": {"type": "string"}
+  },
+  "required": ["kind", "text"]
+}"#;
+
+/// Where a cell event is recorded: on its port's channel, or its module's.
+pub(crate) enum Route<'a> {
+    /// `/ports/PORT`.
+    Port(&'a str),
+    /// `/modules/MODULE`.
+    Module(&'a str),
+}
+
+/// The channel and the JSON of a cell event.
+pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
+    let task = event.task.as_ref().map(|task| task.as_str());
+    let port = |op: &str, port: &'static str, waited: f64| {
+        let mut message = json!({"op": op, "module": event.module.as_str(), "waited_s": waited});
+        if let Some(task) = task {
+            message["task"] = task.into();
+        }
+        (Route::Port(port), message)
+    };
+    match &event.kind {
+        EventKind::Sent { port: p, waited } => port("send", p.as_str(), waited.as_secs_f64()),
+        EventKind::Received { port: p, waited } => {
+            port("receive", p.as_str(), waited.as_secs_f64())
+        }
+        EventKind::Queried { port: p, waited } => port("query", p.as_str(), waited.as_secs_f64()),
+        EventKind::PortError {
+            port: p,
+            error,
+            waited,
+            primitive,
+        } => {
+            let (route, mut message) = port("error", p.as_str(), waited.as_secs_f64());
+            message["error"] = error.as_str().into();
+            message["primitive"] = primitive.to_string().into();
+            (route, message)
+        }
+        EventKind::Responded { handler } => {
+            // A handler is named `PORT.NAME`: its message belongs with the port's.
+            let on = handler
+                .as_str()
+                .rsplit_once('.')
+                .map_or(handler.as_str(), |(port, _)| port);
+            let (route, mut message) = port("response", on, 0.0);
+            message["handler"] = handler.as_str().into();
+            (route, message)
+        }
+        kind => {
+            let mut message = json!({"event": module_event(kind), "text": event.to_string()});
+            if let Some(task) = task {
+                message["task"] = task.into();
+            }
+            match kind {
+                EventKind::SectionEntered { section } | EventKind::SectionLeft { section } => {
+                    message["section"] = section.as_str().into();
+                }
+                EventKind::ExceptionRaised { exception }
+                | EventKind::ExceptionHandled { exception }
+                | EventKind::ExceptionUnhandled { exception } => {
+                    message["detail"] = exception.as_str().into();
+                }
+                EventKind::Alarm { message: detail }
+                | EventKind::ModuleFailed { reason: detail }
+                | EventKind::TaskFailed { reason: detail }
+                | EventKind::StepPerformed { step: detail } => {
+                    message["detail"] = detail.as_str().into();
+                }
+                EventKind::StepFailed { step, error } => {
+                    message["detail"] = format!("{step}: {error}").into();
+                }
+                _ => {}
+            }
+            (Route::Module(event.module.as_str()), message)
+        }
+    }
+}
+
+fn module_event(kind: &EventKind) -> &'static str {
+    match kind {
+        EventKind::ModuleStarted { .. } => "module_started",
+        EventKind::ModuleFinished => "module_finished",
+        EventKind::ModuleKilled => "module_killed",
+        EventKind::ModuleFailed { .. } => "module_failed",
+        EventKind::ModuleRestarted { .. } => "module_restarted",
+        EventKind::TaskStarted => "task_started",
+        EventKind::TaskFinished => "task_finished",
+        EventKind::TaskFailed { .. } => "task_failed",
+        EventKind::TaskRestarted { .. } => "task_restarted",
+        EventKind::SectionEntered { .. } => "section_entered",
+        EventKind::SectionLeft { .. } => "section_left",
+        EventKind::ExceptionRaised { .. } => "exception_raised",
+        EventKind::ExceptionHandled { .. } => "exception_handled",
+        EventKind::ExceptionUnhandled { .. } => "exception_unhandled",
+        EventKind::WaitForReleased { .. } => "waitfor_released",
+        EventKind::StepPerformed { .. } => "step_performed",
+        EventKind::StepFailed { .. } => "step_failed",
+        EventKind::Deadlock { .. } => "deadlock",
+        EventKind::Alarm { .. } => "alarm",
+        _ => "other",
+    }
+}
+
+/// The log entry of a cell event that an engineer should see in Foxglove's log panel:
+/// exceptions, timeouts and other port failures, restarts, failures, deadlocks, alarms.
+pub(crate) fn cell_log(event: &Event) -> Option<Log> {
+    let level = match &event.kind {
+        EventKind::ExceptionRaised { .. }
+        | EventKind::PortError { .. }
+        | EventKind::Alarm { .. }
+        | EventKind::StepFailed { .. }
+        | EventKind::TaskRestarted { .. }
+        | EventKind::ModuleRestarted { .. } => Level::Warning,
+        EventKind::ExceptionHandled { .. } | EventKind::ModuleKilled => Level::Info,
+        EventKind::ExceptionUnhandled { .. }
+        | EventKind::TaskFailed { .. }
+        | EventKind::ModuleFailed { .. }
+        | EventKind::Deadlock { .. } => Level::Error,
+        _ => return None,
+    };
+    Some(Log {
+        timestamp: Some(stamp(event.at)),
+        level: level as i32,
+        message: event.to_string(),
+        name: event.module.as_str().to_string(),
+        file: String::new(),
+        line: 0,
+    })
+}
+
+/// The JSON of a measured fact.
+pub(crate) fn sim_message(event: &SimEvent) -> Value {
+    let text = event.to_string();
+    match &event.kind {
+        SimEventKind::ZoneEntered { robot } => {
+            json!({"kind": "zone_entered", "robot": robot.to_string(), "text": text})
+        }
+        SimEventKind::ZoneLeft { robot } => {
+            json!({"kind": "zone_left", "robot": robot.to_string(), "text": text})
+        }
+        SimEventKind::Collision { a, b, point } => json!({
+            "kind": "collision", "robot": format!("{a} {b}"), "point": point, "text": text
+        }),
+        SimEventKind::PalletReleased { line, pallet } => json!({
+            "kind": "pallet_released", "line": format!("{line:?}"), "pallet": pallet.0, "text": text
+        }),
+        SimEventKind::PalletDone {
+            line,
+            pallet,
+            chips,
+        } => json!({
+            "kind": "pallet_done", "line": format!("{line:?}"), "pallet": pallet.0,
+            "chips": chips, "text": text
+        }),
+        SimEventKind::ChipInserted {
+            line,
+            pallet,
+            chip,
+            on_card,
+        } => json!({
+            "kind": "chip_inserted", "line": format!("{line:?}"), "pallet": pallet.0, "chip": chip,
+            "on_card_mm": [on_card[0] * 1000.0, on_card[1] * 1000.0], "text": text
+        }),
+        SimEventKind::FeederRefilled { feeder, chips } => json!({
+            "kind": "feeder_refilled", "feeder": feeder.0, "chips": chips, "text": text
+        }),
+        _ => json!({"kind": sim_kind(&event.kind), "text": text}),
+    }
+}
+
+fn sim_kind(kind: &SimEventKind) -> &'static str {
+    match kind {
+        SimEventKind::PalletInPlace { .. } => "pallet_in_place",
+        SimEventKind::PalletJammed { .. } => "pallet_jammed",
+        SimEventKind::PalletScrapped { .. } => "pallet_scrapped",
+        SimEventKind::CardPlaced { .. } => "card_placed",
+        SimEventKind::CardScrewed { .. } => "card_screwed",
+        SimEventKind::FaultStruck { .. } => "fault_struck",
+        _ => "other",
+    }
+}
+
+/// The log entry of a measured fact an engineer should see: collisions and faults.
+pub(crate) fn sim_log(event: &SimEvent) -> Option<Log> {
+    let level = match event.kind {
+        SimEventKind::Collision { .. } => Level::Error,
+        SimEventKind::FaultStruck { .. } | SimEventKind::PalletJammed { .. } => Level::Warning,
+        _ => return None,
+    };
+    Some(Log {
+        timestamp: Some(stamp(event.at)),
+        level: level as i32,
+        message: event.to_string(),
+        name: "simulation".into(),
+        file: String::new(),
+        line: 0,
+    })
+}
