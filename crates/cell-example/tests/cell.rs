@@ -168,3 +168,110 @@ fn the_report_is_folded_from_every_event_whatever_the_logs_keep() {
     // What the fold keeps per pallet is dropped when the pallet leaves the line.
     assert!(full.tally.in_flight() <= 2 * full.pallets_left.len());
 }
+
+#[test]
+fn an_empty_feeder_leaves_short_cards_reported_apart_from_the_good_ones() {
+    let config = CellConfig {
+        faults: vec!["feeder:1@60".parse().unwrap()],
+        ..config(0.1, 1985, FeederPolicy::Arbiter)
+    };
+    let record = run(&config).unwrap();
+    let report = Report::of(&record);
+    for line in &report.lines {
+        assert!(line.short > 0, "a chip was skipped on every line\n{report}");
+        assert_eq!(line.good + line.short, line.completed, "{report}");
+        // Good cards carry all four chips; the short ones fewer.
+        assert!(line.chips < 4 * line.completed, "{report}");
+        assert!(line.chips >= 4 * line.good, "{report}");
+    }
+    let feeder = &report.feeders[1];
+    assert_eq!((feeder.empties, feeder.refills), (1, 1), "{report}");
+    assert!(
+        report
+            .alarm_kinds
+            .iter()
+            .any(|(kind, n)| kind == "empty feeder" && *n > 0),
+        "{report}"
+    );
+    let text = report.to_string();
+    assert!(text.contains("cards short (a chip missing)"), "{text}");
+    assert!(text.contains("feeder-1 (chip  4)"), "{text}");
+}
+
+#[test]
+fn every_chip_lies_at_its_work_schedule_place_as_rapier_measured_it() {
+    let record = run(&config(0.1, 3, FeederPolicy::Arbiter)).unwrap();
+    let mut places = Vec::new();
+    for event in &record.sim_events {
+        if let SimEventKind::ChipInserted { chip, on_card, .. } = event.kind {
+            let place = cell_example::chip::place_of_chip(chip).expect("a chip of the schedule");
+            let off = ((on_card[0] - place[0]).powi(2) + (on_card[1] - place[1]).powi(2)).sqrt();
+            assert!(off <= 0.001, "chip {chip} at {on_card:?}, not {place:?}");
+            if !places.contains(&place) {
+                places.push(place);
+            }
+        }
+    }
+    // The four steps put their chips in four places, not one.
+    assert_eq!(places.len(), 4, "{places:?}");
+    let report = Report::of(&record);
+    let rule = report
+        .invariants
+        .iter()
+        .find(|invariant| {
+            invariant
+                .rule
+                .starts_with("every chip lies at its work-schedule place")
+        })
+        .expect("the chip places are checked");
+    assert!(rule.held && rule.required, "{report}");
+    assert!(report.chip_places.0 >= 4 * report.lines[0].completed);
+}
+
+#[test]
+fn the_zone_invariant_is_checked_under_every_policy() {
+    for feeder in [FeederPolicy::Arbiter, FeederPolicy::Appendix] {
+        let report = Report::of(&run(&config(0.05, 5, feeder)).unwrap());
+        let zone = report
+            .invariants
+            .iter()
+            .find(|invariant| {
+                invariant
+                    .rule
+                    .starts_with("no two robots in the feeder zone")
+            })
+            .unwrap_or_else(|| panic!("checked under {feeder:?}\n{report}"));
+        // It is the arbiter's promise; under the Appendix's scheme a violation is a finding.
+        assert_eq!(zone.required, feeder == FeederPolicy::Arbiter);
+        assert_eq!(zone.held, report.zone_conflicts == 0, "{report}");
+        if feeder == FeederPolicy::Arbiter {
+            assert!(zone.held, "{report}");
+        }
+    }
+}
+
+#[test]
+fn the_report_says_how_robots_spent_the_run_and_what_the_deadlocks_cost() {
+    let appendix = Report::of(&run(&config(0.1, 1985, FeederPolicy::Appendix)).unwrap());
+    for robot in &appendix.robots {
+        let total = robot.moving + robot.working + robot.waiting + robot.idle;
+        assert!((total - appendix.simulated).abs() < 1e-6, "{robot:?}");
+        assert!(robot.moving > 0.0 && robot.working > 0.0, "{robot:?}");
+    }
+    assert!(
+        appendix.deadlocks > 0 && appendix.deadlock_lost > 0.0,
+        "{appendix}"
+    );
+    let arbiter = Report::of(&run(&config(0.1, 1985, FeederPolicy::Arbiter)).unwrap());
+    assert_eq!((arbiter.deadlocks, arbiter.deadlock_lost), (0, 0.0));
+    // GATE follows the cycle times the workcells report.
+    for history in &arbiter.cycle_times {
+        assert_eq!(history.first, Some(10.0));
+        assert!(history.changes > 0, "{history:?}");
+    }
+    // Both stations of both lines held pallets in turn.
+    assert!(
+        arbiter.stations.iter().flatten().all(Option::is_some),
+        "{arbiter}"
+    );
+}

@@ -170,3 +170,25 @@ fn the_example_draws_the_appendix_module_tree() {
         assert!(stdout.contains(line), "{line:?} in\n{stdout}");
     }
 }
+
+#[test]
+fn the_example_records_and_draws_as_the_readme_says() {
+    let dir = std::env::temp_dir().join(format!("imrs-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (mcap, svg) = (dir.join("cell.mcap"), dir.join("cell.svg"));
+    let output = Command::new(chip_cell())
+        .args(["--hours", "0.02", "--feeder", "appendix", "--record"])
+        .arg(&mcap)
+        .arg("--timeline")
+        .arg(&svg)
+        .output()
+        .expect("the example is built with the tests");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("open it in Foxglove"), "{stderr}");
+    let summary = imrs_record::read_summary(&mcap).unwrap();
+    assert!(summary.indexed && summary.messages > 100, "{summary}");
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.contains("CHIP_IT2") && picture.contains("deadlock"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -2,17 +2,42 @@
 //! messages and log, a timeline picture of who was in which section and who waited, and a
 //! reader that sums a recording up.
 //!
-//! ```no_run
+//! Record a cell and its simulation, run it, finish, and read the file back:
+//!
+//! ```
+//! use std::sync::Arc;
+//! use std::time::Duration;
+//! use imrs_record::{Recorder, Timeline, read_summary};
+//! use imrs_sim::imrs_core::{Cell, imrs_ports::Instant, time::drive};
+//! use imrs_sim::{FeederId, Line, Role, RobotId, Sim, SimConfig, Target};
+//!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use imrs_record::Recorder;
-//! # let cell: imrs_sim::imrs_core::Cell = unimplemented!();
-//! # let sim: imrs_sim::Sim = unimplemented!();
-//! let recorder = Recorder::create("cell.mcap")?;
+//! # let runtime = tokio::runtime::Builder::new_current_thread().enable_all().start_paused(true).build()?;
+//! # runtime.block_on(async {
+//! let path = std::env::temp_dir().join(format!("imrs-doc-{}.mcap", std::process::id()));
+//! let (cell, clock) = Cell::virtual_clock();
+//! let sim = Sim::new(SimConfig::seeded(7), Arc::clone(cell.clock()));
+//!
+//! let recorder = Recorder::create(&path)?;
 //! recorder.record_cell(cell.events());
 //! recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
-//! // ... run the cell ...
+//! let timeline = Timeline::new(Duration::ZERO, Duration::from_secs(60));
+//! timeline.record_sim(sim.log());
+//!
+//! sim.spawn();
+//! let robot = sim.robot(RobotId::new(Line::A, Role::ChipIt));
+//! tokio::spawn(async move { robot.move_to(Target::Feeder(FeederId(0))).await });
+//! drive(&clock, Instant::from_start(Duration::from_secs(5))).await;
+//!
 //! recorder.finish()?;
-//! println!("{}", imrs_record::read_summary("cell.mcap")?);
+//! let summary = read_summary(&path)?;
+//! assert!(summary.indexed);
+//! assert!(summary.channels.iter().any(|channel| channel.topic == "/tf"));
+//! // The robot reached into the feeder zone: rapier saw it, the timeline shows it.
+//! assert!(timeline.rows().iter().any(|row| row.name == "zone: chip-robot-A"));
+//! # std::fs::remove_file(&path)?;
+//! # Ok::<_, Box<dyn std::error::Error>>(())
+//! # })?;
 //! # Ok(())
 //! # }
 //! ```

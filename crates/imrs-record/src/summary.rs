@@ -68,7 +68,30 @@ pub fn read_summary(path: impl AsRef<Path>) -> Result<RecordingSummary, RecordEr
 /// The bytes an MCAP file starts and ends with.
 const MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
+/// Reads every record once with every check the format offers: the chunks', the data
+/// section's and the summary section's CRCs, and nothing after the end.
+fn validate(bytes: &[u8]) -> Result<(), mcap::McapError> {
+    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+    let options = LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_validate_data_section_crc(true)
+        .with_validate_summary_section_crc(true)
+        .with_check_finishes_after_end_magic(true);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut at = 0;
+    while let Some(event) = reader.next_event() {
+        if let LinearReadEvent::ReadRequest(wanted) = event? {
+            let take = wanted.min(bytes.len() - at);
+            reader.insert(take).copy_from_slice(&bytes[at..at + take]);
+            reader.notify_read(take);
+            at += take;
+        }
+    }
+    Ok(())
+}
+
 fn summarise(bytes: &[u8]) -> Result<RecordingSummary, mcap::McapError> {
+    validate(bytes)?;
     let index = mcap::Summary::read(bytes)?;
     let mut channels: BTreeMap<String, ChannelSummary> = BTreeMap::new();
     let (mut messages, mut span) = (0, None::<(u64, u64)>);

@@ -100,10 +100,11 @@ impl Sim {
         self.world().scene(now)
     }
 
-    /// Calls `see` with the scene now, then after steps of the world, at most once per
-    /// `period` of the clock (a zero period: after every step). The world steps only while
-    /// something moves, so a still cell costs its watchers nothing: the last scene they saw
-    /// is still true.
+    /// Calls `see` with the scene now, then after steps of the world: at most once per
+    /// `period` of the clock while something moves (a zero period: after every step), and
+    /// after the step at which everything stopped. The world steps only while something
+    /// moves, so a still cell costs its watchers nothing: the last scene they saw is still
+    /// true.
     pub fn watch(&self, period: Duration, mut see: impl FnMut(&Scene) + Send + 'static) {
         let scene = self.scene();
         see(&scene);
@@ -116,11 +117,21 @@ impl Sim {
 
     fn tell_watchers(&self, now: Instant) {
         let mut watchers = lock(&self.shared.watchers);
-        if watchers.iter().all(|watcher| watcher.next > now) {
+        if watchers.is_empty() {
             return;
         }
-        let scene = self.world().scene(now);
-        for watcher in watchers.iter_mut().filter(|watcher| watcher.next <= now) {
+        let (scene, still) = {
+            let world = self.world();
+            let still = !world.is_active();
+            if !still && watchers.iter().all(|watcher| watcher.next > now) {
+                return;
+            }
+            (world.scene(now), still)
+        };
+        for watcher in watchers
+            .iter_mut()
+            .filter(|watcher| still || watcher.next <= now)
+        {
             (watcher.see)(&scene);
             watcher.next = now + watcher.period;
         }

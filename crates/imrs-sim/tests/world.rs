@@ -402,3 +402,107 @@ fn an_unknown_feeder_or_a_point_that_is_no_point_is_refused() {
         ));
     });
 }
+
+/// Takes a pallet of line A through the load station (a card laid and screwed) to the chip
+/// station, and inserts a chip from feeder 0 at `place` on its card.
+async fn chip_onto_card(sim: Sim, place: [f32; 2]) -> Result<(), DeviceError> {
+    let Release::Released(_) = sim.gate(Line::A).release().await else {
+        panic!("an empty line is not backed up");
+    };
+    let load = sim.relay(Line::A, Station::Load);
+    load.wait_in_place().await?;
+    let loader = sim.robot(RobotId::new(Line::A, Role::LoadCard));
+    loader.move_to(Target::Magazine).await?;
+    loader.pick_card().await?;
+    loader.move_to(Target::Card).await?;
+    loader.place_card().await?;
+    loader.move_to(Target::Home).await?;
+    let screwer = sim.robot(RobotId::new(Line::A, Role::ScrewInCard));
+    screwer.move_to(Target::Card).await?;
+    screwer.screw().await?;
+    screwer.move_to(Target::Home).await?;
+    load.release()?;
+    sim.relay(Line::A, Station::Chip).wait_in_place().await?;
+    let chipper = sim.robot(CHIP_A);
+    chipper.move_to(Target::Feeder(FeederId(0))).await?;
+    chipper.grasp(FeederId(0)).await?;
+    chipper.move_to(Target::OnCard(place)).await?;
+    chipper.insert().await.map(|_| ())
+}
+
+#[test]
+fn a_chip_goes_where_the_tool_is_over_the_card_and_a_place_off_the_card_is_refused() {
+    paused_runtime().block_on(async {
+        let (sim, clock) = cell(None);
+        let robot = sim.robot(CHIP_A);
+        let refused = robot.move_to(Target::OnCard([0.09, 0.02])).await;
+        assert_eq!(
+            refused,
+            Err(DeviceError::OffCard {
+                robot: robot.id(),
+                at: [90, 20]
+            })
+        );
+        assert!(
+            refused
+                .unwrap_err()
+                .to_string()
+                .contains("(90 mm, 20 mm) on the card, which lies off the card")
+        );
+        let placed = Arc::new(std::sync::Mutex::new(None));
+        let seen = Arc::clone(&placed);
+        sim.log().subscribe(move |event| {
+            if let SimEventKind::ChipInserted { on_card, .. } = event.kind {
+                *seen.lock().unwrap() = Some(on_card);
+            }
+        });
+        let driving = tokio::spawn(chip_onto_card(sim.clone(), [0.015, 0.07]));
+        drive(&clock, secs(120.0)).await;
+        driving.await.unwrap().unwrap();
+        let on_card = placed.lock().unwrap().expect("a chip was inserted");
+        assert!(
+            (on_card[0] - 0.015).abs() < 1e-4 && (on_card[1] - 0.07).abs() < 1e-4,
+            "{on_card:?}"
+        );
+    });
+}
+
+#[test]
+fn watchers_see_the_scene_at_most_once_a_period_while_it_moves_and_when_it_stops() {
+    paused_runtime().block_on(async {
+        let clock = VirtualClock::new();
+        let sim = Sim::new(SimConfig::seeded(3), Arc::new(clock.clone()));
+        let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let into = Arc::clone(&seen);
+        sim.watch(Duration::from_millis(100), move |scene| {
+            into.lock().unwrap().push(scene.clone());
+        });
+        sim.spawn();
+        let robot = sim.robot(CHIP_A);
+        let moving = tokio::spawn(async move { robot.move_to(Target::Feeder(FeederId(0))).await });
+        drive(&clock, secs(10.0)).await;
+        moving.await.unwrap().unwrap();
+        let seen = seen.lock().unwrap();
+        // Once at the start, then at most every 100 ms while the arm moved.
+        assert!(seen.len() >= 3, "{}", seen.len());
+        for pair in seen.windows(2).take(seen.len() - 2) {
+            let gap = pair[1].at.saturating_duration_since(pair[0].at);
+            assert!(gap >= Duration::from_millis(100), "{gap:?}");
+        }
+        // The last scene is the arm at rest over the feeder, as rapier has it: the tool end
+        // of its second link lies over the feeder.
+        let last = seen.last().unwrap();
+        let arm = last.arms.iter().find(|arm| arm.robot == CHIP_A).unwrap();
+        let link = arm.links[1];
+        let tool = [
+            link.centre[0] + link.length / 2.0 * link.yaw.cos(),
+            link.centre[1] + link.length / 2.0 * link.yaw.sin(),
+        ];
+        let feeder = last.feeders[0].at;
+        assert!(
+            (tool[0] - feeder[0]).abs() < 1e-3 && (tool[1] - feeder[1]).abs() < 1e-3,
+            "{tool:?} {feeder:?}"
+        );
+        assert!(arm.in_zone);
+    });
+}
