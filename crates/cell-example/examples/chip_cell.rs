@@ -11,7 +11,7 @@
 
 use std::process::ExitCode;
 
-use std::io::{self, Write};
+use std::io::{self, IsTerminal, Write};
 
 use cell_example::{CellConfig, FeederPolicy, Report, parse, run, speed_line};
 use tracing_subscriber::EnvFilter;
@@ -22,6 +22,7 @@ fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(io::stderr)
+        .with_ansi(io::stderr().is_terminal())
         .init();
     let config = match parse(std::env::args_os().skip(1)) {
         Ok(config) => config,

@@ -192,3 +192,28 @@ fn the_example_records_and_draws_as_the_readme_says() {
     assert!(picture.contains("CHIP_IT2") && picture.contains("deadlock"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn rust_log_shows_what_the_core_emits_and_nothing_without_it() {
+    let run_with = |log: Option<&str>| {
+        let mut command = Command::new(chip_cell());
+        command.args(["--hours", "0.02", "--feeder", "appendix"]);
+        match log {
+            Some(filter) => command.env("RUST_LOG", filter),
+            None => command.env_remove("RUST_LOG"),
+        };
+        let output = command
+            .output()
+            .expect("the example is built with the tests");
+        assert_eq!(output.status.code(), Some(0));
+        String::from_utf8_lossy(&output.stderr).into_owned()
+    };
+    let warned = run_with(Some("imrs=warn"));
+    assert!(
+        warned.contains(
+            "WARN imrs: [27.420s] CHIP_IT2/CHIP_IT2: deadlock: CHIP_IT2 -[SHARE_FEEDER1]-> CHIP_IT"
+        ),
+        "{warned}"
+    );
+    assert!(!run_with(None).contains("imrs:"));
+}

@@ -354,13 +354,13 @@ type Drawn = Result<(), String>;
 fn draw(path: &Path, rows: &[Row], marks: &[Mark], (from, to): (f64, f64)) -> Drawn {
     let to = if to > from { to } else { from + 1.0 };
     let n = rows.len().max(1);
-    let height = 110 + ROW_HEIGHT * n as u32;
+    let height = 130 + ROW_HEIGHT * n as u32;
     let root = SVGBackend::new(path, (1400, height)).into_drawing_area();
     let err = |e: &dyn std::fmt::Display| e.to_string();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut chart = ChartBuilder::on(&root)
         .margin(10)
-        .margin_top(64)
+        .margin_top(84)
         .x_label_area_size(30)
         .y_label_area_size(LABEL_WIDTH)
         .build_cartesian_2d(from..to, 0.0..n as f64)
@@ -400,7 +400,9 @@ fn draw(path: &Path, rows: &[Row], marks: &[Mark], (from, to): (f64, f64)) -> Dr
         ))
         .map_err(|e| err(&e))?;
     }
-    for (index, mark) in marks.iter().enumerate() {
+    // Deadlock labels alternate between two heights, so that close ones stay readable.
+    let mut labelled = 0;
+    for mark in marks {
         match mark.kind {
             MarkKind::Deadlock => {
                 chart
@@ -412,10 +414,11 @@ fn draw(path: &Path, rows: &[Row], marks: &[Mark], (from, to): (f64, f64)) -> Dr
                 let (x, y) = chart.backend_coord(&(mark.at, n as f64));
                 root.draw(&Text::new(
                     mark.label.clone(),
-                    (x + 4, y - 14 - 13 * (index % 3) as i32),
+                    (x + 4, y - 14 - 13 * (labelled % 2)),
                     ("sans-serif", 12).into_font().color(&DEADLOCK),
                 ))
                 .map_err(|e| err(&e))?;
+                labelled += 1;
             }
             MarkKind::Timeout => {
                 let y = top(mark.row.unwrap_or(0)) - 0.1;
@@ -432,7 +435,7 @@ fn draw(path: &Path, rows: &[Row], marks: &[Mark], (from, to): (f64, f64)) -> Dr
     legend(&root, rows).map_err(|e| err(&e))?;
     root.draw(&Text::new(
         format!("who did what, {from:.0} s to {to:.0} s of the cell's clock"),
-        (10, 30),
+        (10, 32),
         ("sans-serif", 16),
     ))
     .map_err(|e| err(&e))?;
