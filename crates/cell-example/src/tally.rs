@@ -205,7 +205,12 @@ impl Tally {
             EventKind::Deadlock { cycle } => {
                 self.deadlocks += 1;
                 self.last_deadlock = Some(event.at.since_start().as_secs_f64());
-                self.stuck.extend(cycle.iter().cloned());
+                // A wait already counted (the same cycle reported again) is counted once.
+                for member in cycle {
+                    if !self.stuck.contains(member) {
+                        self.stuck.push(member.clone());
+                    }
+                }
             }
             // A member of a deadlock is freed when its wait ends, by a reply or a timeout:
             // the whole wait was lost to the deadlock.

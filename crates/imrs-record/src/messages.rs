@@ -2,6 +2,7 @@
 //! schemas that let Foxglove show the fields.
 
 use foxglove::messages::{Log, log::Level};
+use imrs_sim::imrs_core::imrs_ports::Instant;
 use imrs_sim::imrs_core::{Event, EventKind};
 use imrs_sim::{SimEvent, SimEventKind};
 use serde_json::{Value, json};
@@ -177,14 +178,24 @@ pub(crate) fn cell_log(event: &Event) -> Option<Log> {
         | EventKind::Deadlock { .. } => Level::Error,
         _ => return None,
     };
-    Some(Log {
-        timestamp: Some(stamp(event.at)),
+    Some(log_entry(
+        event.at,
+        level,
+        event.to_string(),
+        event.module.as_str(),
+    ))
+}
+
+/// A line of Foxglove's log panel, from `name`, at `at` of the cell's clock.
+fn log_entry(at: Instant, level: Level, message: String, name: &str) -> Log {
+    Log {
+        timestamp: Some(stamp(at)),
         level: level as i32,
-        message: event.to_string(),
-        name: event.module.as_str().to_string(),
+        message,
+        name: name.to_string(),
         file: String::new(),
         line: 0,
-    })
+    }
 }
 
 /// The JSON of a measured fact.
@@ -246,12 +257,5 @@ pub(crate) fn sim_log(event: &SimEvent) -> Option<Log> {
         SimEventKind::FaultStruck { .. } | SimEventKind::PalletJammed { .. } => Level::Warning,
         _ => return None,
     };
-    Some(Log {
-        timestamp: Some(stamp(event.at)),
-        level: level as i32,
-        message: event.to_string(),
-        name: "simulation".into(),
-        file: String::new(),
-        line: 0,
-    })
+    Some(log_entry(event.at, level, event.to_string(), "simulation"))
 }
