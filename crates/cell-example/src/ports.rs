@@ -1,4 +1,5 @@
-//! Every port of the cell, declared as the Appendix declares it.
+//! Every port of the cell, declared as the Appendix declares it, each showing its messages
+//! and replies in a recording (`--record`).
 
 use std::time::Duration;
 
@@ -79,33 +80,39 @@ impl LinePorts {
                     .user_list([n.load_it.clone(), n.chip_it.clone()]),
                 "BOUNDED_BUFFER",
             ),
-            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).timeout(secs(2))),
+            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).timeout(secs(2))).shown(),
             ask_child1: AskChild1::declare(
                 spec(&n.ask_child1, &n.load_it, clock)
                     .user_list([n.load_card.clone()])
                     .timeout(secs(2)),
-            ),
+            )
+            .shown(),
             ask_child2: AskChild2::declare(
                 spec(&n.ask_child2, &n.load_it, clock)
                     .user_list([n.screw_in_card.clone()])
                     .timeout(secs(2)),
-            ),
+            )
+            .shown(),
             pallet_in_place: PalletInPlace::declare(
                 spec(&n.pallet_in_place, &n.load_card, clock).timeout(secs(30)),
-            ),
+            )
+            .shown(),
             card_in_place: CardInPlace::declare(
                 spec(&n.card_in_place, &n.load_card, clock)
                     .user_list([n.screw_in_card.clone()])
                     .timeout(secs(30)),
-            ),
+            )
+            .shown(),
             ready_to_chip: ReadyToChip::declare(
                 spec(&n.ready_to_chip, &n.chip_it, clock).timeout(secs(60)),
-            ),
+            )
+            .shown(),
             share_feeder: ShareFeeder::declare(
                 spec(&n.share_feeder, &n.chip_it, clock)
                     .user_list([twin.chip_it.clone()])
                     .timeout(secs(3)),
-            ),
+            )
+            .shown(),
         }
     }
 }
@@ -120,8 +127,8 @@ impl CellPorts {
                 LinePorts::declare(Line::A, clock),
                 LinePorts::declare(Line::B, clock),
             ],
-            zone_request: ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)),
-            zone_release: ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)),
+            zone_request: ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
+            zone_release: ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
         };
         for line in &ports.lines {
             cell.declare_filtered(&line.frequency)?;

@@ -462,6 +462,21 @@ impl fmt::Display for Report {
         row(f, "seconds waiting for the zone", &|l| {
             format!("{:.1}", self.waits[l].waited)
         })?;
+        for (history, line) in self.cycle_times.iter().zip(["A", "B"]) {
+            if history.recent.is_empty() {
+                continue;
+            }
+            let changes: Vec<String> = history
+                .recent
+                .iter()
+                .map(|(at, value)| format!("{value:.1} s at {at:.0} s"))
+                .collect();
+            writeln!(
+                f,
+                "  GATE CYCLE_TIME, line {line}, last changes: {}",
+                changes.join(", ")
+            )?;
+        }
         writeln!(f)?;
         if self.timeouts.is_empty() {
             writeln!(f, "timeouts: none")?;

@@ -218,7 +218,7 @@ async fn simulate(
     let recorder = match &config.record {
         Some(path) => {
             let recorder = Recorder::create(path).map_err(|error| output(path, error))?;
-            recorder.record_cell(cell.events());
+            recorder.record_cell(&cell);
             recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
             Some(recorder)
         }

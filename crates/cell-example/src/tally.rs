@@ -214,8 +214,8 @@ impl Tally {
             }
             // A member of a deadlock is freed when its wait ends, by a reply or a timeout:
             // the whole wait was lost to the deadlock.
-            EventKind::Sent { port, waited }
-            | EventKind::Queried { port, waited }
+            EventKind::Sent { port, waited, .. }
+            | EventKind::Queried { port, waited, .. }
             | EventKind::PortError { port, waited, .. } => {
                 let member = (event.module.clone(), port.clone());
                 if let Some(index) = self.stuck.iter().position(|stuck| *stuck == member) {

@@ -3,6 +3,7 @@
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::usage::{Plain, Usage};
@@ -24,6 +25,9 @@ use crate::tree::{ModuleTree, Placement};
 pub(crate) struct CellShared {
     pub(crate) clock: SharedClock,
     pub(crate) events: EventLog,
+    /// Whether the primitives put the text of each message and reply in the event log,
+    /// for ports that say how to show them.
+    pub(crate) show_messages: AtomicBool,
     waits: Mutex<WaitGraph>,
     wiring: Mutex<Wiring>,
     modules: Mutex<BTreeMap<Name, Member>>,
@@ -84,6 +88,7 @@ impl Cell {
             shared: Arc::new(CellShared {
                 clock,
                 events: EventLog::new(),
+                show_messages: AtomicBool::new(false),
                 waits: Mutex::default(),
                 wiring: Mutex::default(),
                 modules: Mutex::default(),
@@ -110,6 +115,13 @@ impl Cell {
     /// The cell's event log.
     pub fn events(&self) -> &EventLog {
         &self.shared.events
+    }
+
+    /// Puts the text of each message and reply in the event log from now on, for the ports
+    /// that say how to show them ([`Port::shown`](imrs_ports::Port::shown)); off by
+    /// default, so that a cell nobody records formats nothing. A recorder turns it on.
+    pub fn show_messages(&self, on: bool) {
+        self.shared.show_messages.store(on, Ordering::Relaxed);
     }
 
     /// Makes `port` known to the cell by name, for [`Cell::check`] and [`Cell::use_port`].

@@ -111,6 +111,10 @@ pub enum EventKind {
         port: Name,
         /// How long the send waited for its reply.
         waited: Duration,
+        /// The message, if the port's values are shown ([`Cell::show_messages`](crate::Cell::show_messages)).
+        message: Option<String>,
+        /// The reply, likewise.
+        reply: Option<String>,
     },
     /// A message was received.
     Received {
@@ -118,6 +122,8 @@ pub enum EventKind {
         port: Name,
         /// How long the receive waited for a message.
         waited: Duration,
+        /// The message, if the port's values are shown.
+        message: Option<String>,
     },
     /// A query was answered.
     Queried {
@@ -125,6 +131,10 @@ pub enum EventKind {
         port: Name,
         /// How long the query waited for its answer.
         waited: Duration,
+        /// The query, if the port's values are shown.
+        message: Option<String>,
+        /// The answer, likewise.
+        reply: Option<String>,
     },
     /// A primitive failed.
     PortError {

@@ -156,7 +156,7 @@ pub use event::{Event, EventKind, EventLog, Primitive};
 pub use exception::Exception;
 pub use imrs_ports;
 pub use log::{Log, Record};
-pub use module::ctx::{Ctx, PortFailure, PortOp};
+pub use module::ctx::{Ctx, PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
 pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult};
 pub use order::{Order, Rank};
 pub use processor::{JobHandle, JobLost, Processor};

@@ -83,3 +83,57 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
         assert!(Primitive::Send.awaits_a_peer() && !Primitive::Receive.awaits_a_peer());
     });
 }
+
+/// Runs LOAD_CARD sending card 7 to SCREW_IN_CARD, which replies 70, on a port that shows
+/// its values; returns what the log says of the send and the receive.
+fn shown_in_log(show_messages: bool) -> Vec<(Option<String>, Option<String>)> {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        cell.show_messages(show_messages);
+        let card_in_place = Port::<u32, i32, usage::Send>::declare(
+            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
+        )
+        .shown();
+        let (sender, receiver) = (card_in_place.clone(), card_in_place);
+        let screwer = ModuleSpec::new("SCREW_IN_CARD", ()).task("SCREW_IN_CARD", move |ctx| {
+            let port = receiver.clone();
+            async move {
+                let mut card_in_place = port.user_named("SCREW_IN_CARD")?;
+                let (card, reply) = ctx.receive(&mut card_in_place).await?;
+                reply.reply(card as i32 * 10);
+                Ok(())
+            }
+        });
+        let loader = ModuleSpec::new("LOAD_CARD", ()).task("LOAD_CARD", move |ctx| {
+            let port = sender.clone();
+            async move {
+                ctx.send(&mut port.owner()?, 7).await?;
+                Ok(())
+            }
+        });
+        cell.start(screwer).unwrap();
+        cell.start(loader).unwrap();
+        drive(&clock, at(5)).await;
+        cell.events()
+            .snapshot()
+            .into_iter()
+            .filter_map(|event| match event.kind {
+                EventKind::Sent { message, reply, .. } => Some((message, reply)),
+                EventKind::Received { message, .. } => Some((message, None)),
+                _ => None,
+            })
+            .collect()
+    })
+}
+
+#[test]
+fn a_shown_port_puts_its_values_in_the_log_only_while_the_cell_asks() {
+    assert_eq!(
+        shown_in_log(true),
+        [
+            (Some("7".into()), None),
+            (Some("7".into()), Some("70".into()))
+        ]
+    );
+    assert_eq!(shown_in_log(false), [(None, None), (None, None)]);
+}

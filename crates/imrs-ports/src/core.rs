@@ -4,13 +4,14 @@
 //! declared, plus one slot for the owner's own posts. Users post into their own slot; the
 //! owner posts into its slot (any one user may take it) or, broadcasting, into every user's.
 
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 use std::task::Waker;
 
 use crate::clock::SharedClock;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
+use crate::shown::Shown;
 use crate::slot::Slot;
 use crate::urgency::wake_at;
 
@@ -109,6 +110,8 @@ pub(crate) struct Core<Req, Rep> {
     declarations: AtomicUsize,
     users_attached: AtomicUsize,
     pub(crate) users: Box<[UserSlot<Req, Rep>]>,
+    /// How the port's values read in event logs, if the port says.
+    pub(crate) shown: OnceLock<Shown<Req, Rep>>,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -124,6 +127,7 @@ impl<Req, Rep> Core<Req, Rep> {
             declarations: AtomicUsize::new(1),
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
+            shown: OnceLock::new(),
         }
     }
 

@@ -10,6 +10,7 @@ use crate::meta::Name;
 use crate::post::{Posting, QueryOutcome, SendOutcome};
 use crate::priority::Priority;
 use crate::receive::{Receiving, ReplyHandle};
+use crate::shown::Shown;
 use crate::usage::{CallsAll, Queries, Receives, Sends, SendsAll, Usage};
 
 /// One end of a port, owner's or user's, with usage `U`.
@@ -61,6 +62,12 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
     /// run at every message, such as a module's deadlock diagnosis.
     pub fn each_peer(&self, visit: impl FnMut(Name)) {
         self.attachment.each_peer(visit);
+    }
+
+    /// How the port's messages and replies are shown, if it says (see
+    /// [`Port::shown`](crate::Port::shown)).
+    pub fn shown(&self) -> Option<Shown<Req, Rep>> {
+        self.attachment.core.shown.get().copied()
     }
 
     /// The port's priority, used by [`select`](crate::select()).

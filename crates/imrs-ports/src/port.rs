@@ -16,6 +16,7 @@ use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::response::ResponseEnd;
+use crate::shown::Shown;
 use crate::usage::{self, Answers, Plain, Usage, UsageKind};
 use crate::user_list::{Admits, AnyUser, UserList};
 
@@ -161,6 +162,23 @@ where
             core: Arc::new(Core::new(meta, clock, N)),
             _restrictions: PhantomData,
         }
+    }
+
+    /// Shows the port's messages and replies as `Debug` writes them, in the event log of a
+    /// cell that asks for them (a recorder does; see [`shown`](crate::shown)). The first way
+    /// of showing set holds, for every handle of the port.
+    pub fn shown(self) -> Self
+    where
+        Req: std::fmt::Debug,
+        Rep: std::fmt::Debug,
+    {
+        self.shown_with(Shown::debug())
+    }
+
+    /// Shows the port's messages and replies as `shown` writes them (see [`Port::shown`]).
+    pub fn shown_with(self, shown: Shown<Req, Rep>) -> Self {
+        let _first_holds = self.core.shown.set(shown);
+        self
     }
 
     /// The port's name.

@@ -5,7 +5,9 @@ mod common;
 use std::time::Duration;
 
 use common::{on_both_runtimes, until, until_sleepers, virtual_clock};
-use imrs_ports::{Clock, Instant, Port, PortSpec, ProcessType, ReceiveError, SendError, usage};
+use imrs_ports::{
+    Clock, Instant, Port, PortSpec, ProcessType, ReceiveError, SendError, Shown, usage,
+};
 
 #[test]
 fn send_waits_for_the_reply_and_returns_it() {
@@ -273,4 +275,21 @@ fn an_endless_timeout_on_the_real_clock_is_no_overflow() {
         reply.reply(message + 1);
         assert_eq!(sending.await.unwrap().unwrap(), 4);
     });
+}
+
+#[test]
+fn a_port_says_how_its_values_are_shown_and_the_first_way_set_holds() {
+    let port = Port::<u32, i32, usage::Send>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+    assert!(port.owner().unwrap().shown().is_none());
+    let hex = Shown {
+        request: |card: &u32| format!("{card:#x}"),
+        reply: |rc: &i32| format!("rc {rc}"),
+    };
+    let port = port.shown_with(hex).shown();
+    let end = port.user_named("SCREW_IN_CARD").unwrap();
+    let shown = end.shown().expect("the port shows its values");
+    assert_eq!(
+        ((shown.request)(&255), (shown.reply)(&-1)),
+        ("0xff".into(), "rc -1".into())
+    );
 }

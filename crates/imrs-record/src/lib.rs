@@ -19,7 +19,7 @@
 //! let sim = Sim::new(SimConfig::seeded(7), Arc::clone(cell.clock()));
 //!
 //! let recorder = Recorder::create(&path)?;
-//! recorder.record_cell(cell.events());
+//! recorder.record_cell(&cell);
 //! recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
 //! let timeline = Timeline::new(Duration::ZERO, Duration::from_secs(60));
 //! timeline.record_sim(sim.log());

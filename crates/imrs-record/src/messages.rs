@@ -19,6 +19,8 @@ pub(crate) const PORT_SCHEMA: &str = r#"{
     "module": {"type": "string"},
     "task": {"type": "string"},
     "waited_s": {"type": "number", "description": "how long the primitive waited"},
+    "message": {"type": "string", "description": "the message, where the port shows its values"},
+    "reply": {"type": "string", "description": "the reply, where the port shows its values"},
     "handler": {"type": "string"},
     "primitive": {"type": "string", "description": "the primitive that failed"},
     "error": {"type": "string"}
@@ -80,11 +82,36 @@ pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
         (Route::Port(port), message)
     };
     match &event.kind {
-        EventKind::Sent { port: p, waited } => port("send", p.as_str(), waited.as_secs_f64()),
-        EventKind::Received { port: p, waited } => {
-            port("receive", p.as_str(), waited.as_secs_f64())
+        EventKind::Sent {
+            port: p,
+            waited,
+            message,
+            reply,
         }
-        EventKind::Queried { port: p, waited } => port("query", p.as_str(), waited.as_secs_f64()),
+        | EventKind::Queried {
+            port: p,
+            waited,
+            message,
+            reply,
+        } => {
+            let op = if matches!(event.kind, EventKind::Sent { .. }) {
+                "send"
+            } else {
+                "query"
+            };
+            let (route, mut json) = port(op, p.as_str(), waited.as_secs_f64());
+            shown(&mut json, message.as_deref(), reply.as_deref());
+            (route, json)
+        }
+        EventKind::Received {
+            port: p,
+            waited,
+            message,
+        } => {
+            let (route, mut json) = port("receive", p.as_str(), waited.as_secs_f64());
+            shown(&mut json, message.as_deref(), None);
+            (route, json)
+        }
         EventKind::PortError {
             port: p,
             error,
@@ -133,6 +160,16 @@ pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
             }
             (Route::Module(event.module.as_str()), message)
         }
+    }
+}
+
+/// Adds the text of the message and the reply, where the port shows them.
+fn shown(json: &mut Value, message: Option<&str>, reply: Option<&str>) {
+    if let Some(message) = message {
+        json["message"] = message.into();
+    }
+    if let Some(reply) = reply {
+        json["reply"] = reply.into();
     }
 }
 

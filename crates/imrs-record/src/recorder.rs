@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
 use foxglove::{Channel, Context, McapWriter, McapWriterHandle, RawChannel, Schema};
-use imrs_sim::imrs_core::EventLog;
+use imrs_sim::imrs_core::Cell;
 use imrs_sim::{Scene, Sim};
 use serde_json::Value;
 
@@ -116,11 +116,14 @@ impl Recorder {
         })
     }
 
-    /// Records every event of a cell's event log from now on: each on its port's or its
-    /// module's channel, and the ones an engineer should see also on `/log`.
-    pub fn record_cell(&self, events: &EventLog) {
+    /// Records every event of `cell` from now on: each on its port's or its module's
+    /// channel, with the text of the messages and replies of the ports that show them
+    /// ([`Port::shown`](imrs_sim::imrs_core::imrs_ports::Port::shown): the recorder turns
+    /// [`Cell::show_messages`] on), and the events an engineer should see also on `/log`.
+    pub fn record_cell(&self, cell: &Cell) {
+        cell.show_messages(true);
         let inner = Arc::clone(&self.inner);
-        events.subscribe(move |event| {
+        cell.events().subscribe(move |event| {
             let at = nanos(event.at);
             let (route, message) = cell_message(event);
             let (topic, schema, name) = match route {

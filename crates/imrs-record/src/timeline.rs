@@ -138,7 +138,7 @@ impl Timeline {
                         fold.span(row, since, at, SpanKind::Section(section.to_string()));
                     }
                 }
-                EventKind::Sent { port, waited } | EventKind::Queried { port, waited } => {
+                EventKind::Sent { port, waited, .. } | EventKind::Queried { port, waited, .. } => {
                     let since = at - waited.as_secs_f64();
                     let row = fold.task_row(row, event.module.as_str(), &task);
                     fold.span(row, since, at, SpanKind::Blocked(port.to_string()));

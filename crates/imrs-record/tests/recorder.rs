@@ -89,6 +89,17 @@ fn every_event_is_on_its_channel_with_a_schema_and_the_file_has_its_summary_and_
         })
         .count();
     assert_eq!((on_port, queries), (1, 1));
+    // The port shows its values: the query and the answer CRIT_SECTION gave.
+    let query = messages
+        .iter()
+        .filter(|(topic, ..)| topic == "/ports/SHARE_FEEDER1")
+        .map(|(.., data)| serde_json::from_slice::<Value>(data).unwrap())
+        .find(|json| json["op"] == "query")
+        .unwrap();
+    assert_eq!(
+        (&query["message"], &query["reply"]),
+        (&Value::from("()"), &Value::from("1"))
+    );
     // Every measured fact.
     assert_eq!(on["/sim/events"], ran.sim_events.len());
     // The deadlock, the timeout and the port failure reach the log panel.

@@ -15,7 +15,7 @@ use imrs_ports::post::{Posting, QueryOutcome, SendOutcome};
 use imrs_ports::usage::{Plain, Queries, Receives, Sends, Usage};
 use imrs_ports::{
     End, Instant, ModuleState, Name, Port, QueryError, ReceiveError, Receiving, SendError,
-    SharedClock, UserList, WireError,
+    SharedClock, Shown, UserList, WireError,
 };
 use tracing::Instrument;
 
@@ -288,7 +288,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         &'a self,
         end: &'a mut End<Req, Rep, U>,
         message: Req,
-    ) -> PortOp<'a, S, Posting<'a, Req, Rep, SendOutcome>>
+    ) -> PortOp<'a, S, Posting<'a, Req, Rep, SendOutcome>, ShowReply<Rep>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
@@ -296,35 +296,50 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
+        let shown = self.shown(end);
+        let text = shown.map(|shown| (shown.request)(&message));
+        let show = ShowReply(shown.map(|shown| shown.reply));
         PortOp::new(
             self,
             port,
             Some(waiting),
             end.send(message),
             Primitive::Send,
-            |port, waited| EventKind::Sent { port, waited },
+            |port, waited, message, reply| EventKind::Sent {
+                port,
+                waited,
+                message,
+                reply,
+            },
         )
+        .showing(text, show)
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
     pub fn receive<'a, Req, Rep, U>(
         &'a self,
         end: &'a mut End<Req, Rep, U>,
-    ) -> PortOp<'a, S, Receiving<'a, Req, Rep>>
+    ) -> PortOp<'a, S, Receiving<'a, Req, Rep>, ShowRequest<Req>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Receives,
     {
         let port = end.port().clone();
+        let show = ShowRequest(self.shown(end).map(|shown| shown.request));
         PortOp::new(
             self,
             port,
             None,
             end.receive(),
             Primitive::Receive,
-            |port, waited| EventKind::Received { port, waited },
+            |port, waited, _, message| EventKind::Received {
+                port,
+                waited,
+                message,
+            },
         )
+        .showing(None, show)
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -332,7 +347,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         &'a self,
         end: &'a mut End<Req, Rep, U>,
         query: Req,
-    ) -> PortOp<'a, S, Posting<'a, Req, Rep, QueryOutcome>>
+    ) -> PortOp<'a, S, Posting<'a, Req, Rep, QueryOutcome>, ShowReply<Rep>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
@@ -340,14 +355,37 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
+        let shown = self.shown(end);
+        let text = shown.map(|shown| (shown.request)(&query));
+        let show = ShowReply(shown.map(|shown| shown.reply));
         PortOp::new(
             self,
             port,
             Some(waiting),
             end.query(query),
             Primitive::Query,
-            |port, waited| EventKind::Queried { port, waited },
+            |port, waited, message, reply| EventKind::Queried {
+                port,
+                waited,
+                message,
+                reply,
+            },
         )
+        .showing(text, show)
+    }
+
+    /// How `end`'s values are shown, if the port says and the cell asks.
+    fn shown<Req, Rep, U>(&self, end: &End<Req, Rep, U>) -> Option<Shown<Req, Rep>>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+    {
+        if self.module.cell.show_messages.load(Ordering::Relaxed) {
+            end.shown()
+        } else {
+            None
+        }
     }
 
     /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
@@ -604,26 +642,30 @@ pin_project_lite::pin_project! {
     /// A named type rather than an `async fn`, so that its type does not carry the end's
     /// usage: a misused end is reported once, where the operation is called.
     #[must_use = "a port operation does nothing unless awaited"]
-    pub struct PortOp<'a, S, F> {
+    pub struct PortOp<'a, S, F, D> {
         ctx: &'a Ctx<S>,
         port: Option<Name>,
         waiting: Option<WaitGuard>,
         since: Instant,
         primitive: Primitive,
-        done: fn(Name, Duration) -> EventKind,
+        // The text of the message sent, and how to show what comes back: set only while
+        // the cell shows messages.
+        text: Option<String>,
+        show: D,
+        done: fn(Name, Duration, Option<String>, Option<String>) -> EventKind,
         #[pin]
         operation: F,
     }
 }
 
-impl<'a, S, F> PortOp<'a, S, F> {
+impl<'a, S, F, D: Default> PortOp<'a, S, F, D> {
     fn new(
         ctx: &'a Ctx<S>,
         port: Name,
         waiting: Option<WaitGuard>,
         operation: F,
         primitive: Primitive,
-        done: fn(Name, Duration) -> EventKind,
+        done: fn(Name, Duration, Option<String>, Option<String>) -> EventKind,
     ) -> Self {
         Self {
             ctx,
@@ -631,17 +673,64 @@ impl<'a, S, F> PortOp<'a, S, F> {
             waiting,
             since: ctx.module.cell.clock.now(),
             primitive,
+            text: None,
+            show: D::default(),
             done,
             operation,
         }
     }
+
+    fn showing(mut self, text: Option<String>, show: D) -> Self {
+        self.text = text;
+        self.show = show;
+        self
+    }
 }
 
-impl<S, F, T, E> Future for PortOp<'_, S, F>
+/// How a port operation shows what it got, for the event log.
+pub trait ShowResult<T> {
+    /// The text of `value`, if the port's values are shown.
+    fn show(&self, value: &T) -> Option<String>;
+}
+
+/// Shows the reply a send or a query got, if the port's values are shown.
+#[derive(Debug)]
+pub struct ShowReply<Rep>(Option<fn(&Rep) -> String>);
+
+/// Shows the message a receive got, if the port's values are shown.
+#[derive(Debug)]
+pub struct ShowRequest<Req>(Option<fn(&Req) -> String>);
+
+impl<Rep> Default for ShowReply<Rep> {
+    fn default() -> Self {
+        Self(None)
+    }
+}
+
+impl<Req> Default for ShowRequest<Req> {
+    fn default() -> Self {
+        Self(None)
+    }
+}
+
+impl<Rep> ShowResult<Rep> for ShowReply<Rep> {
+    fn show(&self, reply: &Rep) -> Option<String> {
+        self.0.map(|show| show(reply))
+    }
+}
+
+impl<Req, Handle> ShowResult<(Req, Handle)> for ShowRequest<Req> {
+    fn show(&self, (message, _): &(Req, Handle)) -> Option<String> {
+        self.0.map(|show| show(message))
+    }
+}
+
+impl<S, F, T, E, D> Future for PortOp<'_, S, F, D>
 where
     S: Send + Sync + 'static,
     F: Future<Output = Result<T, E>>,
     E: PortFailure,
+    D: ShowResult<T>,
 {
     type Output = F::Output;
 
@@ -652,7 +741,11 @@ where
         let port = this.port.take().expect("a port operation completes once");
         let waited = this.ctx.now().saturating_duration_since(*this.since);
         match &result {
-            Ok(_) => this.ctx.event((this.done)(port, waited)),
+            Ok(value) => {
+                let shown = this.show.show(value);
+                this.ctx
+                    .event((this.done)(port, waited, this.text.take(), shown));
+            }
             Err(error) => this.ctx.port_failed(
                 port,
                 *this.primitive,
@@ -665,7 +758,7 @@ where
     }
 }
 
-impl<S, F> fmt::Debug for PortOp<'_, S, F> {
+impl<S, F, D> fmt::Debug for PortOp<'_, S, F, D> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("PortOp")
             .field("port", &self.port)

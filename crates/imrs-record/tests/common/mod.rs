@@ -103,7 +103,7 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
         let (cell, clock) = Cell::virtual_clock();
         let sim = Sim::new(SimConfig::seeded(7), Arc::clone(cell.clock()));
         if let Some(recorder) = record {
-            recorder.record_cell(cell.events());
+            recorder.record_cell(&cell);
             recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
         }
         if let Some(timeline) = timeline {
@@ -116,13 +116,15 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
                 .user_list(["CHIP_IT2"])
                 .timeout(secs(3))
                 .clock(cell.clock().clone()),
-        );
+        )
+        .shown();
         let share_feeder1 = Port::<(), i32, usage::Query>::declare(
             PortSpec::new("SHARE_FEEDER1", "CHIP_IT2")
                 .user_list(["CHIP_IT"])
                 .timeout(secs(5))
                 .clock(cell.clock().clone()),
-        );
+        )
+        .shown();
         let a = chip_robot(
             Line::A,
             share_feeder.clone(),
