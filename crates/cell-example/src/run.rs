@@ -213,6 +213,8 @@ async fn simulate(
     driver: Option<VirtualClock>,
 ) -> Result<RunRecord, RunError> {
     let cell = Cell::new(clock.clone());
+    // The report counts the time lost to deadlocks from how long each wait lasted.
+    cell.observe(true);
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
     // Off unless asked for: with neither, nothing subscribes and nothing is paid.
     let recorder = match &config.record {
@@ -226,7 +228,7 @@ async fn simulate(
     };
     let timeline = config.timeline.as_ref().map(|window| {
         let timeline = Timeline::new(window.from, window.from + window.span);
-        timeline.record_cell(cell.events());
+        timeline.record_cell(&cell);
         timeline.record_sim(sim.log());
         (timeline, &window.path)
     });

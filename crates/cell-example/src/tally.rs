@@ -214,13 +214,16 @@ impl Tally {
             }
             // A member of a deadlock is freed when its wait ends, by a reply or a timeout:
             // the whole wait was lost to the deadlock.
-            EventKind::Sent { port, waited, .. }
-            | EventKind::Queried { port, waited, .. }
-            | EventKind::PortError { port, waited, .. } => {
+            EventKind::Sent { port, observed }
+            | EventKind::Queried { port, observed }
+            | EventKind::PortError { port, observed, .. } => {
                 let member = (event.module.clone(), port.clone());
                 if let Some(index) = self.stuck.iter().position(|stuck| *stuck == member) {
                     self.stuck.swap_remove(index);
-                    self.deadlock_lost += waited.as_secs_f64();
+                    // The chip cell observes its primitives, so every wait is measured.
+                    self.deadlock_lost += observed
+                        .as_ref()
+                        .map_or(0.0, |observed| observed.waited.as_secs_f64());
                 }
             }
             _ => {}

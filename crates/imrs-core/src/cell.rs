@@ -25,9 +25,9 @@ use crate::tree::{ModuleTree, Placement};
 pub(crate) struct CellShared {
     pub(crate) clock: SharedClock,
     pub(crate) events: EventLog,
-    /// Whether the primitives put the text of each message and reply in the event log,
-    /// for ports that say how to show them.
-    pub(crate) show_messages: AtomicBool,
+    /// Whether the primitives' events say how long each waited and carry the text of the
+    /// values of the ports that show them.
+    pub(crate) observe: AtomicBool,
     waits: Mutex<WaitGraph>,
     wiring: Mutex<Wiring>,
     modules: Mutex<BTreeMap<Name, Member>>,
@@ -88,7 +88,7 @@ impl Cell {
             shared: Arc::new(CellShared {
                 clock,
                 events: EventLog::new(),
-                show_messages: AtomicBool::new(false),
+                observe: AtomicBool::new(false),
                 waits: Mutex::default(),
                 wiring: Mutex::default(),
                 modules: Mutex::default(),
@@ -117,11 +117,13 @@ impl Cell {
         &self.shared.events
     }
 
-    /// Puts the text of each message and reply in the event log from now on, for the ports
-    /// that say how to show them ([`Port::shown`](imrs_ports::Port::shown)); off by
-    /// default, so that a cell nobody records formats nothing. A recorder turns it on.
-    pub fn show_messages(&self, on: bool) {
-        self.shared.show_messages.store(on, Ordering::Relaxed);
+    /// Observes the primitives closely from now on (or no more): the event of each send,
+    /// receive and query says how long it waited, and carries the text of its message and
+    /// reply where the port shows them ([`Port::shown`](imrs_ports::Port::shown)). Off by
+    /// default: a primitive then reads the clock once, for its event, and formats nothing.
+    /// A recorder and a timeline turn it on.
+    pub fn observe(&self, on: bool) {
+        self.shared.observe.store(on, Ordering::Relaxed);
     }
 
     /// Makes `port` known to the cell by name, for [`Cell::check`] and [`Cell::use_port`].

@@ -58,6 +58,19 @@ impl fmt::Display for Primitive {
     }
 }
 
+/// What a cell that observes its primitives ([`Cell::observe`](crate::Cell::observe)) adds
+/// to the event of each send, receive, query and failure. Boxed in the event, so that a
+/// cell that does not observe logs events no larger for it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Observed {
+    /// How long the primitive waited.
+    pub waited: Duration,
+    /// The message, where the port shows its values ([`Port::shown`](imrs_ports::Port::shown)).
+    pub message: Option<String>,
+    /// The reply (of a send or a query), likewise.
+    pub reply: Option<String>,
+}
+
 /// What happened.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -109,32 +122,22 @@ pub enum EventKind {
     Sent {
         /// The port.
         port: Name,
-        /// How long the send waited for its reply.
-        waited: Duration,
-        /// The message, if the port's values are shown ([`Cell::show_messages`](crate::Cell::show_messages)).
-        message: Option<String>,
-        /// The reply, likewise.
-        reply: Option<String>,
+        /// What a cell that observes its primitives adds.
+        observed: Option<Box<Observed>>,
     },
     /// A message was received.
     Received {
         /// The port.
         port: Name,
-        /// How long the receive waited for a message.
-        waited: Duration,
-        /// The message, if the port's values are shown.
-        message: Option<String>,
+        /// What a cell that observes its primitives adds.
+        observed: Option<Box<Observed>>,
     },
     /// A query was answered.
     Queried {
         /// The port.
         port: Name,
-        /// How long the query waited for its answer.
-        waited: Duration,
-        /// The query, if the port's values are shown.
-        message: Option<String>,
-        /// The answer, likewise.
-        reply: Option<String>,
+        /// What a cell that observes its primitives adds.
+        observed: Option<Box<Observed>>,
     },
     /// A primitive failed.
     PortError {
@@ -142,10 +145,10 @@ pub enum EventKind {
         port: Name,
         /// The error.
         error: String,
-        /// How long the primitive waited before it failed.
-        waited: Duration,
         /// Which primitive failed.
         primitive: Primitive,
+        /// What a cell that observes its primitives adds.
+        observed: Option<Box<Observed>>,
     },
     /// A response handler answered a query.
     Responded {

@@ -152,7 +152,7 @@ mod work;
 
 pub use cell::{Cell, ModuleHandle, ModuleOutcome};
 pub use check::{CellError, CellErrors};
-pub use event::{Event, EventKind, EventLog, Primitive};
+pub use event::{Event, EventKind, EventLog, Observed, Primitive};
 pub use exception::Exception;
 pub use imrs_ports;
 pub use log::{Log, Record};

@@ -13,6 +13,7 @@ use imrs_core::time::drive;
 fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        cell.observe(true);
         // LOAD_CARD sends a card at 2 s; SCREW_IN_CARD takes 3 s to screw it and reply. The
         // second card waits past the port's 4 s TIMEOUT.
         let card_in_place = Port::<u32, i32, usage::Send>::declare(
@@ -58,13 +59,17 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
             .snapshot()
             .into_iter()
             .filter_map(|event| match event.kind {
-                EventKind::Sent { waited, .. } => Some((event.module, "sent", waited, None)),
-                EventKind::Received { waited, .. } => {
-                    Some((event.module, "received", waited, None))
+                EventKind::Sent { observed, .. } => {
+                    Some((event.module, "sent", observed?.waited, None))
+                }
+                EventKind::Received { observed, .. } => {
+                    Some((event.module, "received", observed?.waited, None))
                 }
                 EventKind::PortError {
-                    waited, primitive, ..
-                } => Some((event.module, "failed", waited, Some(primitive))),
+                    observed,
+                    primitive,
+                    ..
+                } => Some((event.module, "failed", observed?.waited, Some(primitive))),
                 _ => None,
             })
             .collect();
@@ -86,10 +91,10 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
 
 /// Runs LOAD_CARD sending card 7 to SCREW_IN_CARD, which replies 70, on a port that shows
 /// its values; returns what the log says of the send and the receive.
-fn shown_in_log(show_messages: bool) -> Vec<(Option<String>, Option<String>)> {
+fn shown_in_log(observe: bool) -> Vec<(Option<String>, Option<String>)> {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        cell.show_messages(show_messages);
+        cell.observe(observe);
         let card_in_place = Port::<u32, i32, usage::Send>::declare(
             PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
         )
@@ -118,8 +123,9 @@ fn shown_in_log(show_messages: bool) -> Vec<(Option<String>, Option<String>)> {
             .snapshot()
             .into_iter()
             .filter_map(|event| match event.kind {
-                EventKind::Sent { message, reply, .. } => Some((message, reply)),
-                EventKind::Received { message, .. } => Some((message, None)),
+                EventKind::Sent { observed, .. } | EventKind::Received { observed, .. } => {
+                    Some(observed.map_or((None, None), |o| (o.message, o.reply)))
+                }
                 _ => None,
             })
             .collect()
@@ -127,7 +133,7 @@ fn shown_in_log(show_messages: bool) -> Vec<(Option<String>, Option<String>)> {
 }
 
 #[test]
-fn a_shown_port_puts_its_values_in_the_log_only_while_the_cell_asks() {
+fn a_shown_port_puts_its_values_in_the_log_only_while_the_cell_observes() {
     assert_eq!(
         shown_in_log(true),
         [
@@ -136,4 +142,46 @@ fn a_shown_port_puts_its_values_in_the_log_only_while_the_cell_asks() {
         ]
     );
     assert_eq!(shown_in_log(false), [(None, None), (None, None)]);
+}
+
+#[test]
+fn a_cell_that_does_not_observe_measures_no_waits() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let port = Port::<u32, i32, usage::Send>::declare(
+            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
+        );
+        let (sender, receiver) = (port.clone(), port);
+        let screwer = ModuleSpec::new("SCREW_IN_CARD", ()).task("SCREW_IN_CARD", move |ctx| {
+            let port = receiver.clone();
+            async move {
+                let (_, reply) = ctx.receive(&mut port.user_named("SCREW_IN_CARD")?).await?;
+                ctx.delay(secs(3)).await;
+                reply.reply(0);
+                Ok(())
+            }
+        });
+        let loader = ModuleSpec::new("LOAD_CARD", ()).task("LOAD_CARD", move |ctx| {
+            let port = sender.clone();
+            async move {
+                ctx.send(&mut port.owner()?, 7).await?;
+                Ok(())
+            }
+        });
+        cell.start(screwer).unwrap();
+        cell.start(loader).unwrap();
+        drive(&clock, at(5)).await;
+        let waits: Vec<_> = cell
+            .events()
+            .snapshot()
+            .into_iter()
+            .filter_map(|event| match event.kind {
+                EventKind::Sent { observed, .. } | EventKind::Received { observed, .. } => {
+                    Some(observed)
+                }
+                _ => None,
+            })
+            .collect();
+        assert_eq!(waits, [None, None]);
+    });
 }

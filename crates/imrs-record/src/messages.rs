@@ -3,7 +3,7 @@
 
 use foxglove::messages::{Log, log::Level};
 use imrs_sim::imrs_core::imrs_ports::Instant;
-use imrs_sim::imrs_core::{Event, EventKind};
+use imrs_sim::imrs_core::{Event, EventKind, Observed};
 use imrs_sim::{SimEvent, SimEventKind};
 use serde_json::{Value, json};
 
@@ -74,54 +74,38 @@ pub(crate) enum Route<'a> {
 /// The channel and the JSON of a cell event.
 pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
     let task = event.task.as_ref().map(|task| task.as_str());
-    let port = |op: &str, port: &'static str, waited: f64| {
-        let mut message = json!({"op": op, "module": event.module.as_str(), "waited_s": waited});
+    let port = |op: &str, port: &'static str, observed: Option<&Observed>| {
+        let mut message = json!({"op": op, "module": event.module.as_str()});
         if let Some(task) = task {
             message["task"] = task.into();
+        }
+        if let Some(observed) = observed {
+            message["waited_s"] = observed.waited.as_secs_f64().into();
+            if let Some(text) = &observed.message {
+                message["message"] = text.as_str().into();
+            }
+            if let Some(text) = &observed.reply {
+                message["reply"] = text.as_str().into();
+            }
         }
         (Route::Port(port), message)
     };
     match &event.kind {
-        EventKind::Sent {
-            port: p,
-            waited,
-            message,
-            reply,
+        EventKind::Sent { port: p, observed } => port("send", p.as_str(), observed.as_deref()),
+        EventKind::Received { port: p, observed } => {
+            port("receive", p.as_str(), observed.as_deref())
         }
-        | EventKind::Queried {
-            port: p,
-            waited,
-            message,
-            reply,
-        } => {
-            let op = if matches!(event.kind, EventKind::Sent { .. }) {
-                "send"
-            } else {
-                "query"
-            };
-            let (route, mut json) = port(op, p.as_str(), waited.as_secs_f64());
-            shown(&mut json, message.as_deref(), reply.as_deref());
-            (route, json)
-        }
-        EventKind::Received {
-            port: p,
-            waited,
-            message,
-        } => {
-            let (route, mut json) = port("receive", p.as_str(), waited.as_secs_f64());
-            shown(&mut json, message.as_deref(), None);
-            (route, json)
-        }
+        EventKind::Queried { port: p, observed } => port("query", p.as_str(), observed.as_deref()),
         EventKind::PortError {
             port: p,
             error,
-            waited,
             primitive,
+            observed,
         } => {
-            let (route, mut message) = port("error", p.as_str(), waited.as_secs_f64());
-            message["error"] = error.as_str().into();
-            message["primitive"] = primitive.to_string().into();
-            (route, message)
+            let (route, mut json) = port("error", p.as_str(), observed.as_deref());
+            json["error"] = error.as_str().into();
+            json["primitive"] = primitive.to_string().into();
+            (route, json)
         }
         EventKind::Responded { handler } => {
             // A handler is named `PORT.NAME`: its message belongs with the port's.
@@ -129,7 +113,7 @@ pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
                 .as_str()
                 .rsplit_once('.')
                 .map_or(handler.as_str(), |(port, _)| port);
-            let (route, mut message) = port("response", on, 0.0);
+            let (route, mut message) = port("response", on, None);
             message["handler"] = handler.as_str().into();
             (route, message)
         }
@@ -160,16 +144,6 @@ pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
             }
             (Route::Module(event.module.as_str()), message)
         }
-    }
-}
-
-/// Adds the text of the message and the reply, where the port shows them.
-fn shown(json: &mut Value, message: Option<&str>, reply: Option<&str>) {
-    if let Some(message) = message {
-        json["message"] = message.into();
-    }
-    if let Some(reply) = reply {
-        json["reply"] = reply.into();
     }
 }
 

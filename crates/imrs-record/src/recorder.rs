@@ -118,10 +118,11 @@ impl Recorder {
 
     /// Records every event of `cell` from now on: each on its port's or its module's
     /// channel, with the text of the messages and replies of the ports that show them
-    /// ([`Port::shown`](imrs_sim::imrs_core::imrs_ports::Port::shown): the recorder turns
-    /// [`Cell::show_messages`] on), and the events an engineer should see also on `/log`.
+    /// ([`Port::shown`](imrs_sim::imrs_core::imrs_ports::Port::shown)), how long each
+    /// primitive waited (the recorder turns [`Cell::observe`] on), and the events an
+    /// engineer should see also on `/log`.
     pub fn record_cell(&self, cell: &Cell) {
-        cell.show_messages(true);
+        cell.observe(true);
         let inner = Arc::clone(&self.inner);
         cell.events().subscribe(move |event| {
             let at = nanos(event.at);

@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_sim::imrs_core::{EventKind, EventLog};
+use imrs_sim::imrs_core::{Cell, EventKind};
 use imrs_sim::{SimEventKind, SimLog};
 use plotters::prelude::*;
 
@@ -116,10 +116,11 @@ impl Timeline {
         }
     }
 
-    /// Folds every event of a cell from now on.
-    pub fn record_cell(&self, events: &EventLog) {
+    /// Folds every event of `cell` from now on; turns [`Cell::observe`] on, for the waits.
+    pub fn record_cell(&self, cell: &Cell) {
+        cell.observe(true);
         let fold = Arc::clone(&self.fold);
-        events.subscribe(move |event| {
+        cell.events().subscribe(move |event| {
             let at = event.at.since_start().as_secs_f64();
             let mut fold = lock(&fold);
             fold.last = fold.last.max(at);
@@ -138,18 +139,25 @@ impl Timeline {
                         fold.span(row, since, at, SpanKind::Section(section.to_string()));
                     }
                 }
-                EventKind::Sent { port, waited, .. } | EventKind::Queried { port, waited, .. } => {
-                    let since = at - waited.as_secs_f64();
+                EventKind::Sent {
+                    port,
+                    observed: Some(observed),
+                }
+                | EventKind::Queried {
+                    port,
+                    observed: Some(observed),
+                } => {
+                    let since = at - observed.waited.as_secs_f64();
                     let row = fold.task_row(row, event.module.as_str(), &task);
                     fold.span(row, since, at, SpanKind::Blocked(port.to_string()));
                 }
                 EventKind::PortError {
                     port,
-                    waited,
                     primitive,
+                    observed: Some(observed),
                     ..
                 } if primitive.awaits_a_peer() => {
-                    let since = at - waited.as_secs_f64();
+                    let since = at - observed.waited.as_secs_f64();
                     let row = fold.task_row(row, event.module.as_str(), &task);
                     fold.span(row, since, at, SpanKind::Blocked(port.to_string()));
                 }

@@ -22,7 +22,7 @@ use tracing::Instrument;
 use super::spec::ModuleSpec;
 use crate::cell::{CellShared, Children, ModuleHandle, spawn_module};
 use crate::check::CellError;
-use crate::event::{Event, EventKind, Primitive};
+use crate::event::{Event, EventKind, Observed, Primitive};
 use crate::exception::Exception;
 use crate::order::{Order, Rank};
 use crate::supervision::RestartPolicy;
@@ -112,8 +112,13 @@ impl<S> ModuleShared<S> {
     }
 
     pub(crate) fn event(&self, task: Option<&Name>, kind: EventKind) {
+        self.event_at(self.cell.clock.now(), task, kind);
+    }
+
+    /// As [`ModuleShared::event`], at `at`: for a caller that has just read the clock.
+    pub(crate) fn event_at(&self, at: Instant, task: Option<&Name>, kind: EventKind) {
         self.cell.events.record(Event {
-            at: self.cell.clock.now(),
+            at,
             module: self.name.clone(),
             task: task.cloned(),
             kind,
@@ -296,23 +301,15 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
-        let shown = self.shown(end);
-        let text = shown.map(|shown| (shown.request)(&message));
-        let show = ShowReply(shown.map(|shown| shown.reply));
-        PortOp::new(
-            self,
-            port,
-            Some(waiting),
-            end.send(message),
-            Primitive::Send,
-            |port, waited, message, reply| EventKind::Sent {
-                port,
-                waited,
-                message,
-                reply,
-            },
-        )
-        .showing(text, show)
+        let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&message)));
+        let started = Started {
+            waiting: Some(waiting),
+            watch,
+            primitive: Primitive::Send,
+            show: ShowReply(shown.map(|shown| shown.reply)),
+            done: |port, observed| EventKind::Sent { port, observed },
+        };
+        PortOp::new(self, port, end.send(message), started)
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -326,20 +323,15 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         U: Receives,
     {
         let port = end.port().clone();
-        let show = ShowRequest(self.shown(end).map(|shown| shown.request));
-        PortOp::new(
-            self,
-            port,
-            None,
-            end.receive(),
-            Primitive::Receive,
-            |port, waited, _, message| EventKind::Received {
-                port,
-                waited,
-                message,
-            },
-        )
-        .showing(None, show)
+        let (watch, shown) = self.watch(end, |_| None);
+        let started = Started {
+            waiting: None,
+            watch,
+            primitive: Primitive::Receive,
+            show: ShowRequest(shown.map(|shown| shown.request)),
+            done: |port, observed| EventKind::Received { port, observed },
+        };
+        PortOp::new(self, port, end.receive(), started)
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -355,37 +347,42 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
-        let shown = self.shown(end);
-        let text = shown.map(|shown| (shown.request)(&query));
-        let show = ShowReply(shown.map(|shown| shown.reply));
-        PortOp::new(
-            self,
-            port,
-            Some(waiting),
-            end.query(query),
-            Primitive::Query,
-            |port, waited, message, reply| EventKind::Queried {
-                port,
-                waited,
-                message,
-                reply,
-            },
-        )
-        .showing(text, show)
+        let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&query)));
+        let started = Started {
+            waiting: Some(waiting),
+            watch,
+            primitive: Primitive::Query,
+            show: ShowReply(shown.map(|shown| shown.reply)),
+            done: |port, observed| EventKind::Queried { port, observed },
+        };
+        PortOp::new(self, port, end.query(query), started)
     }
 
-    /// How `end`'s values are shown, if the port says and the cell asks.
-    fn shown<Req, Rep, U>(&self, end: &End<Req, Rep, U>) -> Option<Shown<Req, Rep>>
+    /// Whether the cell observes its primitives closely ([`Cell::observe`]).
+    fn observing(&self) -> bool {
+        self.module.cell.observe.load(Ordering::Relaxed)
+    }
+
+    /// What an operation on `end` watches, if the cell observes (else nothing, at the cost
+    /// of one load): its start, and the text `message` gives of what it sends, where the
+    /// port shows its values; with how the port shows them.
+    #[allow(clippy::type_complexity)]
+    fn watch<Req, Rep, U>(
+        &self,
+        end: &End<Req, Rep, U>,
+        message: impl FnOnce(Shown<Req, Rep>) -> Option<String>,
+    ) -> (Option<Box<Watch>>, Option<Shown<Req, Rep>>)
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Usage,
     {
-        if self.module.cell.show_messages.load(Ordering::Relaxed) {
-            end.shown()
-        } else {
-            None
+        if !self.observing() {
+            return (None, None);
         }
+        let shown = end.shown();
+        let text = shown.and_then(message);
+        (Some(Box::new(Watch { since: None, text })), shown)
     }
 
     /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
@@ -400,7 +397,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     where
         M: Send + Sync + 'static,
     {
-        let since = self.now();
+        let since = self.observing().then(|| self.now());
         let result = barrier
             .waitfor(self.task.as_str(), message, combine, timeout)
             .await;
@@ -410,12 +407,17 @@ impl<S: Send + Sync + 'static> Ctx<S> {
             }),
             Err(error) => {
                 let timed_out = matches!(error, WaitForError::Timeout { .. });
-                let waited = self.now().saturating_duration_since(since);
+                let observed = since.map(|since| {
+                    Box::new(Observed {
+                        waited: self.now().saturating_duration_since(since),
+                        ..Observed::default()
+                    })
+                });
                 self.port_failed(
                     barrier.name().clone(),
                     Primitive::WaitFor,
                     error.to_string(),
-                    waited,
+                    observed,
                     timed_out,
                 );
             }
@@ -529,14 +531,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         port: Name,
         primitive: Primitive,
         error: String,
-        waited: Duration,
+        observed: Option<Box<Observed>>,
         timed_out: bool,
     ) {
         self.event(EventKind::PortError {
             port: port.clone(),
             error: error.clone(),
-            waited,
             primitive,
+            observed,
         });
         if timed_out {
             self.module.raise(Exception {
@@ -646,44 +648,49 @@ pin_project_lite::pin_project! {
         ctx: &'a Ctx<S>,
         port: Option<Name>,
         waiting: Option<WaitGuard>,
-        since: Instant,
+        // What an observing cell watches; `None` (and no clock read, no text) otherwise.
+        watch: Option<Box<Watch>>,
         primitive: Primitive,
-        // The text of the message sent, and how to show what comes back: set only while
-        // the cell shows messages.
-        text: Option<String>,
+        // How to show what comes back, where the port shows its values.
         show: D,
-        done: fn(Name, Duration, Option<String>, Option<String>) -> EventKind,
+        done: fn(Name, Option<Box<Observed>>) -> EventKind,
         #[pin]
         operation: F,
     }
 }
 
-impl<'a, S, F, D: Default> PortOp<'a, S, F, D> {
-    fn new(
-        ctx: &'a Ctx<S>,
-        port: Name,
-        waiting: Option<WaitGuard>,
-        operation: F,
-        primitive: Primitive,
-        done: fn(Name, Duration, Option<String>, Option<String>) -> EventKind,
-    ) -> Self {
+/// What an observing cell's port operation keeps until it ends: when it first had to wait
+/// (`None` while it has not, so that one that completes at once reads the clock only for its
+/// event), and the text of the message it sent.
+struct Watch {
+    since: Option<Instant>,
+    text: Option<String>,
+}
+
+/// What a port operation knows when it starts: its wait in the deadlock graph, what it
+/// watches (only while the cell observes), which primitive it is, how to show what comes
+/// back, and the event it logs when it ends.
+struct Started<D> {
+    waiting: Option<WaitGuard>,
+    watch: Option<Box<Watch>>,
+    primitive: Primitive,
+    show: D,
+    done: fn(Name, Option<Box<Observed>>) -> EventKind,
+}
+
+impl<'a, S, F, D> PortOp<'a, S, F, D> {
+    // Built in one go, so that the operation's future is moved as few times as it can be.
+    fn new(ctx: &'a Ctx<S>, port: Name, operation: F, started: Started<D>) -> Self {
         Self {
             ctx,
             port: Some(port),
-            waiting,
-            since: ctx.module.cell.clock.now(),
-            primitive,
-            text: None,
-            show: D::default(),
-            done,
+            waiting: started.waiting,
+            watch: started.watch,
+            primitive: started.primitive,
+            show: started.show,
+            done: started.done,
             operation,
         }
-    }
-
-    fn showing(mut self, text: Option<String>, show: D) -> Self {
-        self.text = text;
-        self.show = show;
-        self
     }
 }
 
@@ -700,18 +707,6 @@ pub struct ShowReply<Rep>(Option<fn(&Rep) -> String>);
 /// Shows the message a receive got, if the port's values are shown.
 #[derive(Debug)]
 pub struct ShowRequest<Req>(Option<fn(&Req) -> String>);
-
-impl<Rep> Default for ShowReply<Rep> {
-    fn default() -> Self {
-        Self(None)
-    }
-}
-
-impl<Req> Default for ShowRequest<Req> {
-    fn default() -> Self {
-        Self(None)
-    }
-}
 
 impl<Rep> ShowResult<Rep> for ShowReply<Rep> {
     fn show(&self, reply: &Rep) -> Option<String> {
@@ -736,21 +731,44 @@ where
 
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<F::Output> {
         let this = self.project();
-        let result = std::task::ready!(this.operation.poll(cx));
+        let clock = &this.ctx.module.cell.clock;
+        let Poll::Ready(result) = this.operation.poll(cx) else {
+            if let Some(watch) = this.watch {
+                watch.since.get_or_insert_with(|| clock.now());
+            }
+            return Poll::Pending;
+        };
         drop(this.waiting.take());
         let port = this.port.take().expect("a port operation completes once");
-        let waited = this.ctx.now().saturating_duration_since(*this.since);
+        let now = clock.now();
+        let mut observed = this.watch.take().map(|watch| {
+            let waited = watch
+                .since
+                .map_or(Duration::ZERO, |since| now.saturating_duration_since(since));
+            Box::new(Observed {
+                waited,
+                message: watch.text,
+                reply: None,
+            })
+        });
         match &result {
             Ok(value) => {
-                let shown = this.show.show(value);
-                this.ctx
-                    .event((this.done)(port, waited, this.text.take(), shown));
+                if let Some(observed) = &mut observed {
+                    // What came back: a send's or a query's reply, a receive's message.
+                    let shown = this.show.show(value);
+                    match *this.primitive {
+                        Primitive::Receive => observed.message = shown,
+                        _ => observed.reply = shown,
+                    }
+                }
+                let kind = (this.done)(port, observed);
+                this.ctx.module.event_at(now, Some(&this.ctx.task), kind);
             }
             Err(error) => this.ctx.port_failed(
                 port,
                 *this.primitive,
                 error.to_string(),
-                waited,
+                observed,
                 error.is_timeout(),
             ),
         }

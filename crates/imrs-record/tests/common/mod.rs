@@ -107,7 +107,7 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
             recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
         }
         if let Some(timeline) = timeline {
-            timeline.record_cell(cell.events());
+            timeline.record_cell(&cell);
             timeline.record_sim(sim.log());
         }
         sim.spawn();
