@@ -79,7 +79,8 @@ impl LinePorts {
                 spec(&n.frequency, &n.gate, clock)
                     .user_list([n.load_it.clone(), n.chip_it.clone()]),
                 "BOUNDED_BUFFER",
-            ),
+            )
+            .shown(),
             let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).timeout(secs(2))).shown(),
             ask_child1: AskChild1::declare(
                 spec(&n.ask_child1, &n.load_it, clock)

@@ -82,6 +82,19 @@ fn a_recorded_run_holds_every_event_on_channels_with_schemas_and_an_index() {
                 .is_some_and(|m| m.starts_with("PalletId("))),
         "{values:?}"
     );
+    // Through the bounded buffer too: the cycle times LOAD_IT and CHIP_IT report to GATE.
+    let reported = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|message| message.unwrap())
+        .filter(|message| message.channel.topic == "/ports/FREQUENCY")
+        .map(|message| serde_json::from_slice::<Value>(&message.data).unwrap())
+        .any(|json| {
+            json["op"] == "send"
+                && json["message"]
+                    .as_str()
+                    .is_some_and(|m| m.starts_with("(0, ") || m.starts_with("(1, "))
+        });
+    assert!(reported, "FREQUENCY shows the cycle times sent on it");
     let summed = {
         let path = temp("summed.mcap");
         std::fs::write(&path, &bytes).unwrap();

@@ -5,7 +5,9 @@ mod common;
 use std::time::Duration;
 
 use common::{on_both_runtimes, until, until_sleepers, virtual_clock};
-use imrs_ports::{BoundedBuffer, BoundedBufferPort, Named, PortSpec, SendError, user_list};
+use imrs_ports::{
+    AnyUser, BoundedBuffer, BoundedBufferPort, Named, PortSpec, SendError, user_list,
+};
 
 struct LoadIt;
 impl Named for LoadIt {
@@ -86,4 +88,19 @@ fn a_full_buffer_holds_the_sender_back_and_loses_nothing() {
         assert_eq!(gate.send(()).await.unwrap(), None);
         filter.abort();
     });
+}
+
+#[test]
+fn a_shown_filtered_port_shows_both_sides() {
+    let port = BoundedBufferPort::<(i32, f64), AnyUser, 2>::declare(
+        PortSpec::new("FREQUENCY", "GATE").user_list(["LOAD_IT", "CHIP_IT"]),
+        "BOUNDED_BUFFER",
+    )
+    .shown();
+    let user = port.user_named("LOAD_IT").unwrap();
+    let shown = user.shown().expect("the users' side shows its values");
+    assert_eq!((shown.request)(&(0, 18.5)), "(0, 18.5)");
+    let owner = port.owner().unwrap();
+    let shown = owner.shown().expect("FILTER shows its values");
+    assert_eq!((shown.reply)(&Some((1, 9.0))), "Some((1, 9.0))");
 }

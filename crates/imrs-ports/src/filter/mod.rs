@@ -71,6 +71,22 @@ where
         }
     }
 
+    /// Shows the values on both sides of the filter as `Debug` writes them, as
+    /// [`Port::shown`] does for a plain port.
+    pub fn shown(self) -> Self
+    where
+        Req: std::fmt::Debug,
+        Rep: std::fmt::Debug,
+        FReq: std::fmt::Debug,
+        FRep: std::fmt::Debug,
+    {
+        Self {
+            port: self.port.shown(),
+            filter: self.filter.shown(),
+            filter_task: self.filter_task,
+        }
+    }
+
     /// The port's name.
     pub fn name(&self) -> &Name {
         self.port.name()
