@@ -189,3 +189,28 @@ fn a_recording_that_cannot_be_written_is_refused_by_name() {
         "{refused}"
     );
 }
+
+#[test]
+fn the_timeline_keeps_only_its_window_however_long_the_run() {
+    let draw = |hours: f64| {
+        let path = temp(&format!("window-{hours}.svg"));
+        let config = CellConfig {
+            hours,
+            feeder: FeederPolicy::Appendix,
+            timeline: Some(TimelineConfig {
+                path: path.clone(),
+                from: Duration::from_secs(20),
+                span: Duration::from_secs(60),
+            }),
+            ..CellConfig::default()
+        };
+        run(&config).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        svg
+    };
+    // Four times the run, the same picture: nothing after the window was kept.
+    let (short, long) = (draw(0.05), draw(0.2));
+    assert!(short.contains("deadlock CHIP_IT"));
+    assert!(short == long, "the longer run drew something else");
+}

@@ -63,16 +63,32 @@ pub(crate) const SIM_SCHEMA: &str = r#"{
   "required": ["kind", "text"]
 }"#;
 
-/// Where a cell event is recorded: on its port's channel, or its module's.
-pub(crate) enum Route<'a> {
+/// Where a cell event is recorded: on its port's channel, or its module's. Names are
+/// interned, so a route is a key that costs no string per event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) enum Route {
     /// `/ports/PORT`.
-    Port(&'a str),
+    Port(&'static str),
     /// `/modules/MODULE`.
-    Module(&'a str),
+    Module(&'static str),
+}
+
+impl Route {
+    /// The channel's topic, its schema, and the schema's name.
+    pub(crate) fn channel(self) -> (String, &'static str, &'static str) {
+        match self {
+            Route::Port(port) => (format!("/ports/{port}"), PORT_SCHEMA, "imrs.PortEvent"),
+            Route::Module(module) => (
+                format!("/modules/{module}"),
+                MODULE_SCHEMA,
+                "imrs.ModuleEvent",
+            ),
+        }
+    }
 }
 
 /// The channel and the JSON of a cell event.
-pub(crate) fn cell_message(event: &Event) -> (Route<'_>, Value) {
+pub(crate) fn cell_message(event: &Event) -> (Route, Value) {
     let task = event.task.as_ref().map(|task| task.as_str());
     let port = |op: &str, port: &'static str, observed: Option<&Observed>| {
         let mut message = json!({"op": op, "module": event.module.as_str()});

@@ -16,9 +16,7 @@ use imrs_sim::{Scene, Sim};
 use serde_json::Value;
 
 use crate::error::RecordError;
-use crate::messages::{
-    MODULE_SCHEMA, PORT_SCHEMA, Route, SIM_SCHEMA, cell_log, cell_message, sim_log, sim_message,
-};
+use crate::messages::{Route, SIM_SCHEMA, cell_log, cell_message, sim_log, sim_message};
 use crate::scene::{self, Moved, Parts};
 use crate::time::nanos;
 
@@ -49,7 +47,7 @@ struct Inner {
     writer: Mutex<Option<McapWriterHandle<BufWriter<File>>>>,
     /// The port and module channels, made as their first message comes, so that the same
     /// run makes them in the same order.
-    topics: Mutex<HashMap<String, Arc<RawChannel>>>,
+    topics: Mutex<HashMap<Route, Arc<RawChannel>>>,
     log: Channel<Log>,
     sim: Arc<RawChannel>,
     fixed: Channel<SceneUpdate>,
@@ -127,15 +125,7 @@ impl Recorder {
         cell.events().subscribe(move |event| {
             let at = nanos(event.at);
             let (route, message) = cell_message(event);
-            let (topic, schema, name) = match route {
-                Route::Port(port) => (format!("/ports/{port}"), PORT_SCHEMA, "imrs.PortEvent"),
-                Route::Module(module) => (
-                    format!("/modules/{module}"),
-                    MODULE_SCHEMA,
-                    "imrs.ModuleEvent",
-                ),
-            };
-            inner.json(&topic, schema, name, &message, at);
+            inner.json(route, &message, at);
             if let Some(entry) = cell_log(event) {
                 inner.log.log_with_time(&entry, at);
                 inner.counted();
@@ -217,11 +207,12 @@ impl Recorder {
 }
 
 impl Inner {
-    fn json(&self, topic: &str, schema: &'static str, name: &str, message: &Value, at: u64) {
+    fn json(&self, route: Route, message: &Value, at: u64) {
         let mut topics = lock(&self.topics);
-        let channel = match topics.get(topic) {
+        let channel = match topics.get(&route) {
             Some(channel) => Arc::clone(channel),
             None => {
+                let (topic, schema, name) = route.channel();
                 let made = self
                     .context
                     .channel_builder(topic)
@@ -232,7 +223,7 @@ impl Inner {
                     // The only refusal is a missing encoding, given above.
                     return;
                 };
-                topics.insert(topic.to_string(), Arc::clone(&channel));
+                topics.insert(route, Arc::clone(&channel));
                 channel
             }
         };

@@ -90,7 +90,7 @@ struct Fold {
     rows: Vec<Row>,
     row_of: HashMap<String, usize>,
     /// Sections entered and not yet left: (row, task, section) to when.
-    open: HashMap<(usize, String, String), f64>,
+    open: HashMap<(usize, &'static str, &'static str), f64>,
     /// Robots inside the zone: robot to when it entered.
     inside: HashMap<String, f64>,
     shared_since: Option<f64>,
@@ -125,17 +125,14 @@ impl Timeline {
             let mut fold = lock(&fold);
             fold.last = fold.last.max(at);
             let row = fold.row(event.module.as_str());
-            let task = event
-                .task
-                .as_ref()
-                .map_or("", |task| task.as_str())
-                .to_string();
+            // Names are interned: the fold keys on them without copying a string per event.
+            let task: &'static str = event.task.as_ref().map_or("", |task| task.as_str());
             match &event.kind {
                 EventKind::SectionEntered { section } => {
-                    fold.open.insert((row, task, section.to_string()), at);
+                    fold.open.insert((row, task, section.as_str()), at);
                 }
                 EventKind::SectionLeft { section } => {
-                    if let Some(since) = fold.open.remove(&(row, task, section.to_string())) {
+                    if let Some(since) = fold.open.remove(&(row, task, section.as_str())) {
                         fold.span(row, since, at, SpanKind::Section(section.to_string()));
                     }
                 }
@@ -148,8 +145,7 @@ impl Timeline {
                     observed: Some(observed),
                 } => {
                     let since = at - observed.waited.as_secs_f64();
-                    let row = fold.task_row(row, event.module.as_str(), &task);
-                    fold.span(row, since, at, SpanKind::Blocked(port.to_string()));
+                    fold.blocked(row, event.module.as_str(), task, (since, at), port.as_str());
                 }
                 EventKind::PortError {
                     port,
@@ -158,8 +154,7 @@ impl Timeline {
                     ..
                 } if primitive.awaits_a_peer() => {
                     let since = at - observed.waited.as_secs_f64();
-                    let row = fold.task_row(row, event.module.as_str(), &task);
-                    fold.span(row, since, at, SpanKind::Blocked(port.to_string()));
+                    fold.blocked(row, event.module.as_str(), task, (since, at), port.as_str());
                 }
                 EventKind::ExceptionRaised { exception }
                     if exception.as_str().ends_with(".TIMEOUT") =>
@@ -266,6 +261,22 @@ impl Fold {
         }
     }
 
+    /// A wait on a peer from `since` to `until`, on its task's row: made only if the wait
+    /// reaches into the window, so that a run's length adds no rows.
+    fn blocked(
+        &mut self,
+        module_row: usize,
+        module: &str,
+        task: &str,
+        (since, until): (f64, f64),
+        port: &str,
+    ) {
+        if since.max(self.from) < until.min(self.to) {
+            let row = self.task_row(module_row, module, task);
+            self.span(row, since, until, SpanKind::Blocked(port.to_string()));
+        }
+    }
+
     /// Keeps the part of a stretch that lies inside the window.
     fn span(&mut self, row: usize, from: f64, to: f64, kind: SpanKind) {
         let (from, to) = (from.max(self.from), to.min(self.to));
@@ -296,7 +307,7 @@ impl Fold {
                 rows[*row].spans.push(Span {
                     from,
                     to,
-                    kind: SpanKind::Section(section.clone()),
+                    kind: SpanKind::Section(section.to_string()),
                 });
             }
         }

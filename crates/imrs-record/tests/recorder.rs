@@ -284,3 +284,29 @@ fn a_recording_is_finished_once_and_a_file_that_cannot_be_made_is_named() {
         "{nowhere}"
     );
 }
+
+#[test]
+fn two_recordings_made_at_once_on_two_threads_never_mix() {
+    let (_, alone, path) = record("alone.mcap");
+    std::fs::remove_file(&path).unwrap();
+    let together: Vec<Vec<Read>> = std::thread::scope(|scope| {
+        let makers: Vec<_> = ["first-of-two.mcap", "second-of-two.mcap"]
+            .map(|file| {
+                scope.spawn(move || {
+                    let (_, messages, path) = record(file);
+                    std::fs::remove_file(&path).unwrap();
+                    messages
+                })
+            })
+            .into_iter()
+            .collect();
+        makers
+            .into_iter()
+            .map(|maker| maker.join().unwrap())
+            .collect()
+    });
+    for messages in together {
+        assert_eq!(messages.len(), alone.len());
+        assert!(messages == alone, "a recording made beside another differs");
+    }
+}

@@ -2,6 +2,7 @@
 //! handles through which modules drive its devices.
 
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
@@ -48,6 +49,8 @@ struct Shared {
     stepped: Notify,
     log: SimLog,
     watchers: Mutex<Vec<Watcher>>,
+    /// Whether anyone watches: read at every step, so that an unwatched world takes no lock.
+    watched: AtomicBool,
 }
 
 /// Someone who draws the scene, at most once per `period` of the clock.
@@ -68,6 +71,7 @@ impl Sim {
                 stepped: Notify::new(),
                 log: SimLog::default(),
                 watchers: Mutex::new(Vec::new()),
+                watched: AtomicBool::new(false),
             }),
         }
     }
@@ -113,13 +117,14 @@ impl Sim {
             next: scene.at + period,
             see: Box::new(see),
         });
+        self.shared.watched.store(true, Ordering::Release);
     }
 
     fn tell_watchers(&self, now: Instant) {
-        let mut watchers = lock(&self.shared.watchers);
-        if watchers.is_empty() {
+        if !self.shared.watched.load(Ordering::Acquire) {
             return;
         }
+        let mut watchers = lock(&self.shared.watchers);
         let (scene, still) = {
             let world = self.world();
             let still = !world.is_active();
