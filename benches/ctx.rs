@@ -2,6 +2,9 @@
 //! modules, with the event log and the deadlock diagnosis on, beside the raw `End` round
 //! trip in the same group: on one processor, and as tasks of a two-worker runtime.
 
+#[path = "config.rs"]
+mod config;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -78,10 +81,7 @@ fn ctx(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = ctx
 }
 criterion_main!(benches);

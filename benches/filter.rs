@@ -4,6 +4,9 @@
 //! A filter is a task between two rendezvous: every message costs a rendezvous in and,
 //! drained, one out, where the mpsc costs a queue write and read in one task.
 
+#[path = "config.rs"]
+mod config;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -76,10 +79,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = filter_benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = benches
 }
 criterion_main!(filter_benches);

@@ -2,6 +2,9 @@
 //! with the responder in a lower-ranked section at a suspension point; the same-thread
 //! send/receive/reply round trip as baseline. Both ends of each run on one processor.
 
+#[path = "config.rs"]
+mod config;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -93,10 +96,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = query_benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = benches
 }
 criterion_main!(query_benches);

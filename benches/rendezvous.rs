@@ -5,6 +5,9 @@
 //! current-thread and the multi-thread runtime, kameo's `ask` and ractor's `call!` on the
 //! same runtimes, a crossbeam ping-pong, an atomic spin ping-pong.
 
+#[path = "config.rs"]
+mod config;
+
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -109,10 +112,7 @@ fn rendezvous(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = rendezvous
 }
 criterion_main!(benches);

@@ -4,6 +4,9 @@
 //! send answered through a oneshot. One iteration is one hop: criterion's figure per
 //! iteration is the time per message, its throughput line messages per second.
 
+#[path = "config.rs"]
+mod config;
+
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
@@ -89,10 +92,7 @@ fn ring(c: &mut Criterion) {
 
 criterion_group! {
     name = benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
-        .sample_size(10);
+    config = config::long_run();
     targets = ring
 }
 criterion_main!(benches);

@@ -1,5 +1,8 @@
 //! `select` over 8 ports of different priorities, with one ready and with all ready.
 
+#[path = "config.rs"]
+mod config;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -68,10 +71,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = select_benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = benches
 }
 criterion_main!(select_benches);

@@ -1,6 +1,9 @@
 //! How fast the simulated cell runs: simulated seconds per wall second, for the chip cell's
 //! world with both chip robots working and pallets flowing, on virtual time.
 
+#[path = "config.rs"]
+mod config;
+
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -61,10 +64,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = sim_benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
-        .sample_size(10);
+    config = config::long_run();
     targets = benches
 }
 criterion_main!(sim_benches);

@@ -6,6 +6,9 @@
 //! rendezvous' own cost: a function that folds over the whole pool makes every round O(n²)
 //! by itself, whatever the rendezvous costs.
 
+#[path = "config.rs"]
+mod config;
+
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -80,10 +83,7 @@ fn benches(c: &mut Criterion) {
 
 criterion_group! {
     name = waitfor_benches;
-    config = Criterion::default()
-        .warm_up_time(Duration::from_millis(300))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(20);
+    config = config::primitive();
     targets = benches
 }
 criterion_main!(waitfor_benches);
