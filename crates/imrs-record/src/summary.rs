@@ -111,8 +111,14 @@ fn summarise(bytes: &[u8]) -> Result<RecordingSummary, mcap::McapError> {
         let at = message.log_time;
         span = Some(span.map_or((at, at), |(first, last)| (first.min(at), last.max(at))));
     }
+    // A finished recording has a summary with its statistics, and an index entry for each
+    // chunk; one that holds no message has no chunk to index.
     let (chunks, indexed) = index.as_ref().map_or((0, false), |index| {
-        (index.chunk_indexes.len(), !index.chunk_indexes.is_empty())
+        let chunks = index.chunk_indexes.len();
+        (
+            chunks,
+            index.stats.is_some() && (chunks > 0 || messages == 0),
+        )
     });
     Ok(RecordingSummary {
         channels: channels.into_values().collect(),

@@ -310,3 +310,18 @@ fn two_recordings_made_at_once_on_two_threads_never_mix() {
         assert!(messages == alone, "a recording made beside another differs");
     }
 }
+
+#[test]
+fn messages_that_come_after_finish_are_dropped_and_the_file_stays_whole() {
+    let path = temp("finished-early.mcap");
+    let recorder = Recorder::create(&path).unwrap();
+    let finished = recorder.finish().unwrap();
+    let before = std::fs::read(&path).unwrap();
+    // The whole cell runs with the finished recorder subscribed.
+    run(Some(&recorder), None);
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    let summary = read_summary(&path).unwrap();
+    assert!(summary.indexed);
+    assert_eq!(summary.messages, finished.messages);
+    std::fs::remove_file(&path).unwrap();
+}
