@@ -66,6 +66,7 @@ mod response;
 pub mod select;
 pub mod shown;
 mod slot;
+pub mod synchronous;
 pub mod urgency;
 pub mod usage;
 mod user_list;
