@@ -43,6 +43,7 @@ mod device;
 mod error;
 mod event;
 mod fault;
+pub mod hand;
 mod ids;
 pub mod layout;
 pub mod profile;
