@@ -21,11 +21,15 @@ use super::object::{Detection, Object, Shape};
 /// radian of error.
 const FINGER_SPRING: (f32, f32) = (0.5, 0.016);
 /// The wrist's springs: stiff, so that the palm follows its ramped target closely.
-const WRIST_LINEAR_SPRING: (f32, f32) = (400.0, 40.0);
-const WRIST_ANGULAR_SPRING: (f32, f32) = (20.0, 2.0);
+const WRIST_LINEAR_SPRING: (f32, f32) = (2000.0, 80.0);
+const WRIST_ANGULAR_SPRING: (f32, f32) = (20.0, 0.4);
 /// Reflected rotor inertia on every joint, which keeps the light finger links well
 /// conditioned.
 const ARMATURE: f32 = 1e-4;
+
+/// How thick a fingertip's tactile pad is: a surface this close presses on it. A finger
+/// held where it first touched stays within it, so the touch does not flicker on and off.
+const SKIN: f32 = 0.0015;
 
 /// What a fingertip touches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -226,12 +230,12 @@ impl HandWorld {
             .narrow_phase
             .contact_pairs_with(tip)
             .filter(|pair| {
-                // Rapier keeps speculative contacts before shapes meet; a touch is a
-                // contact that pushed in the last step, as a pressure sensor feels it.
-                pair.solver_manifolds()
+                // Rapier keeps speculative contacts before shapes meet: a touch is a
+                // contact point within the pad's skin.
+                pair.manifolds()
                     .iter()
                     .flat_map(|manifold| &manifold.points)
-                    .any(|point| point.data.impulse > 0.0)
+                    .any(|point| point.dist <= SKIN)
             })
             .find_map(|pair| {
                 let other = if pair.collider1 == tip {

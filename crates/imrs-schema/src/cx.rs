@@ -1,0 +1,90 @@
+//! What an instance's set-up and behaviour can do besides reading and writing its ports.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use imrs_core::imrs_ports::synchronous::{AnyPort, Input, Output, connect, connect_any};
+use imrs_core::imrs_ports::{Instant, Name, SharedClock};
+
+use crate::error::SchemaError;
+use crate::instance::{Si, find, forall, instantiate};
+use crate::schema::Schema;
+use crate::scope::Scope;
+
+/// An instance's view of the network: the assemblage it instantiates into, its own name,
+/// the clock.
+#[derive(Clone)]
+pub struct Cx {
+    scope: Arc<Scope>,
+    me: Name,
+    number: u32,
+}
+
+impl Cx {
+    pub(crate) fn new(scope: Arc<Scope>, me: Name, number: u32) -> Self {
+        Self { scope, me, number }
+    }
+
+    /// The instance this context belongs to (the network's top: `/`).
+    pub fn me(&self) -> &Name {
+        &self.me
+    }
+
+    /// The instance's number `i` (0 for the network's top). A special schema reads which
+    /// joint or sensor it stands for here: the `i`th instance of `Jmotor` drives joint `i`.
+    pub fn number(&self) -> u32 {
+        self.number
+    }
+
+    /// `N{V0}`: a new instance of `schema`, whose fields are its internal variables' initial
+    /// values, numbered with the lowest number free in this assemblage.
+    pub fn instantiate<S: Schema>(&self, schema: S) -> Result<Si<S>, SchemaError> {
+        instantiate(&self.scope, None, schema)
+    }
+
+    /// `N_i{V0}`: a new instance numbered `number`; refused if `N_number` is live here.
+    pub fn instantiate_as<S: Schema>(&self, number: u32, schema: S) -> Result<Si<S>, SchemaError> {
+        instantiate(&self.scope, Some(number), schema)
+    }
+
+    /// `FORALL N`: the live instances of `S` here, by number.
+    pub fn forall<S: Schema>(&self) -> Vec<Si<S>> {
+        forall(&self.scope)
+    }
+
+    /// The live instance `S_number` here, if there is one.
+    pub fn get<S: Schema>(&self, number: u32) -> Option<Si<S>> {
+        find(&self.scope, number)
+    }
+
+    /// A couplet of a connection map, `Ipname ← SIPname`, checked by the compiler.
+    pub fn connect<T: Clone + Send + 'static>(&self, output: &Output<T>, input: &Input<T>) {
+        connect(output, input);
+    }
+
+    /// A couplet given by name, checked now: the directions, and that both ends carry one
+    /// type. The error names both ends.
+    pub fn connect_any(
+        &self,
+        output: &dyn AnyPort,
+        input: &dyn AnyPort,
+    ) -> Result<(), SchemaError> {
+        Ok(connect_any(output, input)?)
+    }
+
+    /// The network's clock.
+    pub fn clock(&self) -> &SharedClock {
+        &self.scope.net.clock
+    }
+
+    /// The time now.
+    pub fn now(&self) -> Instant {
+        self.scope.net.clock.now()
+    }
+
+    /// Waits `duration` on the network's clock.
+    pub async fn delay(&self, duration: Duration) {
+        let clock = &self.scope.net.clock;
+        clock.sleep_until(clock.now() + duration).await;
+    }
+}

@@ -1,0 +1,146 @@
+//! A schema network: the top-level assemblage, the processor its instances run on, and the
+//! trace of their lives.
+
+use std::fmt;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use imrs_core::Processor;
+use imrs_core::imrs_ports::{Instant, Name, SharedClock};
+
+use crate::cx::Cx;
+use crate::error::SchemaError;
+use crate::instance::Si;
+use crate::schema::Schema;
+use crate::scope::Scope;
+
+/// How an instance ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// Its behaviour said `STOP` (for a task-unit: its r-schema did).
+    Stopped,
+    /// Another instance (or the network) deinstantiated it, or the assemblage it is in
+    /// ended.
+    Deinstantiated,
+    /// An assemblage whose components had all ended.
+    ComponentsEnded,
+    /// Its behaviour failed.
+    Failed(SchemaError),
+}
+
+/// One line of a network's trace.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceEntry {
+    /// When, on the network's clock.
+    pub at: Instant,
+    /// The instance.
+    pub instance: Name,
+    /// `None` when it was instantiated; how it ended, when it ended.
+    pub ended: Option<Ending>,
+}
+
+impl fmt::Display for TraceEntry {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let at = self.at.since_start().as_secs_f64();
+        match &self.ended {
+            None => write!(f, "{at:9.3} s  {} instantiated", self.instance),
+            Some(Ending::Failed(error)) => {
+                write!(f, "{at:9.3} s  {} failed: {error}", self.instance)
+            }
+            Some(ending) => write!(f, "{at:9.3} s  {} ended: {ending:?}", self.instance),
+        }
+    }
+}
+
+pub(crate) struct Net {
+    pub(crate) clock: SharedClock,
+    pub(crate) processor: Processor,
+    trace: Mutex<Vec<TraceEntry>>,
+}
+
+impl Net {
+    pub(crate) fn record(&self, instance: &Name, ended: Option<Ending>) {
+        let entry = TraceEntry {
+            at: self.clock.now(),
+            instance: instance.clone(),
+            ended,
+        };
+        self.trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(entry);
+    }
+}
+
+/// A network of schema instances: the top-level assemblage.
+///
+/// Its instances run on one [`Processor`] — the seed's processes "close together in
+/// communication space" — which polls woken instances in the order they woke, so that
+/// all are "treated equally with respect to resource access", and a run on virtual time
+/// is reproducible.
+#[derive(Clone)]
+pub struct Network {
+    top: Arc<Scope>,
+}
+
+impl Network {
+    /// An empty network on `clock`, its processor named `name`.
+    ///
+    /// # Panics
+    ///
+    /// Outside a tokio runtime, as the processor's task is spawned on it.
+    pub fn new(name: impl Into<Name>, clock: SharedClock) -> Self {
+        let net = Arc::new(Net {
+            clock,
+            processor: Processor::new(name),
+            trace: Mutex::default(),
+        });
+        Self {
+            top: Scope::top(net),
+        }
+    }
+
+    /// The network's top, as a context to instantiate and connect in.
+    pub fn cx(&self) -> Cx {
+        Cx::new(Arc::clone(&self.top), "/".into(), 0)
+    }
+
+    /// Instantiates `schema` at the top, with the lowest free number.
+    pub fn instantiate<S: Schema>(&self, schema: S) -> Result<Si<S>, SchemaError> {
+        self.cx().instantiate(schema)
+    }
+
+    /// Instantiates `schema` at the top as number `number`.
+    pub fn instantiate_as<S: Schema>(&self, number: u32, schema: S) -> Result<Si<S>, SchemaError> {
+        self.cx().instantiate_as(number, schema)
+    }
+
+    /// The live instances of `S` at the top.
+    pub fn forall<S: Schema>(&self) -> Vec<Si<S>> {
+        self.cx().forall()
+    }
+
+    /// Every instantiation and ending so far, in order.
+    pub fn trace(&self) -> Vec<TraceEntry> {
+        self.top
+            .net
+            .trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    /// Deinstantiates every instance.
+    pub fn stop(&self) {
+        self.top.stop_all();
+    }
+
+    /// Completes once no instance is left at the top.
+    pub async fn ended(&self) {
+        self.top.emptied().await;
+    }
+
+    /// The processor the instances run on: a module placed on it shares their turns.
+    pub fn processor(&self) -> &Processor {
+        &self.top.net.processor
+    }
+}

@@ -1,0 +1,22 @@
+//! The four test examples of seed 004 §5, written in this crate's API, on the simulated
+//! hand. The examples `guarded_move`, `reach`, `object_search` and `virtual_fingers` run
+//! them; the tests check their physical outcome in rapier.
+//!
+//! | seed | here |
+//! |---|---|
+//! | `TClosejoint`, the r-schema of the guarded move | [`TClosejoint`] |
+//! | the `Closejoint_i` task-unit (Figure 3) | [`Closejoint`] |
+//! | `[Grip () () (Closejoint) (FOR i = 1…n DO Closejoint(i,10) ENDFOR) () ()]` | [`Grip`] |
+//! | `RObject`, `Reach` (Figure 4) | [`RObject`], [`Reach`] |
+//! | `Objtest`, `Object?` (Figure 5) | [`Objtest`], [`ObjectQ`] |
+//! | `VF_k`, `N = [T_i - F_i]`, `FORALL VF_k_i DO N(i) ENDFOR` | [`Vf`], [`Closefinger`], [`Grasp`] |
+
+mod grip;
+mod object;
+mod reach;
+mod vf;
+
+pub use grip::{Closejoint, Grip, TClosejoint, TClosejointPorts};
+pub use object::{Desired, ObjectQ, ObjectQPorts, Objtest, ObjtestPorts};
+pub use reach::{RObject, RObjectPorts, Reach, ReachPorts};
+pub use vf::{Closefinger, ClosefingerPorts, Grasp, Vf};

@@ -1,0 +1,233 @@
+//! The four examples of seed 004 §5, judged by their physical outcome in rapier: contact
+//! reached and fingers stopped; the wrist at the object; the matching object chosen; the
+//! virtual finger's fingers moved and no other.
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use imrs_core::imrs_ports::{Clock, VirtualClock};
+use imrs_schema::seed::{Desired, Grasp, Grip, ObjectQ, Reach, Vf};
+use imrs_schema::special::Vision;
+use imrs_schema::{Ending, Network, Si};
+use imrs_sim::hand::{FINGERS, Hand, HandConfig, Shape, Touch, finger_joints};
+
+struct Bench {
+    hand: Hand,
+    net: Network,
+    clock: VirtualClock,
+}
+
+impl Bench {
+    /// A hand over the default table, its vision interface running.
+    fn new() -> Self {
+        let clock = VirtualClock::new();
+        let hand = Hand::new(HandConfig::seeded(4), Arc::new(clock.clone()));
+        hand.spawn();
+        let net = Network::new("HAND", Arc::new(clock.clone()));
+        net.instantiate(Vision::new(&hand)).unwrap();
+        Self { hand, net, clock }
+    }
+
+    async fn run_for(&self, seconds: f64) {
+        let until = self.clock.now() + Duration::from_secs_f64(seconds);
+        imrs_core::time::drive(&self.clock, until).await;
+    }
+
+    /// The SEF the vision interface gives object `index` of the table: numbered in order
+    /// of x at first sight.
+    fn sef_of(&self, index: usize) -> u32 {
+        let objects = self.hand.objects();
+        let x = objects[index].position.x;
+        1 + objects.iter().filter(|o| o.position.x < x).count() as u32
+    }
+
+    fn index_of(&self, shape: Shape) -> usize {
+        self.hand
+            .objects()
+            .iter()
+            .position(|o| o.shape == shape)
+            .unwrap()
+    }
+
+    /// Reaches over object `index` (its SEF found by the camera), then down around it:
+    /// coming straight down, the fingers never sweep into the object.
+    async fn reach(&self, object: usize) -> Si<Reach> {
+        self.run_for(0.1).await; // the camera's first frame
+        let sef = self.sef_of(object);
+        self.reach_to(sef, 0.2).await;
+        self.reach_to(sef, 0.1).await
+    }
+
+    async fn reach_to(&self, sef: u32, above: f32) -> Si<Reach> {
+        let reach = self
+            .net
+            .instantiate(Reach::new(&self.hand, sef, above))
+            .unwrap();
+        for _ in 0..100 {
+            if !reach.is_live() {
+                break;
+            }
+            self.run_for(0.1).await;
+        }
+        assert!(!reach.is_live(), "the reach never got there");
+        reach
+    }
+
+    /// How far the palm is from `above` over object `index`, and its yaw.
+    fn palm_error(&self, index: usize, above: f32) -> f32 {
+        let object = self.hand.objects()[index].position;
+        let palm = self.hand.palm().translation.vector;
+        (palm - (object.coords + nalgebra::Vector3::new(0.0, 0.0, above))).norm()
+    }
+
+    fn angles(&self, finger: usize) -> [f32; 2] {
+        finger_joints(finger).map(|j| self.hand.position(j).unwrap())
+    }
+}
+
+fn ended(net: &Network, instance: &str) -> Option<Ending> {
+    net.trace()
+        .into_iter()
+        .find(|e| e.instance == instance && e.ended.is_some())
+        .and_then(|e| e.ended)
+}
+
+#[tokio::test(start_paused = true)]
+async fn example_1_the_guarded_move_closes_every_finger_until_it_touches() {
+    let bench = Bench::new();
+    let cube = bench.index_of(Shape::Cube);
+    bench.reach(cube).await;
+    let cube_before = bench.hand.objects()[cube].position;
+    let joints = FINGERS.iter().flat_map(|&f| finger_joints(f));
+    bench
+        .net
+        .instantiate(Grip::new(&bench.hand, joints, 0.01))
+        .unwrap();
+    bench.run_for(3.0).await;
+
+    let held: Vec<[f32; 2]> = FINGERS.iter().map(|&f| bench.angles(f)).collect();
+    bench.run_for(1.0).await;
+    for (&finger, before) in FINGERS.iter().zip(&held) {
+        assert_eq!(
+            bench.hand.touch(finger).unwrap(),
+            Some(Touch::Object(cube)),
+            "finger {finger} never reached the cube"
+        );
+        assert!(
+            before[0] > 0.02,
+            "finger {finger} did not close: {before:?}"
+        );
+        let after = bench.angles(finger);
+        for k in 0..2 {
+            assert!(
+                (after[k] - before[k]).abs() < 0.005,
+                "finger {finger} kept moving after contact: {before:?} -> {after:?}"
+            );
+        }
+        assert!(bench.hand.finger_speed(finger).unwrap() < 1e-3);
+    }
+    let moved = (bench.hand.objects()[cube].position - cube_before).norm();
+    assert!(moved < 0.005, "the grip pushed the cube {moved} m");
+}
+
+#[tokio::test(start_paused = true)]
+async fn example_2_reach_takes_the_wrist_to_the_object_its_sef_reports() {
+    let bench = Bench::new();
+    let ball = bench.index_of(Shape::Ball);
+    let reach = bench.reach(ball).await;
+    assert_eq!(
+        ended(&bench.net, reach.name().as_str()),
+        Some(Ending::Stopped)
+    );
+    bench.run_for(0.5).await;
+    let error = bench.palm_error(ball, 0.1);
+    assert!(
+        error < 0.004,
+        "the palm is {error} m from its target over the ball"
+    );
+    let yaw = bench.hand.palm().rotation.euler_angles().2;
+    assert!(yaw.abs() < 0.02, "yaw {yaw}");
+    for other in (0..3).filter(|&i| i != ball) {
+        assert!(bench.palm_error(other, 0.1) > 0.1);
+    }
+}
+
+#[tokio::test(start_paused = true)]
+async fn example_3_object_search_tests_every_sef_in_parallel_and_reaches_the_match() {
+    let bench = Bench::new();
+    let ball = bench.index_of(Shape::Ball);
+    let hand = bench.hand.clone();
+    let desired = Desired {
+        shape: Shape::Ball,
+        size: 0.06,
+        tolerance: 0.005,
+    };
+    bench.run_for(0.1).await;
+    bench
+        .net
+        .instantiate(ObjectQ::new(desired, move |cx, sef| {
+            // Tj: reach over the object found.
+            cx.instantiate(Reach::new(&hand, sef, 0.2)).map(drop)
+        }))
+        .unwrap();
+    bench.run_for(4.0).await;
+
+    let trace = bench.net.trace();
+    let tests: Vec<_> = trace
+        .iter()
+        .filter(|e| e.instance.as_str().starts_with("Objtest_") && e.ended.is_none())
+        .collect();
+    assert!(tests.len() >= 3, "not every SEF was tested: {tests:?}");
+    assert!(
+        tests[..3].iter().all(|e| e.at == tests[0].at),
+        "the first tests did not start together"
+    );
+    assert_eq!(ended(&bench.net, "Object?_1"), Some(Ending::Stopped));
+    assert_eq!(ended(&bench.net, "Reach_1"), Some(Ending::Stopped));
+    let error = bench.palm_error(ball, 0.2);
+    assert!(
+        error < 0.004,
+        "the palm is {error} m from its target over the ball"
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn example_4_a_virtual_finger_moves_its_fingers_and_no_other() {
+    let bench = Bench::new();
+    let cube = bench.index_of(Shape::Cube);
+    bench.reach(cube).await;
+    // f_2 = {1, 2, 4}
+    for finger in [1, 2, 4] {
+        bench.net.instantiate_as(finger, Vf::<2>).unwrap();
+    }
+    bench
+        .net
+        .instantiate(Grasp::<2>::new(&bench.hand, 0.01))
+        .unwrap();
+    bench.run_for(3.0).await;
+
+    let closing: Vec<_> = bench
+        .net
+        .trace()
+        .into_iter()
+        .filter(|e| {
+            let name = e.instance.as_str();
+            name.starts_with("Closefinger_") && !name.contains('/') && e.ended.is_none()
+        })
+        .map(|e| e.instance.to_string())
+        .collect();
+    assert_eq!(closing, ["Closefinger_1", "Closefinger_2", "Closefinger_4"]);
+    for finger in [1, 2, 4] {
+        assert!(
+            bench.angles(finger)[0] > 0.02,
+            "finger {finger} did not move"
+        );
+        assert_eq!(bench.hand.touch(finger).unwrap(), Some(Touch::Object(cube)));
+    }
+    let still = bench.angles(3);
+    assert!(
+        still.iter().all(|a| a.abs() < 0.005),
+        "finger 3 moved: {still:?}"
+    );
+    assert_eq!(bench.hand.touch(3).unwrap(), None);
+}
