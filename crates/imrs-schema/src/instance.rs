@@ -199,7 +199,10 @@ async fn live<S: Schema>(
             }
         }
     };
+    // Its components end first (each at its next suspension point), so that an instance
+    // ends only once everything inside it has.
     control.inside.stop_all();
+    control.inside.emptied().await;
     ports.list().iter().for_each(|(_, port)| port.close());
     drop(schema);
     scope.remove(S::NAME, number);

@@ -16,7 +16,8 @@ ports! {
 
 /// `Jmotor_i`: each value read on `desired` is its command for joint `i` (metres or
 /// radians); the joint receives the mean of the commands of every live `Jmotor_i`, and
-/// `actual` reports that mean. Deinstantiating it withdraws its command.
+/// `actual` reports that mean. It takes at most one command per step of the hand.
+/// Deinstantiating it withdraws its command.
 #[derive(Debug)]
 pub struct Jmotor {
     hand: Hand,
@@ -64,6 +65,9 @@ impl Schema for Jmotor {
                         instance: cx.me().clone(),
                         error,
                     })?;
+                // A command takes effect at the next step: one per step, so that a
+                // commander that writes without pause cannot spin the network in place.
+                self.hand.stepped().await;
             }
             Either::Right(reported) => reported?,
         }
