@@ -10,7 +10,7 @@
 //! | `[N (ip) (op) (v) (b)]` | a type implementing [`Schema`]: `NAME`, `Ports` (declared with [`ports!`]), its fields are `(v)`, [`Schema::behavior`] is one pass of `(b)` |
 //! | `[N (ip) (op) (s) (ib) (p) (n)]` | a [`Schema`] of [`Kind::Assemblage`]: [`Schema::set_up`] instantiates and connects the components (`s`, `ib`, `n`) and returns the component ports that are its own (`p`) |
 //! | `[N (ip) (op) (sl) (ml) (ib) (var) (b)]` | [`Kind::TaskUnit`]: `set_up` makes the sensing and motor components, `behavior` is the r-schema |
-//! | `N_i{V0}{C0}` | [`Cx::instantiate_as`]`(i, N { v0… })`, then [`Cx::connect`] per couplet (or [`Cx::connect_any`] by name) |
+//! | `N_i{V0}{C0}` | [`Cx::instantiate_as`]`(i, N { v0… })`, then [`Cx::connect`] per couplet (checked by the compiler); or [`Cx::instantiate_with`] and a map of [`Couplet`]s by name (checked at instantiation) |
 //! | `STOP` / `STOP{N_i}` | `Ok(Flow::Stop)` / [`Si::stop`] |
 //! | `FORALL N DO … ENDFOR` | `for si in cx.forall::<N>() { … }` |
 //! | `x := p` (read), `p := e` (write) | `p.read().await?`, `p.write(e).await?` |
@@ -70,7 +70,7 @@ mod scope;
 pub mod seed;
 pub mod special;
 
-pub use cx::Cx;
+pub use cx::{Couplet, Cx};
 pub use error::SchemaError;
 pub use imrs_core::imrs_ports::Name;
 pub use imrs_core::imrs_ports::synchronous::{AnyPort, Input, Output, ReadError, WriteError};

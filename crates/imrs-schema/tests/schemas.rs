@@ -400,3 +400,52 @@ async fn a_run_on_virtual_time_is_reproducible() {
     assert!(first.0.len() > 50);
     assert_eq!(first, second);
 }
+
+/// A connection map given at instantiation is checked then; a refused couplet leaves no
+/// instance behind (and no half-made connection that could take values), and names both
+/// ends.
+#[tokio::test(start_paused = true)]
+async fn a_connection_map_is_checked_at_instantiation_and_a_refused_instance_does_not_stay() {
+    use imrs_schema::Couplet;
+    use imrs_schema::seed::TClosejoint;
+    let (net, clock) = network();
+    let hand = Hand::new(HandConfig::seeded(1), Arc::new(clock.clone()));
+    let motor = net.instantiate_as(7, Jmotor::new(&hand)).unwrap();
+    let refused = net.cx().instantiate_with(
+        None,
+        TClosejoint { del: 0.01 },
+        &[
+            Couplet::output("Pout", motor.port("desired").unwrap()),
+            Couplet::input("Tin", motor.port("actual").unwrap()),
+        ],
+    );
+    assert_eq!(
+        refused.unwrap_err().to_string(),
+        "cannot connect Jmotor_7(actual) to TClosejoint_1(Tin): Jmotor_7(actual) writes f32, \
+         TClosejoint_1(Tin) reads bool"
+    );
+    run_for(&clock, 0.01).await;
+    assert!(net.forall::<TClosejoint>().is_empty());
+    assert!(endings(&net).contains(&("TClosejoint_1".into(), Ending::Deinstantiated)));
+    let Err(error) = net.cx().instantiate_with(
+        Some(2),
+        TClosejoint { del: 0.01 },
+        &[Couplet::input("Nope", motor.port("actual").unwrap())],
+    ) else {
+        panic!("a couplet on a port the schema lacks was accepted");
+    };
+    assert_eq!(error.to_string(), "TClosejoint_2 has no port Nope");
+    let kept = net
+        .cx()
+        .instantiate_with(
+            None,
+            TClosejoint { del: 0.01 },
+            &[Couplet::output("Pout", motor.port("desired").unwrap())],
+        )
+        .unwrap();
+    assert_eq!(
+        kept.number(),
+        1,
+        "the refused instance's number was not freed"
+    );
+}
