@@ -3,6 +3,12 @@
 //! [`imrs_ports::synchronous`](imrs_core::imrs_ports::synchronous), with the special
 //! schemas of a simulated dextrous hand.
 //!
+//! Why a crate of its own: the model is a second way of programming a cell, beside
+//! `imrs-core`'s modules, and its special schemas drive the simulated hand of `imrs-sim`,
+//! which a robot crate embedding `imrs-core` should not have to compile. The synchronous
+//! ports themselves live in `imrs-ports`, so a module talks to a schema network without
+//! this crate's help.
+//!
 //! # The notation, in Rust
 //!
 //! | seed 004 | here |

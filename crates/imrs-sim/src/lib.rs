@@ -1,5 +1,6 @@
 //! The simulated chip-insertion cell: two assembly lines of robots, conveyors, pallets and a
-//! shared feeder zone, in a rapier3d world stepped on the framework clock.
+//! shared feeder zone, in a rapier3d world stepped on the framework clock; and, in
+//! [`hand`], a dextrous hand over a table of objects, for the schemas of seed 004.
 //!
 //! The seed's Appendix omits its device drivers; this crate stands in for the hardware. It
 //! runs faster than real time on a [`VirtualClock`](imrs_core::imrs_ports::VirtualClock), or

@@ -29,10 +29,18 @@ pub use vision::Vision;
 pub use wrist::{Gather, GatherPorts, MoveWrist, OrientWrist, Split, SplitPorts, WristPorts};
 
 use imrs_core::imrs_ports::synchronous::Write;
-use imrs_sim::hand::Hand;
+use imrs_sim::hand::{Hand, HandError};
 
 use crate::race::{Either, race};
-use crate::{SchemaError, WriteError};
+use crate::{Cx, SchemaError, WriteError};
+
+/// Turns the hand's refusal of a number into the error of the instance `cx` belongs to.
+pub(crate) fn refused(cx: &Cx) -> impl FnOnce(HandError) -> SchemaError + '_ {
+    |error| SchemaError::Hand {
+        instance: cx.me().clone(),
+        error,
+    }
+}
 
 /// Writes one reading, fresh at this step; gives up at the next step if nobody took it,
 /// and otherwise waits for the next step, so that a reading is written once per step.

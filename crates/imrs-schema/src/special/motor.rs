@@ -2,7 +2,7 @@
 
 use imrs_sim::hand::Hand;
 
-use super::once_per_step;
+use super::{once_per_step, refused};
 use crate::race::{Either, race};
 use crate::{Behavior, Cx, Declare, Flow, ReadError, Schema, SchemaError, ports};
 
@@ -42,12 +42,7 @@ impl Schema for Jmotor {
 
     fn set_up(&mut self, cx: &Cx) -> Result<Self::Ports, SchemaError> {
         self.joint = cx.number() as usize;
-        self.hand
-            .target(self.joint)
-            .map_err(|error| SchemaError::Hand {
-                instance: cx.me().clone(),
-                error,
-            })?;
+        self.hand.target(self.joint).map_err(refused(cx))?;
         Ok(Declare::declare(cx.me()))
     }
 
@@ -61,10 +56,7 @@ impl Schema for Jmotor {
                 let desired = desired?;
                 self.hand
                     .command(self.joint, self.source, desired)
-                    .map_err(|error| SchemaError::Hand {
-                        instance: cx.me().clone(),
-                        error,
-                    })?;
+                    .map_err(refused(cx))?;
                 // A command takes effect at the next step: one per step, so that a
                 // commander that writes without pause cannot spin the network in place.
                 self.hand.stepped().await;

@@ -2,7 +2,7 @@
 
 use imrs_sim::hand::Hand;
 
-use super::once_per_step;
+use super::{once_per_step, refused};
 use crate::{Behavior, Cx, Declare, Flow, Schema, SchemaError, ports};
 
 ports! {
@@ -42,12 +42,7 @@ impl Schema for Jposition {
 
     fn set_up(&mut self, cx: &Cx) -> Result<Self::Ports, SchemaError> {
         self.joint = cx.number() as usize;
-        self.hand
-            .position(self.joint)
-            .map_err(|error| SchemaError::Hand {
-                instance: cx.me().clone(),
-                error,
-            })?;
+        self.hand.position(self.joint).map_err(refused(cx))?;
         Ok(Declare::declare(cx.me()))
     }
 
@@ -82,12 +77,7 @@ impl Schema for Tactile {
 
     fn set_up(&mut self, cx: &Cx) -> Result<Self::Ports, SchemaError> {
         self.sensor = cx.number() as usize;
-        self.hand
-            .touch(self.sensor)
-            .map_err(|error| SchemaError::Hand {
-                instance: cx.me().clone(),
-                error,
-            })?;
+        self.hand.touch(self.sensor).map_err(refused(cx))?;
         Ok(Declare::declare(cx.me()))
     }
 
