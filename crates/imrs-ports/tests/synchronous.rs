@@ -220,3 +220,44 @@ fn several_threads_lose_nothing_and_read_nothing_twice() {
         }
     });
 }
+
+/// A synchronous input is an alternative of `select`, beside a port's end: of the ready
+/// ones, the one of highest priority is taken.
+#[test]
+fn a_select_takes_the_most_urgent_ready_input() {
+    use imrs_ports::{Priority, select};
+    runtime().block_on(async {
+        let stop = Input::<&str>::with_priority("STOP", "HAND", Priority::declared(1));
+        let position = Input::<f32>::with_priority("Pin", "HAND", Priority::declared(5));
+        let (alarm, sensor) = (
+            Output::new("alarm", "SAFETY"),
+            Output::new("position", "Jposition_7"),
+        );
+        connect(&alarm, &stop);
+        connect(&sensor, &position);
+        let writers =
+            tokio::spawn(
+                async move { tokio::join!(sensor.write(0.5), alarm.write("emergency stop")) },
+            );
+        tokio::task::yield_now().await;
+        assert_eq!((stop.waiting(), position.waiting()), (1, 1));
+        let first = select()
+            .or(&position, |p| format!("position {p}"))
+            .or(&stop, |s| s.to_string())
+            .await
+            .unwrap();
+        assert_eq!(first, "emergency stop");
+        let second = select()
+            .or(&position, |p| format!("position {p}"))
+            .or(&stop, |s| s.to_string())
+            .await
+            .unwrap();
+        assert_eq!(second, "position 0.5");
+        let (a, b) = writers.await.unwrap();
+        a.unwrap();
+        b.unwrap();
+        // Both writers are gone and nothing is left: every alternative is closed.
+        let closed = select().or(&position, |_| ()).or(&stop, |_| ()).await;
+        assert!(closed.is_err());
+    });
+}

@@ -10,6 +10,8 @@ use std::task::{Context, Poll, Waker};
 use super::error::ReadError;
 use super::ticket::Ticket;
 use crate::meta::Name;
+use crate::priority::Priority;
+use crate::select::Alternative;
 
 /// An input port of a schema instance: reads what connected [`Output`](super::Output)s write.
 ///
@@ -34,6 +36,7 @@ impl<T> Drop for Handle<T> {
 pub(crate) struct InputShared<T> {
     pub(crate) port: Name,
     pub(crate) owner: Name,
+    priority: Priority,
     state: Mutex<InputState<T>>,
 }
 
@@ -101,9 +104,20 @@ impl<T> InputShared<T> {
 impl<T: Clone + Send + 'static> Input<T> {
     /// An input port named `port` of the instance (or module) `owner`.
     pub fn new(port: impl Into<Name>, owner: impl Into<Name>) -> Self {
+        Self::with_priority(port, owner, Priority::DEFAULT)
+    }
+
+    /// An input with a priority: of several ready alternatives of a
+    /// [`select`](crate::select()), the one of highest priority is taken.
+    pub fn with_priority(
+        port: impl Into<Name>,
+        owner: impl Into<Name>,
+        priority: Priority,
+    ) -> Self {
         let shared = Arc::new(InputShared {
             port: port.into(),
             owner: owner.into(),
+            priority,
             state: Mutex::new(InputState {
                 queue: VecDeque::new(),
                 closed: false,
@@ -192,7 +206,36 @@ impl<T> Future for Read<'_, T> {
     type Output = Result<T, ReadError>;
 
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
-        let input = self.input;
+        self.input.poll_read(cx)
+    }
+}
+
+/// A synchronous input is an alternative of a [`select`](crate::select()): it is ready when
+/// a value waits, and chosen by its priority among the ready ones.
+impl<T: Clone + Send + 'static> Alternative for &Input<T> {
+    type Output = T;
+
+    fn priority(&self) -> Option<Priority> {
+        Some(self.handle.shared.priority)
+    }
+
+    fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<T> {
+        match self.handle.shared.poll_read(cx) {
+            Poll::Ready(Ok(value)) => Poll::Ready(value),
+            // A read that failed is a closed alternative: `is_closed` says so.
+            Poll::Ready(Err(_)) | Poll::Pending => Poll::Pending,
+        }
+    }
+
+    fn is_closed(&self) -> bool {
+        let state = self.handle.shared.lock();
+        state.queue.is_empty() && (state.closed || (state.connected && state.live_writers == 0))
+    }
+}
+
+impl<T> InputShared<T> {
+    fn poll_read(&self, cx: &mut Context<'_>) -> Poll<Result<T, ReadError>> {
+        let input = self;
         let mut state = input.lock();
         if let Some(value) = state.take() {
             return Poll::Ready(Ok(value));

@@ -15,6 +15,10 @@
 //!   it takes the value back from every input, so a sensor can replace a stale sample with a
 //!   fresh one (`select` the write against its next sample) without a reader ever seeing the
 //!   stale one.
+//! - **Select.** An input is an alternative of [`select`](crate::select()), beside ports'
+//!   ends: of the ready alternatives the one of highest priority is taken
+//!   ([`Input::with_priority`]), so a module can wait on a schema network and on its other
+//!   ports at once.
 //! - **Ends.** An end is closed by [`Input::close`] / [`Output::close`], or when its last clone
 //!   is dropped. A read on an input all of whose connected outputs are closed, with nothing
 //!   left to read, fails with [`ReadError::Disconnected`]; so does a write whose connected
