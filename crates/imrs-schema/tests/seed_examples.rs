@@ -85,6 +85,18 @@ impl Bench {
     }
 }
 
+/// No instance of the run failed: every one ended by `STOP`, by being stopped, or with its
+/// components — none by a read or write that found its peer gone.
+fn assert_none_failed(net: &Network) {
+    let failed: Vec<String> = net
+        .trace()
+        .iter()
+        .filter(|e| matches!(e.ended, Some(Ending::Failed(_))))
+        .map(|e| e.to_string())
+        .collect();
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
 fn ended(net: &Network, instance: &str) -> Option<Ending> {
     net.trace()
         .into_iter()
@@ -128,6 +140,7 @@ async fn example_1_the_guarded_move_closes_every_finger_until_it_touches() {
     }
     let moved = (bench.hand.objects()[cube].position - cube_before).norm();
     assert!(moved < 0.005, "the grip pushed the cube {moved} m");
+    assert_none_failed(&bench.net);
 }
 
 #[tokio::test(start_paused = true)]
@@ -150,6 +163,7 @@ async fn example_2_reach_takes_the_wrist_to_the_object_its_sef_reports() {
     for other in (0..3).filter(|&i| i != ball) {
         assert!(bench.palm_error(other, 0.1) > 0.1);
     }
+    assert_none_failed(&bench.net);
 }
 
 #[tokio::test(start_paused = true)]
@@ -189,6 +203,7 @@ async fn example_3_object_search_tests_every_sef_in_parallel_and_reaches_the_mat
         error < 0.004,
         "the palm is {error} m from its target over the ball"
     );
+    assert_none_failed(&bench.net);
 }
 
 #[tokio::test(start_paused = true)]
@@ -230,4 +245,5 @@ async fn example_4_a_virtual_finger_moves_its_fingers_and_no_other() {
         "finger 3 moved: {still:?}"
     );
     assert_eq!(bench.hand.touch(3).unwrap(), None);
+    assert_none_failed(&bench.net);
 }

@@ -115,3 +115,19 @@ async fn numbers_the_hand_lacks_are_refused_by_name() {
         "the hand has no joint 15 (joints are 1 to 14)"
     );
 }
+
+/// A command that is not a number would put NaN into the physics and stop the world: it
+/// is refused, and the joint keeps the command it had.
+#[tokio::test(start_paused = true)]
+async fn a_command_that_is_not_a_number_is_refused_and_changes_nothing() {
+    let (hand, clock) = hand();
+    let [joint, _] = finger_joints(1);
+    hand.command(joint, 1, 0.3).unwrap();
+    let error = hand.command(joint, 1, f32::NAN).unwrap_err();
+    assert_eq!(error.to_string(), "NaN for joint 7 is not a finite number");
+    assert!(hand.command(2, 1, f32::INFINITY).is_err());
+    assert!(hand.push(0, [f32::NAN, 0.0]).is_err());
+    imrs_core::time::drive(&clock, at(1.0)).await;
+    assert!((hand.position(joint).unwrap() - 0.3).abs() < 0.01);
+    assert!(hand.palm().translation.vector.iter().all(|v| v.is_finite()));
+}

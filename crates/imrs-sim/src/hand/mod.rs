@@ -74,7 +74,7 @@ impl HandConfig {
 }
 
 /// A joint or a sensor that the hand does not have.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum HandError {
     /// No joint has this number (joints are 1 to [`JOINTS`]).
     NoJoint(usize),
@@ -82,6 +82,13 @@ pub enum HandError {
     NoFinger(usize),
     /// No object has this index.
     NoObject(usize),
+    /// A command or a position that is not a finite number.
+    NotFinite {
+        /// What it was for: `joint 7`, `object 1`.
+        what: String,
+        /// The value given.
+        value: f32,
+    },
 }
 
 impl fmt::Display for HandError {
@@ -90,6 +97,9 @@ impl fmt::Display for HandError {
             Self::NoJoint(j) => write!(f, "the hand has no joint {j} (joints are 1 to {JOINTS})"),
             Self::NoFinger(i) => write!(f, "the hand has no finger {i} (fingers are 1 to 4)"),
             Self::NoObject(i) => write!(f, "the table has no object {i}"),
+            Self::NotFinite { what, value } => {
+                write!(f, "{value} for {what} is not a finite number")
+            }
         }
     }
 }
@@ -153,6 +163,12 @@ impl Hand {
     /// finger joint. The joint is driven to the mean of all live sources' commands.
     pub fn command(&self, joint: usize, source: u64, value: f32) -> Result<(), HandError> {
         check_joint(joint)?;
+        if !value.is_finite() {
+            return Err(HandError::NotFinite {
+                what: format!("joint {joint}"),
+                value,
+            });
+        }
         self.world().command(joint, source, value);
         Ok(())
     }
@@ -226,6 +242,12 @@ impl Hand {
     pub fn push(&self, index: usize, at: [f32; 2]) -> Result<(), HandError> {
         if index >= self.shared.objects {
             return Err(HandError::NoObject(index));
+        }
+        if let Some(&value) = at.iter().find(|v| !v.is_finite()) {
+            return Err(HandError::NotFinite {
+                what: format!("object {index}"),
+                value,
+            });
         }
         self.world().push(index, at);
         Ok(())
