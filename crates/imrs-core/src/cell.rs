@@ -176,6 +176,12 @@ impl Cell {
         lock(&self.shared.wiring).use_port(module, port)
     }
 
+    /// Every port declared to the cell, as the wiring describes it (name order): what a
+    /// report on the cell's network needs — owner, users, message sizes, timeout, priority.
+    pub fn ports(&self) -> Vec<imrs_ports::PortInfo> {
+        lock(&self.shared.wiring).ports()
+    }
+
     /// The seed's load-time check: every problem with these modules and the declared ports,
     /// all at once, each naming its module and port.
     pub fn check(&self, modules: &[ModuleDecl]) -> Result<(), CellErrors> {

@@ -19,6 +19,8 @@ use crate::user_list::UserList;
 trait Declared: Send + Sync {
     fn meta(&self) -> &PortMeta;
     fn types(&self) -> (TypeId, TypeId, &'static str, &'static str);
+    /// The sizes of the request and reply types, in bytes.
+    fn sizes(&self) -> (usize, usize);
     fn core(&self) -> Arc<dyn Any + Send + Sync>;
     fn capacity(&self) -> usize;
 }
@@ -41,6 +43,10 @@ where
             type_name::<Req>(),
             type_name::<Rep>(),
         )
+    }
+
+    fn sizes(&self) -> (usize, usize) {
+        (size_of::<Req>(), size_of::<Rep>())
     }
 
     fn core(&self) -> Arc<dyn Any + Send + Sync> {
@@ -132,6 +138,7 @@ impl Wiring {
         let declared = self.ports.get(&Name::from(port))?;
         let meta = declared.meta();
         let (_, _, request, reply) = declared.types();
+        let (request_size, reply_size) = declared.sizes();
         Some(PortInfo {
             name: meta.name.clone(),
             owner: meta.owner.clone(),
@@ -140,12 +147,24 @@ impl Wiring {
             capacity: declared.capacity(),
             request,
             reply,
+            request_size,
+            reply_size,
+            timeout: meta.timeout,
+            priority: meta.priority,
         })
     }
 
     /// The names of every declared port, in order.
     pub fn port_names(&self) -> impl Iterator<Item = &Name> {
         self.ports.keys()
+    }
+
+    /// What the wiring knows of every declared port, in name order.
+    pub fn ports(&self) -> Vec<PortInfo> {
+        self.ports
+            .keys()
+            .filter_map(|name| self.port_info(name.as_str()))
+            .collect()
     }
 
     /// Every problem met so far, or `Ok` if there was none.
@@ -229,6 +248,14 @@ pub struct PortInfo {
     pub request: &'static str,
     /// The reply type's name.
     pub reply: &'static str,
+    /// The request type's size in memory, in bytes: what a fixed-size message of it takes.
+    pub request_size: usize,
+    /// The reply type's size in memory, in bytes.
+    pub reply_size: usize,
+    /// The port's `TIMEOUT`, if it has one.
+    pub timeout: Option<std::time::Duration>,
+    /// The port's priority.
+    pub priority: crate::Priority,
 }
 
 /// Every wiring problem of a cell, each naming its port and module.

@@ -1,0 +1,13 @@
+//! The coordination layer of a multiple-arm cell, after Basañez, Suárez et al. (seed 003):
+//! arms that share space and tools, a coordinator, and the network that carries their
+//! messages.
+//!
+//! Built so far: [`network`], the worst-case delay of a deterministic CSMA/DCR bus for a
+//! given cell (the seed's `D_max`), the priority-ordered, non-preemptive transmit queue that
+//! bounds a high-priority message's wait, and a report of every port's worst case once the
+//! cell's modules are placed on stations.
+//!
+//! Why a crate of its own: the layer uses the core and the simulation but the core must not
+//! depend on it; a robot crate embedding `imrs-core` does not compile it.
+
+pub mod network;
