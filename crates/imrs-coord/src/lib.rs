@@ -11,3 +11,4 @@
 //! depend on it; a robot crate embedding `imrs-core` does not compile it.
 
 pub mod network;
+pub mod scheduler;
