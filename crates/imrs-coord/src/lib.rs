@@ -2,13 +2,21 @@
 //! arms that share space and tools, a coordinator, and the network that carries their
 //! messages.
 //!
-//! Built so far: [`network`], the worst-case delay of a deterministic CSMA/DCR bus for a
-//! given cell (the seed's `D_max`), the priority-ordered, non-preemptive transmit queue that
-//! bounds a high-priority message's wait, and a report of every port's worst case once the
-//! cell's modules are placed on stations.
+//! Built so far:
+//! - [`network`]: the worst-case delay of a deterministic CSMA/DCR bus for a given cell
+//!   (the seed's `D_max`), the priority-ordered, non-preemptive transmit queue that bounds a
+//!   high-priority message's wait, and a report of every port's worst case once the cell's
+//!   modules are placed on stations;
+//! - [`scheduler`]: the run-time task scheduler, against static assignments;
+//! - [`zones`]: zones and tools as resources, the coordinator's table of them, deadlock
+//!   detection among exclusive resources, and the arm's pipeline of points checked ahead.
+//!
+//! Not yet: the coordinator as a module on typed ports driving the simulated arms, geometric
+//! deadlock and alternative trajectories, and the cells that use them.
 //!
 //! Why a crate of its own: the layer uses the core and the simulation but the core must not
 //! depend on it; a robot crate embedding `imrs-core` does not compile it.
 
 pub mod network;
 pub mod scheduler;
+pub mod zones;

@@ -1,0 +1,64 @@
+//! Deadlock among exclusive resources: exclusive zones and tools meet every condition for
+//! it, so the coordinator looks for a cycle of robots each sleeping on what the next holds.
+
+use std::collections::BTreeMap;
+
+use imrs_core::imrs_ports::Name;
+
+use super::{Resources, ZoneError};
+
+/// A cycle of robots, each asleep on a resource the next one holds, and the one chosen to
+/// back off.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Deadlock {
+    /// The robots in the cycle, each waiting for the next (the last for the first).
+    pub cycle: Vec<Name>,
+    /// The one that backs off: the last in name order, so the choice is reproducible.
+    pub victim: Name,
+}
+
+impl Resources {
+    /// The first cycle in the wait-for graph of exclusive zones and tools, if any.
+    pub fn deadlock(&self) -> Option<Deadlock> {
+        let mut waits_for: BTreeMap<Name, Vec<Name>> = BTreeMap::new();
+        for (_, holders, sleepers) in self.exclusive_waits() {
+            for sleeper in &sleepers {
+                waits_for
+                    .entry(sleeper.clone())
+                    .or_default()
+                    .extend(holders.iter().filter(|h| *h != sleeper).cloned());
+            }
+        }
+        let robots: Vec<Name> = waits_for.keys().cloned().collect();
+        for start in robots {
+            let mut path = vec![start.clone()];
+            if let Some(cycle) = find_cycle(&waits_for, &mut path) {
+                let victim = cycle.iter().max_by_key(|r| r.as_str()).cloned()?;
+                return Some(Deadlock { cycle, victim });
+            }
+        }
+        None
+    }
+
+    /// Resolves `deadlock`: its victim backs off (gives up what it holds and its place in
+    /// every queue). Returns who is woken.
+    pub fn resolve(&mut self, deadlock: &Deadlock) -> Result<Vec<Name>, ZoneError> {
+        self.back_off(deadlock.victim.as_str())
+    }
+}
+
+/// Depth-first: a cycle through the last robot of `path` back to one on it.
+fn find_cycle(waits_for: &BTreeMap<Name, Vec<Name>>, path: &mut Vec<Name>) -> Option<Vec<Name>> {
+    let last = path.last()?.clone();
+    for next in waits_for.get(&last).into_iter().flatten() {
+        if let Some(at) = path.iter().position(|r| r == next) {
+            return Some(path[at..].to_vec());
+        }
+        path.push(next.clone());
+        if let Some(cycle) = find_cycle(waits_for, path) {
+            return Some(cycle);
+        }
+        path.pop();
+    }
+    None
+}

@@ -1,0 +1,220 @@
+//! Zones and tools as resources, as the coordinator of seed 003 shares them: exclusive and
+//! shared zones, tools, the active-zone grant, deadlocks found and resolved, and the arm's
+//! pipeline stopping before a zone it may not enter.
+
+use imrs_coord::zones::{Answer, Command, Pipeline, Resources, ZoneDef, ZoneError, ZoneKind};
+
+fn table() -> Resources {
+    Resources::new(
+        [
+            ZoneDef::boxed(
+                "FIXTURE",
+                ZoneKind::Exclusive,
+                [0.0, 0.0, 0.2],
+                [0.1, 0.1, 0.2],
+            ),
+            ZoneDef::boxed(
+                "TRAY",
+                ZoneKind::Exclusive,
+                [0.5, 0.0, 0.2],
+                [0.1, 0.1, 0.2],
+            ),
+            ZoneDef::boxed(
+                "FEEDERS",
+                ZoneKind::Shared,
+                [0.0, 0.5, 0.2],
+                [0.1, 0.1, 0.2],
+            ),
+            ZoneDef::boxed("BIN", ZoneKind::Shared, [0.5, 0.5, 0.2], [0.1, 0.1, 0.2]),
+        ],
+        ["SCREWDRIVER", "GRIPPER"],
+        ["ARM_A", "ARM_B", "ARM_C"],
+    )
+}
+
+#[test]
+fn an_exclusive_zone_takes_one_robot_and_wakes_the_next_when_it_leaves() -> Result<(), ZoneError> {
+    let mut t = table();
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Grant);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Sleep);
+    assert_eq!(t.request_move("ARM_C", "FIXTURE")?, Answer::Sleep);
+    assert!(
+        t.stopped_inside("ARM_A", "FIXTURE")?.is_empty(),
+        "still inside"
+    );
+    assert_eq!(t.release("ARM_A", "FIXTURE")?, ["ARM_B"]);
+    // First come, first served: C may not jump the queue.
+    assert_eq!(t.request_move("ARM_C", "FIXTURE")?, Answer::Sleep);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Grant);
+    Ok(())
+}
+
+#[test]
+fn a_shared_zone_holds_several_robots_but_lets_one_move() -> Result<(), ZoneError> {
+    let mut t = table();
+    assert_eq!(t.request_move("ARM_A", "FEEDERS")?, Answer::Grant);
+    assert_eq!(t.request_move("ARM_B", "FEEDERS")?, Answer::Sleep);
+    assert_eq!(t.stopped_inside("ARM_A", "FEEDERS")?, ["ARM_B"]);
+    assert_eq!(t.request_move("ARM_B", "FEEDERS")?, Answer::Grant);
+    // A is still inside, stopped; to move again it waits for B to stop or leave.
+    assert_eq!(t.request_move("ARM_A", "FEEDERS")?, Answer::Sleep);
+    assert_eq!(t.release("ARM_B", "FEEDERS")?, ["ARM_A"]);
+    assert_eq!(t.request_move("ARM_A", "FEEDERS")?, Answer::Grant);
+    Ok(())
+}
+
+#[test]
+fn zones_change_only_while_every_robot_is_stopped() -> Result<(), ZoneError> {
+    let mut t = table();
+    t.request_move("ARM_A", "TRAY")?;
+    let error = t.set_active("FIXTURE", false).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "zones change only while every robot is stopped; moving: ARM_A"
+    );
+    t.trajectory_end("ARM_A")?;
+    t.set_active("FIXTURE", false)?;
+    // An inactive zone restricts nothing, and no point lies in it.
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Grant);
+    assert_eq!(t.request_move("ARM_C", "FIXTURE")?, Answer::Grant);
+    assert!(t.zones_at([0.0, 0.0, 0.1]).is_empty());
+    assert_eq!(t.zones_at([0.5, 0.0, 0.1]), ["TRAY"]);
+    Ok(())
+}
+
+#[test]
+fn names_it_does_not_know_are_refused_by_name() {
+    let mut t = table();
+    assert_eq!(
+        t.request_move("ARM_A", "DOOR").unwrap_err().to_string(),
+        "no zone or tool DOOR was defined before start"
+    );
+    assert_eq!(
+        t.request_tool("ARM_Z", "GRIPPER").unwrap_err().to_string(),
+        "no robot ARM_Z in the cell"
+    );
+    assert!(
+        t.request_tool("ARM_A", "FIXTURE").is_err(),
+        "a zone is not a tool"
+    );
+}
+
+/// Exclusive zones meet every condition for deadlock: two robots each holding one and
+/// asking for the other's. The coordinator finds the cycle, one backs off, the other goes.
+#[test]
+fn a_zone_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
+    let mut t = table();
+    t.request_move("ARM_A", "FIXTURE")?;
+    t.request_move("ARM_B", "TRAY")?;
+    assert_eq!(t.deadlock(), None);
+    assert_eq!(t.request_move("ARM_A", "TRAY")?, Answer::Sleep);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Sleep);
+    let deadlock = t.deadlock().expect("the cycle A → B → A");
+    assert_eq!(deadlock.cycle.len(), 2);
+    assert_eq!(deadlock.victim, "ARM_B");
+    assert_eq!(t.resolve(&deadlock)?, ["ARM_A"]);
+    assert_eq!(t.deadlock(), None);
+    assert_eq!(t.request_move("ARM_A", "TRAY")?, Answer::Grant);
+    Ok(())
+}
+
+#[test]
+fn a_tool_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
+    let mut t = table();
+    t.request_tool("ARM_A", "SCREWDRIVER")?;
+    t.request_tool("ARM_C", "GRIPPER")?;
+    assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Sleep);
+    assert_eq!(t.request_tool("ARM_C", "SCREWDRIVER")?, Answer::Sleep);
+    let deadlock = t.deadlock().expect("a tool cycle");
+    assert_eq!(deadlock.victim, "ARM_C");
+    assert_eq!(t.resolve(&deadlock)?, ["ARM_A"]);
+    assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Grant);
+    Ok(())
+}
+
+/// In shared zones a robot refused the next zone stops at the border and gives up moving
+/// in its own: nobody holds two movement resources, so no cycle can form.
+#[test]
+fn shared_zones_never_deadlock_because_movement_is_released_at_the_border() -> Result<(), ZoneError>
+{
+    let mut t = table();
+    t.request_move("ARM_A", "FEEDERS")?;
+    t.request_move("ARM_B", "BIN")?;
+    assert_eq!(t.request_move("ARM_A", "BIN")?, Answer::Sleep);
+    assert!(t.stopped_inside("ARM_A", "FEEDERS")?.is_empty());
+    assert_eq!(t.request_move("ARM_B", "FEEDERS")?, Answer::Grant);
+    assert_eq!(t.deadlock(), None);
+    assert_eq!(t.stopped_inside("ARM_B", "BIN")?, ["ARM_A"]);
+    assert_eq!(t.request_move("ARM_A", "BIN")?, Answer::Grant);
+    Ok(())
+}
+
+/// A straight line through the fixture at z = 0.1, from x0 to x1, a point per centimetre.
+fn line(x0: f32, x1: f32) -> Vec<[f32; 3]> {
+    let n = ((x1 - x0).abs() / 0.01).round() as usize;
+    (0..=n)
+        .map(|i| [x0 + (x1 - x0) * i as f32 / n as f32, 0.0, 0.1])
+        .collect()
+}
+
+/// Two arms cross the exclusive fixture from either side. Each checks its points `offset`
+/// ahead: the one that comes second is stopped (STOP_C) while still outside, at least
+/// `offset` points before the zone, and continues once the first has left. Never are both
+/// inside.
+#[test]
+fn the_pipeline_stops_an_arm_before_a_zone_it_may_not_enter() -> Result<(), ZoneError> {
+    let mut t = table();
+    let fixture = ZoneDef::boxed(
+        "FIXTURE",
+        ZoneKind::Exclusive,
+        [0.0, 0.0, 0.2],
+        [0.1, 0.1, 0.2],
+    );
+    // 0.5 m/s, 2.5 m/s²: 5 cm to stop, five points.
+    let mut arms = [
+        Pipeline::new("ARM_A", line(-0.3, 0.3), 0.5, 2.5, 0.01),
+        Pipeline::new("ARM_B", line(0.25, -0.3), 0.5, 2.5, 0.01),
+    ];
+    assert_eq!((arms[0].offset(), arms[0].capacity()), (5, 7));
+    let mut at: [Option<[f32; 3]>; 2] = [None, None];
+    let mut done = [false, false];
+    let mut stops = [0, 0];
+    for _ in 0..400 {
+        for (i, arm) in arms.iter_mut().enumerate() {
+            if done[i] {
+                continue;
+            }
+            match arm.step(&mut t)?.0 {
+                Command::Continue(p) => at[i] = Some(p),
+                Command::StopC(zone) => {
+                    assert_eq!(zone, "FIXTURE");
+                    stops[i] += 1;
+                    let here = at[i].expect("stopped before it started");
+                    assert!(!fixture.contains(here), "arm {i} was stopped inside");
+                    // At least `offset` points (1 cm each) from the zone's nearer face.
+                    let gap = here[0].abs() - 0.1;
+                    assert!(
+                        gap >= 0.05 - 1e-4,
+                        "arm {i} stopped {gap} m short of the zone"
+                    );
+                }
+                Command::TrajectoryEnd => done[i] = true,
+            }
+        }
+        let inside = at
+            .iter()
+            .filter(|p| p.is_some_and(|p| fixture.contains(p)))
+            .count();
+        assert!(inside < 2, "both arms in the exclusive zone");
+        if done == [true, true] {
+            break;
+        }
+    }
+    assert_eq!(done, [true, true], "an arm never finished");
+    assert_eq!(
+        stops.iter().filter(|&&n| n > 0).count(),
+        1,
+        "stops: {stops:?}"
+    );
+    Ok(())
+}
