@@ -218,3 +218,58 @@ fn the_pipeline_stops_an_arm_before_a_zone_it_may_not_enter() -> Result<(), Zone
     );
     Ok(())
 }
+
+/// A stopped arm lies across the way: the trajectory is blocked, the alternative goes round
+/// it from the same start to the same end and keeps its margin everywhere (checked here by
+/// sampling the path, apart from the search that found it).
+#[test]
+fn a_geometric_deadlock_is_resolved_by_an_alternative_trajectory() {
+    use imrs_coord::zones::{Obstacle, detour, first_blocked};
+    let z = 0.3;
+    let stopped = Obstacle::links(
+        &[
+            ([-0.3, 0.0, z], [0.05, 0.0, z]),
+            ([0.05, 0.0, z], [0.05, 0.2, z]),
+        ],
+        0.035,
+    );
+    let path: Vec<[f32; 3]> = (0..=10).map(|i| [0.0, -0.5 + 0.1 * i as f32, z]).collect();
+    let (radius, margin) = (0.02, 0.01);
+    assert_eq!(
+        first_blocked(&path, radius, std::slice::from_ref(&stopped), margin),
+        Some(4)
+    );
+    let around =
+        detour(&path, radius, std::slice::from_ref(&stopped), margin, 0.6).expect("a way round");
+    assert_eq!(around.first(), path.first());
+    assert_eq!(around.last(), path.last());
+    for pair in around.windows(2) {
+        for k in 0..=20 {
+            let t = k as f32 / 20.0;
+            let p = [0, 1, 2].map(|i| pair[0][i] + (pair[1][i] - pair[0][i]) * t);
+            assert!(
+                stopped.distance(p, p, radius) >= margin,
+                "the detour touches at {p:?}"
+            );
+        }
+    }
+    let length = |p: &[[f32; 3]]| -> f32 {
+        p.windows(2)
+            .map(|s| ((s[1][0] - s[0][0]).powi(2) + (s[1][1] - s[0][1]).powi(2)).sqrt())
+            .sum()
+    };
+    assert!(
+        length(&around) < 2.5 * length(&path),
+        "a detour of {} m",
+        length(&around)
+    );
+    // Nothing in the way: the trajectory stands.
+    let clear = Obstacle::links(&[([1.0, 1.0, z], [1.2, 1.0, z])], 0.035);
+    assert_eq!(
+        detour(&path, radius, &[clear], margin, 0.6),
+        Some(path.clone())
+    );
+    // A robot stopped on the end point: no alternative; only it moving can free the way.
+    let on_goal = Obstacle::links(&[([-0.2, 0.5, z], [0.2, 0.5, z])], 0.035);
+    assert_eq!(detour(&path, radius, &[on_goal], margin, 0.6), None);
+}

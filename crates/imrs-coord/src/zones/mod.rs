@@ -8,7 +8,10 @@
 //! or for **simultaneous use with restrictions** (several inside, one moving at a time);
 //! tools are always exclusive. The [`Resources`] table answers each request as the seed's
 //! coordinator does — a grant, or *sleep* (stop at the border) — and wakes sleepers when a
-//! resource frees.
+//! resource frees. Exclusive zones and tools can deadlock: [`Resources::deadlock`] finds the
+//! cycle and [`Resources::resolve`] makes one robot back off. A stopped robot in the way of
+//! one that may move is a geometric deadlock: [`detour`] computes the alternative
+//! trajectory round it.
 //!
 //! ```
 //! use imrs_coord::zones::{Answer, Resources, ZoneDef, ZoneKind};
@@ -28,9 +31,11 @@
 //! ```
 
 mod deadlock;
+mod detour;
 mod pipeline;
 mod table;
 
 pub use deadlock::Deadlock;
+pub use detour::{Obstacle, detour, first_blocked};
 pub use pipeline::{Command, Pipeline};
 pub use table::{Answer, Resources, ZoneDef, ZoneError, ZoneKind};
