@@ -9,14 +9,17 @@
 //!   modules are placed on stations;
 //! - [`scheduler`]: the run-time task scheduler, against static assignments;
 //! - [`zones`]: zones and tools as resources, the coordinator's table of them, deadlock
-//!   detection among exclusive resources, and the arm's pipeline of points checked ahead.
+//!   detection among exclusive resources and its resolution, the alternative trajectory
+//!   round a stopped robot, and the arm's pipeline of points checked ahead;
+//! - [`coordinator`]: the zone coordinator as a module, speaking the seed's message set over
+//!   typed ports.
 //!
-//! Not yet: the coordinator as a module on typed ports driving the simulated arms, geometric
-//! deadlock and alternative trajectories, and the cells that use them.
+//! Not yet: the coordinator driving the simulated arms, and the cells that use it.
 //!
 //! Why a crate of its own: the layer uses the core and the simulation but the core must not
 //! depend on it; a robot crate embedding `imrs-core` does not compile it.
 
+pub mod coordinator;
 pub mod network;
 pub mod scheduler;
 pub mod zones;

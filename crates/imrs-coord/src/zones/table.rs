@@ -248,6 +248,11 @@ impl Resources {
         }
     }
 
+    /// Whether `name` is a tool.
+    pub fn is_tool(&self, name: &str) -> bool {
+        self.tools.contains(&Name::from(name))
+    }
+
     /// Puts a tool down; returns who is woken.
     pub fn release_tool(&mut self, robot: &str, tool: &str) -> Result<Vec<Name>, ZoneError> {
         self.release_held(robot, tool)

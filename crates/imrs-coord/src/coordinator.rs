@@ -1,0 +1,310 @@
+//! The zone coordinator as a module (seed 003, centralized loose coordination), speaking
+//! the seed's message set over typed ports.
+//!
+//! | seed | port | from → to |
+//! |---|---|---|
+//! | request to move in a shared zone; position (stopped inside); zone release; trajectory end | `TO_COORDINATOR`, a [`Message`], answered [`Answer::Grant`] or [`Answer::Sleep`] | robot → coordinator |
+//! | alarm | `ALARM` (priority 1: served before everything else) | robot → coordinator |
+//! | wake up (and back off, to resolve a deadlock) | `WAKE_<ROBOT>`, a [`Wake`] | coordinator → robot |
+//! | alarm: an emergency stop reaches every robot | `EMERGENCY`, a `sendall` | coordinator → every robot |
+//!
+//! After every sleep it looks for a deadlock among exclusive resources; the victim is told
+//! to back off.
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, SharedClock, select, usage};
+use imrs_core::prelude::*;
+
+use crate::zones::{Answer, Resources, ZoneError};
+
+/// What a robot tells the coordinator.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Message {
+    /// Request to move in a zone (or to take a tool).
+    Request(Name),
+    /// Stopped inside this zone, away from the trajectory's end point.
+    Position(Name),
+    /// Left this zone (or put this tool down).
+    Release(Name),
+    /// The trajectory has ended: the robot is stopped.
+    TrajectoryEnd,
+}
+
+/// What the coordinator tells a sleeping robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wake {
+    /// The resource it slept on may be free: ask again.
+    WakeUp,
+    /// It is the victim of a deadlock: give up what it holds, and ask again later.
+    BackOff,
+}
+
+/// How many robots a coordinator's ports admit.
+pub const MAX_ROBOTS: usize = 16;
+
+/// The coordinator's ports. Declare them, give each robot its [`RobotLink`], and start
+/// [`coordinator`].
+#[derive(Clone)]
+pub struct CoordinatorPorts {
+    /// `TO_COORDINATOR`: requests, positions, releases, trajectory ends.
+    pub to_coordinator:
+        Port<(Name, Message), Result<Answer, String>, usage::Receive, AnyUser, MAX_ROBOTS>,
+    /// `ALARM`.
+    pub alarm: Port<(Name, String), (), usage::Receive, AnyUser, MAX_ROBOTS>,
+    /// `EMERGENCY`: the emergency stop, to every robot.
+    pub emergency: Port<String, (), usage::SendAll, AnyUser, MAX_ROBOTS>,
+    /// `WAKE_<ROBOT>`, one per robot.
+    pub wake: BTreeMap<Name, Port<Wake, (), usage::Send>>,
+}
+
+impl CoordinatorPorts {
+    /// The ports of a coordinator named `name` for `robots`, on `clock`.
+    pub fn new(name: &str, robots: &[&str], clock: &SharedClock) -> Self {
+        let spec = |port: String| PortSpec::new(port, name).clock(clock.clone());
+        Self {
+            to_coordinator: Port::declare(spec("TO_COORDINATOR".into()).priority(2)),
+            alarm: Port::declare(spec("ALARM".into()).priority(1)),
+            emergency: Port::declare(spec("EMERGENCY".into()).priority(1)),
+            wake: robots
+                .iter()
+                .map(|&robot| {
+                    let port = Port::declare(spec(format!("WAKE_{robot}")).user_list([robot]));
+                    (Name::from(robot), port)
+                })
+                .collect(),
+        }
+    }
+
+    /// Robot `robot`'s ends of the ports.
+    pub fn link(&self, robot: &str) -> Result<RobotLink, imrs_core::imrs_ports::WireError> {
+        let wake = self.wake.get(&Name::from(robot)).ok_or_else(|| {
+            imrs_core::imrs_ports::WireError::NotOnUserList {
+                port: format!("WAKE_{robot}").into(),
+                module: robot.into(),
+            }
+        })?;
+        Ok(RobotLink {
+            robot: robot.into(),
+            to: self.to_coordinator.user_named(robot)?,
+            alarm: self.alarm.user_named(robot)?,
+            wake: wake.user_named(robot)?,
+            emergency: self.emergency.user_named(robot)?,
+        })
+    }
+}
+
+/// Why a robot could not have a zone.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Refused {
+    /// It must back off: it was chosen to resolve a deadlock.
+    BackOff,
+    /// The coordinator could not be reached, or refused the name.
+    Failed(String),
+}
+
+/// A robot's ends of the coordinator's ports.
+pub struct RobotLink {
+    robot: Name,
+    to: End<(Name, Message), Result<Answer, String>, usage::Send>,
+    alarm: End<(Name, String), (), usage::Send>,
+    wake: End<Wake, (), usage::Receive>,
+    emergency: End<String, (), usage::Receive>,
+}
+
+impl RobotLink {
+    /// Tells the coordinator `message`; its answer.
+    pub async fn tell(&mut self, message: Message) -> Result<Answer, Refused> {
+        self.to
+            .send((self.robot.clone(), message))
+            .await
+            .map_err(|error| Refused::Failed(error.to_string()))?
+            .map_err(Refused::Failed)
+    }
+
+    /// Asks for `zone` (or a tool) until granted, sleeping at the border meanwhile.
+    pub async fn acquire(&mut self, zone: &str) -> Result<(), Refused> {
+        loop {
+            match self.tell(Message::Request(zone.into())).await? {
+                Answer::Grant => return Ok(()),
+                Answer::Sleep => {
+                    let (wake, reply) = self
+                        .wake
+                        .receive()
+                        .await
+                        .map_err(|error| Refused::Failed(error.to_string()))?;
+                    reply.reply(());
+                    if wake == Wake::BackOff {
+                        return Err(Refused::BackOff);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Raises an alarm: the coordinator stops every robot.
+    pub async fn alarm(&mut self, text: impl Into<String>) -> Result<(), Refused> {
+        self.alarm
+            .send((self.robot.clone(), text.into()))
+            .await
+            .map_err(|error| Refused::Failed(error.to_string()))
+    }
+
+    /// Waits for an emergency stop; its text.
+    pub async fn emergency(&mut self) -> Result<String, Refused> {
+        let (text, reply) = self
+            .emergency
+            .receive()
+            .await
+            .map_err(|error| Refused::Failed(error.to_string()))?;
+        reply.reply(());
+        Ok(text)
+    }
+}
+
+/// What the coordinator did, for a cell's report.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CoordinatorLog {
+    /// Requests granted at once.
+    pub granted: u32,
+    /// Requests answered with sleep.
+    pub slept: u32,
+    /// Deadlocks found and resolved, with their victims.
+    pub deadlocks: Vec<Name>,
+    /// Alarms, each passed on to every robot.
+    pub alarms: Vec<(Name, String)>,
+    /// Messages it could not take (unknown zone or robot), named.
+    pub refused: Vec<String>,
+}
+
+/// The coordinator module `name`: answers every message from `table`'s bookkeeping, wakes
+/// sleepers, resolves deadlocks, and passes alarms on to every robot. Its log is shared.
+pub fn coordinator(
+    name: &str,
+    table: Resources,
+    ports: &CoordinatorPorts,
+    log: Arc<Mutex<CoordinatorLog>>,
+) -> ModuleSpec<()> {
+    let ports = ports.clone();
+    let table = Arc::new(Mutex::new(table));
+    let mut spec = ModuleSpec::new(name, ())
+        .owns(&ports.to_coordinator)
+        .owns(&ports.alarm)
+        .owns(&ports.emergency);
+    for port in ports.wake.values() {
+        spec = spec.owns(port);
+    }
+    spec.task(name, move |_ctx| {
+        let (ports, table, log) = (ports.clone(), Arc::clone(&table), Arc::clone(&log));
+        async move {
+            let mut to = ports.to_coordinator.owner()?;
+            let mut alarm = ports.alarm.owner()?;
+            let mut emergency = ports.emergency.owner()?;
+            let mut wake: BTreeMap<Name, End<Wake, (), usage::Send>> = BTreeMap::new();
+            for (robot, port) in &ports.wake {
+                wake.insert(robot.clone(), port.owner()?);
+            }
+            loop {
+                enum Event {
+                    Alarm(Name, String),
+                    Message(
+                        Name,
+                        Message,
+                        imrs_core::imrs_ports::ReplyHandle<Result<Answer, String>>,
+                    ),
+                }
+                let event = select()
+                    .or(&mut alarm, |((robot, text), reply)| {
+                        reply.reply(());
+                        Event::Alarm(robot, text)
+                    })
+                    .or(&mut to, |((robot, message), reply)| {
+                        Event::Message(robot, message, reply)
+                    })
+                    .await?;
+                match event {
+                    Event::Alarm(robot, text) => {
+                        lock(&log).alarms.push((robot.clone(), text.clone()));
+                        // Every robot that takes it stops; one that does not is not waited for.
+                        let _ = emergency.send_all(format!("{robot}: {text}")).await;
+                    }
+                    Event::Message(robot, message, reply) => {
+                        let answered = answer(&mut lock(&table), &robot, &message);
+                        let (answer, woken) = match answered {
+                            Ok(answered) => answered,
+                            Err(error) => {
+                                // Refused by name: the robot hears what was wrong.
+                                lock(&log).refused.push(error.to_string());
+                                reply.reply(Err(error.to_string()));
+                                continue;
+                            }
+                        };
+                        match answer {
+                            Answer::Grant => lock(&log).granted += 1,
+                            Answer::Sleep => lock(&log).slept += 1,
+                        }
+                        reply.reply(Ok(answer));
+                        for robot in woken {
+                            if let Some(end) = wake.get_mut(&robot) {
+                                let _ = end.send(Wake::WakeUp).await;
+                            }
+                        }
+                        if answer == Answer::Sleep {
+                            let found = lock(&table).deadlock();
+                            if let Some(deadlock) = found {
+                                let woken = lock(&table).resolve(&deadlock).unwrap_or_default();
+                                lock(&log).deadlocks.push(deadlock.victim.clone());
+                                if let Some(end) = wake.get_mut(&deadlock.victim) {
+                                    let _ = end.send(Wake::BackOff).await;
+                                }
+                                for robot in woken {
+                                    if let Some(end) = wake.get_mut(&robot) {
+                                        let _ = end.send(Wake::WakeUp).await;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    })
+}
+
+/// The table's answer to one message, and who it wakes.
+fn answer(
+    table: &mut Resources,
+    robot: &Name,
+    message: &Message,
+) -> Result<(Answer, Vec<Name>), ZoneError> {
+    let robot = robot.as_str();
+    Ok(match message {
+        Message::Request(zone) => {
+            let answer = if table.is_tool(zone.as_str()) {
+                table.request_tool(robot, zone.as_str())?
+            } else {
+                table.request_move(robot, zone.as_str())?
+            };
+            (answer, Vec::new())
+        }
+        Message::Position(zone) => (Answer::Grant, table.stopped_inside(robot, zone.as_str())?),
+        Message::Release(zone) => {
+            let woken = if table.is_tool(zone.as_str()) {
+                table.release_tool(robot, zone.as_str())?
+            } else {
+                table.release(robot, zone.as_str())?
+            };
+            (Answer::Grant, woken)
+        }
+        Message::TrajectoryEnd => {
+            table.trajectory_end(robot)?;
+            (Answer::Grant, Vec::new())
+        }
+    })
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    // Each critical section is a few field updates: a panic cannot leave it half-changed.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
