@@ -77,36 +77,41 @@ fn main() -> ExitCode {
     }
 }
 
-/// Writes the report, then the other feeder policy's beside it, to `out`.
+/// Writes the report, then the other feeder policies' beside it, to `out`.
 fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::Result<()> {
     write!(out, "{report}")?;
-    // The other feeder policy, same seed, hours and faults, for the side-by-side table.
-    let other = CellConfig {
-        feeder: match config.feeder {
-            FeederPolicy::Arbiter => FeederPolicy::Appendix,
-            FeederPolicy::Appendix => FeederPolicy::Arbiter,
-        },
-        progress: false,
-        record: None,
-        timeline: None,
-        ..config.clone()
-    };
-    match run(&other) {
-        Ok(record) => {
-            let other = Report::of(&record);
-            let (appendix, arbiter) = match config.feeder {
-                FeederPolicy::Appendix => (report, &other),
-                FeederPolicy::Arbiter => (&other, report),
-            };
-            writeln!(out)?;
-            writeln!(
-                out,
-                "feeder policies side by side (same seed, hours and faults):"
-            )?;
-            write!(out, "{}", Report::side_by_side(appendix, arbiter))?;
+    // The other feeder policies, same seed, hours and faults, for the side-by-side table.
+    let mut reports = Vec::new();
+    for policy in [
+        FeederPolicy::Appendix,
+        FeederPolicy::Arbiter,
+        FeederPolicy::Coordinator,
+    ] {
+        if policy == config.feeder {
+            reports.push(report.clone());
+            continue;
         }
-        Err(problems) => eprintln!("the other feeder policy could not run: {problems}"),
+        let other = CellConfig {
+            feeder: policy,
+            progress: false,
+            record: None,
+            timeline: None,
+            ..config.clone()
+        };
+        match run(&other) {
+            Ok(record) => reports.push(Report::of(&record)),
+            Err(problems) => {
+                eprintln!("the {policy:?} feeder policy could not run: {problems}");
+                return out.flush();
+            }
+        }
     }
+    writeln!(out)?;
+    writeln!(
+        out,
+        "feeder policies side by side (same seed, hours and faults):"
+    )?;
+    write!(out, "{}", Report::side_by_side(&reports))?;
     writeln!(out)?;
     writeln!(out, "{}", speed_line(report))?;
     out.flush()

@@ -4,15 +4,20 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
-use imrs_sim::imrs_core::imrs_ports::{End, usage};
+use imrs_coord::zones::{Reservations, Sweep};
+use imrs_sim::imrs_core::imrs_ports::{End, ReplyHandle, select, usage};
 use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::layout::LINK_RADIUS;
 use imrs_sim::{
     DeviceError, FEEDER_CHIPS, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target,
 };
 
 use crate::alarms::{AlarmKind, alarm};
 use crate::help::{drive_relay, insisted, retried};
-use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+use crate::names::{
+    FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
+    ZONE_RESERVE,
+};
 use crate::ports::{CellPorts, ZonePort};
 
 /// How the two chip robots share the feeder zone.
@@ -23,6 +28,9 @@ pub enum FeederPolicy {
     Appendix,
     /// A monitor task that hands the zone to one robot at a time.
     Arbiter,
+    /// A coordinator (seed 003) that reserves for each robot the space its trajectory will
+    /// sweep, and lets both robots into the zone where their trajectories do not meet.
+    Coordinator,
 }
 
 /// One step of CHIP_IT's work schedule: `GRASP(n), INSERT(X, Y, Z)`.
@@ -111,14 +119,22 @@ pub struct ChipItState {
     cycle_times: Vec<f64>,
 }
 
-/// The way into the zone under a policy: the twin's permission, or the arbiter's.
+/// The way into the zone under a policy: the twin's permission, the arbiter's, or the
+/// coordinator's reservation of the trajectory's space.
 enum Access {
     Appendix(End<(), i32, usage::Query>),
     Arbiter {
         request: End<String, (), usage::Send>,
         release: End<String, (), usage::Send>,
     },
+    Coordinator {
+        reserve: End<(String, Sweep), (), usage::Send>,
+        free: End<String, (), usage::Send>,
+    },
 }
+
+/// How finely a trajectory's sweep is sampled: a pose every few centimetres of tool travel.
+const SWEEP_SAMPLES: usize = 12;
 
 impl Access {
     /// Asks to enter the zone; whether it may.
@@ -131,15 +147,51 @@ impl Access {
             Access::Arbiter { request, .. } => {
                 ctx.send(request, ctx.module().to_string()).await.is_ok()
             }
+            // The coordinator is asked per step, with the step's trajectory: see `reserve`.
+            Access::Coordinator { .. } => true,
         }
+    }
+
+    /// Under the coordinator, reserves the space the arm sweeps to `feeder` and on to the
+    /// card's `place`, and waits until it is granted; returns how long it waited (`None`
+    /// under the other policies, which ask in `enter`). A coordinator that cannot be
+    /// reached is asked again each second, as `left` does.
+    async fn reserve(
+        &mut self,
+        ctx: &Ctx<ChipItState>,
+        robot: &Robot,
+        feeder: FeederId,
+        place: [f32; 2],
+    ) -> Result<Option<f64>, DeviceError> {
+        let Access::Coordinator { reserve, .. } = self else {
+            return Ok(None);
+        };
+        let mut sweep = robot.sweep(None, Target::Feeder(feeder), SWEEP_SAMPLES)?;
+        sweep.extend(robot.sweep(
+            Some(Target::Feeder(feeder)),
+            Target::OnCard(place),
+            SWEEP_SAMPLES,
+        )?);
+        let asked = ctx.now();
+        while ctx
+            .send(reserve, (ctx.module().to_string(), sweep.clone()))
+            .await
+            .is_err()
+        {
+            ctx.delay(Duration::from_secs(1)).await;
+        }
+        Ok(Some((ctx.now() - asked).as_secs_f64()))
     }
 
     /// Says it has left the zone.
     async fn left(&mut self, ctx: &Ctx<ChipItState>) {
-        if let Access::Arbiter { release, .. } = self {
-            while ctx.send(release, ctx.module().to_string()).await.is_err() {
-                ctx.delay(Duration::from_secs(1)).await;
-            }
+        let release = match self {
+            Access::Arbiter { release, .. } => release,
+            Access::Coordinator { free, .. } => free,
+            Access::Appendix(_) => return,
+        };
+        while ctx.send(release, ctx.module().to_string()).await.is_err() {
+            ctx.delay(Duration::from_secs(1)).await;
         }
     }
 }
@@ -187,10 +239,18 @@ pub fn chip_it(
             "CRIT_SECTION",
             |_: &ChipItState, ()| 1,
         );
-    if policy == FeederPolicy::Arbiter {
-        spec = spec
-            .uses_named(ZONE_REQUEST, UsageKind::Send)
-            .uses_named(ZONE_RELEASE, UsageKind::Send);
+    match policy {
+        FeederPolicy::Arbiter => {
+            spec = spec
+                .uses_named(ZONE_REQUEST, UsageKind::Send)
+                .uses_named(ZONE_RELEASE, UsageKind::Send);
+        }
+        FeederPolicy::Coordinator => {
+            spec = spec
+                .uses_named(ZONE_RESERVE, UsageKind::Send)
+                .uses_named(ZONE_FREE, UsageKind::Send);
+        }
+        FeederPolicy::Appendix => {}
     }
     // The asymmetric timeout handlers (note 6): CHIP_IT steps into a procedure ranked below
     // CRIT_SECTION for a moment, so its twin's pending query is answered; CHIP_IT2 just
@@ -209,6 +269,7 @@ pub fn chip_it(
         line_ports.frequency.clone(),
     );
     let (zone_request, zone_release) = (ports.zone_request.clone(), ports.zone_release.clone());
+    let (zone_reserve, zone_free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
     let robot = sim.robot(RobotId::new(line, Role::ChipIt));
     let name = n.chip_it.clone();
     let background = move |ctx: Ctx<ChipItState>| {
@@ -220,6 +281,7 @@ pub fn chip_it(
             robot.clone(),
             name.clone(),
         );
+        let (zone_reserve, zone_free) = (zone_reserve.clone(), zone_free.clone());
         let waits = Arc::clone(&waits);
         async move {
             let mut ready_to_chip = ready_port.owner()?;
@@ -229,6 +291,10 @@ pub fn chip_it(
                 FeederPolicy::Arbiter => Access::Arbiter {
                     request: zone_request.user_named(name.clone())?,
                     release: zone_release.user_named(name.clone())?,
+                },
+                FeederPolicy::Coordinator => Access::Coordinator {
+                    reserve: zone_reserve.user_named(name.clone())?,
+                    free: zone_free.user_named(name.clone())?,
                 },
             };
             let mut work = work_schedule();
@@ -246,13 +312,16 @@ pub fn chip_it(
                     let asked = ctx.now();
                     let ok = access.enter(&ctx).await;
                     let waited = (ctx.now() - asked).as_secs_f64();
-                    record_wait(&waits, line, ok, waited);
+                    // Under the coordinator the step's own reservation is what waits.
+                    if !matches!(access, Access::Coordinator { .. }) {
+                        record_wait(&waits, line, ok, waited);
+                    }
                     if !ok {
                         // {Signal operator}: counted; a timeout already raised SHARE_FEEDER.TIMEOUT.
                         continue;
                     }
                     ctx.perform(&mut work, |step| {
-                        chip_step(&ctx, &robot, *step, &mut access)
+                        chip_step(&ctx, &robot, *step, &mut access, &waits)
                     })
                     .await;
                 }
@@ -314,7 +383,14 @@ async fn chip_step(
     robot: &Robot,
     step: ChipStep,
     access: &mut Access,
+    waits: &SharedWaits,
 ) -> Result<(), DeviceError> {
+    if let Some(waited) = access
+        .reserve(ctx, robot, step.feeder, step.place())
+        .await?
+    {
+        record_wait(waits, robot.id().line, true, waited);
+    }
     let grasped = ctx
         .section("GRASP", async {
             let grasped = async {
@@ -351,6 +427,59 @@ async fn chip_step(
     })
     .await
 }
+
+/// FEEDER_COORDINATOR: reserves for each chip robot the space its trajectory to the feeder
+/// and back to the card will sweep, granting it at once where it keeps clear of the other
+/// robot's reservation, and in turn where it does not.
+pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
+    let (reserve, free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
+    ModuleSpec::new(FEEDER_COORDINATOR, ())
+        .owns(ZONE_RESERVE)
+        .owns(ZONE_FREE)
+        .task(FEEDER_COORDINATOR, move |_ctx| {
+            let (reserve, free) = (reserve.clone(), free.clone());
+            async move {
+                let (mut reserve, mut free) = (reserve.owner()?, free.owner()?);
+                let mut space = Reservations::new(LINK_RADIUS, SWEEP_MARGIN);
+                // Requests not yet granted, by robot: answered when their space frees.
+                let mut asleep = Vec::new();
+                loop {
+                    enum Event {
+                        Reserve(String, Sweep, ReplyHandle<()>),
+                        Free(String, ReplyHandle<()>),
+                    }
+                    let event = select()
+                        .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
+                        .or(&mut reserve, |((robot, sweep), reply)| {
+                            Event::Reserve(robot, sweep, reply)
+                        })
+                        .await?;
+                    match event {
+                        Event::Reserve(robot, sweep, reply) => {
+                            if space.request(robot.as_str(), &sweep) {
+                                reply.reply(());
+                            } else {
+                                asleep.push((robot, reply));
+                            }
+                        }
+                        Event::Free(robot, reply) => {
+                            reply.reply(());
+                            for granted in space.release(&robot) {
+                                if let Some(at) =
+                                    asleep.iter().position(|(r, _)| granted == r.as_str())
+                                {
+                                    asleep.swap_remove(at).1.reply(());
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        })
+}
+
+/// How far apart two reservations keep the arms' links.
+const SWEEP_MARGIN: f32 = 0.03;
 
 /// FEEDER_MONITOR: hands the feeder zone to one chip robot at a time.
 pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {

@@ -22,8 +22,9 @@ struct Flags {
     /// Seeds every random choice: the same seed and flags give the same report.
     #[arg(long, value_name = "S", default_value_t = 1985)]
     seed: u64,
-    /// How the chip robots share the feeder zone: the Appendix's query/order scheme, or an
-    /// arbiter module.
+    /// How the chip robots share the feeder zone: the Appendix's query/order scheme, an
+    /// arbiter module that holds the zone for one robot's round trip, or a coordinator that
+    /// reserves the space each trajectory sweeps (seed 003).
     #[arg(long, value_enum, default_value_t = FeederPolicy::Arbiter)]
     feeder: FeederPolicy,
     /// Run on the wall clock instead of virtual time.

@@ -73,3 +73,10 @@ pub const FEEDER_MONITOR: &str = "FEEDER_MONITOR";
 pub const ZONE_REQUEST: &str = "ZONE_REQUEST";
 /// The arbiter's port for handing the zone back.
 pub const ZONE_RELEASE: &str = "ZONE_RELEASE";
+
+/// The coordinator of the feeder zone (the `--feeder coordinator` policy).
+pub const FEEDER_COORDINATOR: &str = "FEEDER_COORDINATOR";
+/// The coordinator's port for reserving the space a trajectory sweeps.
+pub const ZONE_RESERVE: &str = "ZONE_RESERVE";
+/// The coordinator's port for freeing it.
+pub const ZONE_FREE: &str = "ZONE_FREE";

@@ -9,7 +9,11 @@ use imrs_sim::imrs_core::imrs_ports::{
 };
 use imrs_sim::{Line, PalletId};
 
-use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+use crate::chip::FeederPolicy;
+use crate::names::{
+    FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
+    ZONE_RESERVE,
+};
 
 /// FREQUENCY(TASK_NUM: INTEGER; TIME_FOR_ONE: REAL), through the bounded buffer.
 pub type Frequency = BoundedBufferPort<(i32, f64), AnyUser, 2>;
@@ -29,6 +33,10 @@ pub type ReadyToChip = Port<PalletId, (), usage::Receive, AnyUser, 1>;
 pub type ShareFeeder = Port<(), i32, usage::Query>;
 /// The arbiter's ports: a chip robot sends and waits until it may enter (or has left).
 pub type ZonePort = Port<String, (), usage::Receive, AnyUser, 2>;
+
+/// The coordinator's reservation port: a chip robot sends the space its trajectory will
+/// sweep and waits until that space is its own.
+pub type ReservePort = Port<(String, imrs_coord::zones::Sweep), (), usage::Receive, AnyUser, 2>;
 
 /// One line's ports.
 #[derive(Debug, Clone)]
@@ -60,6 +68,10 @@ pub struct CellPorts {
     pub zone_request: ZonePort,
     /// The arbiter's release port.
     pub zone_release: ZonePort,
+    /// The coordinator's reservation port.
+    pub zone_reserve: ReservePort,
+    /// The coordinator's port for freeing a reservation.
+    pub zone_free: ZonePort,
 }
 
 fn spec(name: &str, owner: &str, clock: &SharedClock) -> PortSpec {
@@ -120,8 +132,8 @@ impl LinePorts {
 
 impl CellPorts {
     /// Declares every port on `clock`, and makes each known to `cell` for the wiring check;
-    /// the arbiter's ports only when `arbiter` runs.
-    pub fn declare(cell: &Cell, arbiter: bool) -> Result<Self, WireError> {
+    /// the arbiter's or the coordinator's ports only under its policy.
+    pub fn declare(cell: &Cell, policy: FeederPolicy) -> Result<Self, WireError> {
         let clock = cell.clock();
         let ports = Self {
             lines: [
@@ -130,6 +142,8 @@ impl CellPorts {
             ],
             zone_request: ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
             zone_release: ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
+            zone_reserve: ReservePort::declare(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)),
+            zone_free: ZonePort::declare(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
         };
         for line in &ports.lines {
             cell.declare_filtered(&line.frequency)?;
@@ -141,9 +155,16 @@ impl CellPorts {
             cell.declare(&line.ready_to_chip)?;
             cell.declare(&line.share_feeder)?;
         }
-        if arbiter {
-            cell.declare(&ports.zone_request)?;
-            cell.declare(&ports.zone_release)?;
+        match policy {
+            FeederPolicy::Arbiter => {
+                cell.declare(&ports.zone_request)?;
+                cell.declare(&ports.zone_release)?;
+            }
+            FeederPolicy::Coordinator => {
+                cell.declare(&ports.zone_reserve)?;
+                cell.declare(&ports.zone_free)?;
+            }
+            FeederPolicy::Appendix => {}
         }
         Ok(ports)
     }

@@ -188,12 +188,20 @@ impl Report {
             required: true,
         });
         // Under every policy; the Appendix's scheme is not expected to keep it (note 6), so
-        // a violation there is a finding, not a failure of the run.
+        // a violation there is a finding, not a failure of the run. The coordinator lets both
+        // arms into the zone by design, where their trajectories do not meet: what it must
+        // keep is the next rule.
         invariants.push(Invariant {
             rule: "no two robots in the feeder zone together (rapier)",
             held: zone_conflicts == 0,
             detail: format!("{zone_conflicts} conflicts, {zone_shared:.1} s shared"),
             required: record.config.feeder == FeederPolicy::Arbiter,
+        });
+        invariants.push(Invariant {
+            rule: "no two arms touching (rapier)",
+            held: tally.collisions == 0,
+            detail: format!("{} collisions", tally.collisions),
+            required: record.config.feeder != FeederPolicy::Appendix,
         });
         invariants.push(Invariant {
             rule: "every chip lies at its work-schedule place on the card (within 1 mm, rapier)",
@@ -291,63 +299,60 @@ impl Report {
             .all(|invariant| invariant.held || !invariant.required)
     }
 
-    /// The two policies side by side.
-    pub fn side_by_side(appendix: &Report, arbiter: &Report) -> String {
+    /// The policies side by side, in the order given.
+    pub fn side_by_side(reports: &[Report]) -> String {
         let mut out = String::new();
-        let row = |out: &mut String, what: &str, a: String, b: String| {
-            out.push_str(&format!("  {what:<34}{a:>12}{b:>12}\n"));
+        let row = |out: &mut String, what: &str, cells: Vec<String>| {
+            out.push_str(&format!("  {what:<34}"));
+            for cell in cells {
+                out.push_str(&format!("{cell:>13}"));
+            }
+            out.push('\n');
         };
-        out.push_str(&format!(
-            "  {:<34}{:>12}{:>12}\n",
-            "", "appendix", "arbiter"
-        ));
+        let each = |f: &dyn Fn(&Report) -> String| reports.iter().map(f).collect::<Vec<_>>();
+        row(&mut out, "", each(&|r| policy_name(r.policy).to_string()));
         for (line, name) in [(0, "A"), (1, "B")] {
             row(
                 &mut out,
                 &format!("cards per hour, line {name}"),
-                format!("{:.1}", appendix.cards_per_hour(line)),
-                format!("{:.1}", arbiter.cards_per_hour(line)),
+                each(&|r| format!("{:.1}", r.cards_per_hour(line))),
             );
         }
-        let waited = |r: &Report| format!("{:.1}", r.waits[0].waited + r.waits[1].waited);
         row(
             &mut out,
             "seconds waiting for the zone",
-            waited(appendix),
-            waited(arbiter),
+            each(&|r| format!("{:.1}", r.waits[0].waited + r.waits[1].waited)),
         );
-        let refused = |r: &Report| format!("{}", r.waits[0].refused + r.waits[1].refused);
         row(
             &mut out,
             "zone requests refused",
-            refused(appendix),
-            refused(arbiter),
+            each(&|r| format!("{}", r.waits[0].refused + r.waits[1].refused)),
         );
-        let short = |r: &Report| format!("{}", r.lines[0].short + r.lines[1].short);
-        row(&mut out, "cards short", short(appendix), short(arbiter));
         row(
             &mut out,
-            "deadlocks",
-            appendix.deadlocks.to_string(),
-            arbiter.deadlocks.to_string(),
+            "cards short",
+            each(&|r| format!("{}", r.lines[0].short + r.lines[1].short)),
         );
+        row(&mut out, "deadlocks", each(&|r| r.deadlocks.to_string()));
         row(
             &mut out,
             "robot-seconds lost to deadlocks",
-            format!("{:.1}", appendix.deadlock_lost),
-            format!("{:.1}", arbiter.deadlock_lost),
+            each(&|r| format!("{:.1}", r.deadlock_lost)),
         );
         row(
             &mut out,
             "zone conflicts (rapier)",
-            appendix.zone_conflicts.to_string(),
-            arbiter.zone_conflicts.to_string(),
+            each(&|r| r.zone_conflicts.to_string()),
+        );
+        row(
+            &mut out,
+            "seconds both arms in the zone",
+            each(&|r| format!("{:.1}", r.zone_shared_seconds)),
         );
         row(
             &mut out,
             "collisions (rapier)",
-            appendix.collisions.to_string(),
-            arbiter.collisions.to_string(),
+            each(&|r| r.collisions.to_string()),
         );
         out
     }
@@ -365,6 +370,7 @@ fn policy_name(policy: FeederPolicy) -> &'static str {
     match policy {
         FeederPolicy::Appendix => "appendix",
         FeederPolicy::Arbiter => "arbiter",
+        FeederPolicy::Coordinator => "coordinator",
     }
 }
 

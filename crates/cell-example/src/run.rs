@@ -14,7 +14,9 @@ use imrs_sim::{
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, chip_it, feeder_monitor};
+use crate::chip::{
+    FeederPolicy, SharedWaits, ZoneWaits, chip_it, feeder_coordinator, feeder_monitor,
+};
 use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes, gate};
 use crate::load::{load_card, load_it, screw_in_card};
@@ -240,8 +242,7 @@ async fn simulate(
         .subscribe(move |event| lock(&folded).cell(event));
     let folded = Arc::clone(&tally);
     sim.log().subscribe(move |event| lock(&folded).sim(event));
-    let ports = CellPorts::declare(&cell, config.feeder == FeederPolicy::Arbiter)
-        .map_err(CellErrors::from)?;
+    let ports = CellPorts::declare(&cell, config.feeder).map_err(CellErrors::from)?;
     let deaths: [ReleaseDeath; 2] = Default::default();
     let cycle_times: [SharedCycleTimes; 2] = Default::default();
     let waits: SharedWaits = Arc::default();
@@ -260,15 +261,23 @@ async fn simulate(
         declarations
             .push(chip_it(line, config.feeder, &ports, &sim, Arc::clone(&waits)).declaration());
     }
-    if config.feeder == FeederPolicy::Arbiter {
-        declarations.push(feeder_monitor(&ports).declaration());
+    match config.feeder {
+        FeederPolicy::Arbiter => declarations.push(feeder_monitor(&ports).declaration()),
+        FeederPolicy::Coordinator => declarations.push(feeder_coordinator(&ports).declaration()),
+        FeederPolicy::Appendix => {}
     }
     cell.check(&declarations)?;
 
     sim.spawn();
     let policy = RestartPolicy::restart(3, Duration::from_secs(5));
-    if config.feeder == FeederPolicy::Arbiter {
-        cell.start(feeder_monitor(&ports))?;
+    match config.feeder {
+        FeederPolicy::Arbiter => {
+            cell.start(feeder_monitor(&ports))?;
+        }
+        FeederPolicy::Coordinator => {
+            cell.start(feeder_coordinator(&ports))?;
+        }
+        FeederPolicy::Appendix => {}
     }
     for line in Line::ALL {
         let (lines, sim) = (ports.lines[line.index()].clone(), sim.clone());

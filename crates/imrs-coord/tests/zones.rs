@@ -273,3 +273,36 @@ fn a_geometric_deadlock_is_resolved_by_an_alternative_trajectory() {
     let on_goal = Obstacle::links(&[([-0.2, 0.5, z], [0.2, 0.5, z])], 0.035);
     assert_eq!(detour(&path, radius, &[on_goal], margin, 0.6), None);
 }
+
+/// Zones that follow the trajectories: sweeps that keep clear are held at once, one that
+/// meets a held sweep waits for its release, and a later request never jumps an earlier
+/// one it would block.
+#[test]
+fn reservations_grant_sweeps_that_keep_clear_and_queue_the_others() {
+    use imrs_coord::zones::{Reservations, Sweep};
+    // An arm from (0, 0) reaching straight out to x = 0.7 at height y.
+    let reach = |y: f32| -> Sweep {
+        (0..=5)
+            .map(|i| {
+                let x = 0.7 * i as f32 / 5.0;
+                [[0.0, y], [x / 2.0, y], [x, y]]
+            })
+            .collect()
+    };
+    let mut space = Reservations::new(0.035, 0.03);
+    assert!(space.request("ARM_A", &reach(0.0)));
+    assert!(space.request("ARM_B", &reach(0.2)), "20 cm apart: clear");
+    assert!(
+        !space.request("ARM_C", &reach(0.05)),
+        "5 cm from A's: must wait"
+    );
+    // D is clear of A and B but would block C, which asked first: it waits its turn.
+    assert!(!space.request("ARM_D", &reach(0.1)));
+    assert_eq!(
+        space.release("ARM_B"),
+        Vec::<imrs_core::imrs_ports::Name>::new()
+    );
+    assert_eq!(space.release("ARM_A"), ["ARM_C"]);
+    assert_eq!(space.release("ARM_C"), ["ARM_D"]);
+    assert_eq!(space.holders(), ["ARM_D"]);
+}

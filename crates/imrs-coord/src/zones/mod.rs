@@ -33,9 +33,11 @@
 mod deadlock;
 mod detour;
 mod pipeline;
+mod sweep;
 mod table;
 
 pub use deadlock::Deadlock;
 pub use detour::{Obstacle, detour, first_blocked};
 pub use pipeline::{Command, Pipeline};
+pub use sweep::{Reservations, Sweep};
 pub use table::{Answer, Resources, ZoneDef, ZoneError, ZoneKind};

@@ -32,6 +32,37 @@ impl Robot {
         self.sim.now()
     }
 
+    /// The space the arm's links sweep moving in a straight line from `from` (or from
+    /// where its tool is now) to `to`: `samples + 1` poses, each its base, elbow and tool in
+    /// the working plane, computed from the same kinematics the simulation moves it by.
+    pub fn sweep(
+        &self,
+        from: Option<Target>,
+        to: Target,
+        samples: usize,
+    ) -> Result<Vec<[[f32; 2]; 3]>, DeviceError> {
+        let robot = self.id;
+        self.sim.with(|world, now| {
+            let start = match from {
+                Some(from) => world.reachable(robot, from)?,
+                None => world.arm(robot).tool_at(now),
+            };
+            let end = world.reachable(robot, to)?;
+            let arm = world.arm(robot);
+            let samples = samples.max(1);
+            Ok((0..=samples)
+                .filter_map(|i| {
+                    let t = i as f32 / samples as f32;
+                    let tool = [
+                        start[0] + (end[0] - start[0]) * t,
+                        start[1] + (end[1] - start[1]) * t,
+                    ];
+                    arm.links_at(tool)
+                })
+                .collect())
+        })
+    }
+
     /// Moves the tool in a straight line to `target`, taking the time its trapezoidal
     /// profile takes.
     pub async fn move_to(&self, target: Target) -> Result<(), DeviceError> {

@@ -88,6 +88,11 @@ impl Arm {
         arm
     }
 
+    /// The arm's links with its tool at `tool`: base, elbow, tool; `None` out of reach.
+    pub(crate) fn links_at(&self, tool: [f32; 2]) -> Option<[[f32; 2]; 3]> {
+        elbow(self.base, tool, LINK_1, LINK_2, self.side).map(|elbow| [self.base, elbow, tool])
+    }
+
     pub(crate) fn reaches(&self, target: [f32; 2]) -> bool {
         elbow(self.base, target, LINK_1, LINK_2, self.side).is_some()
     }

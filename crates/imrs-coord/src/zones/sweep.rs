@@ -1,0 +1,101 @@
+//! Zones that follow the trajectories: each robot reserves the space its links will sweep,
+//! and a reservation is granted only where it keeps clear of every other one.
+
+use std::collections::VecDeque;
+
+use imrs_core::imrs_ports::Name;
+use rapier3d::parry::query;
+use rapier3d::parry::shape::Capsule;
+use rapier3d::prelude::{Pose, Vector};
+
+/// The poses of an arm along a trajectory: base, elbow and tool in the working plane.
+pub type Sweep = Vec<[[f32; 2]; 3]>;
+
+/// Reservations of swept space. Where two robots' trajectories do not meet they hold their
+/// reservations at the same time; where they do, the later one waits, first come first
+/// served. A reservation is the space of the links, `radius` thick, kept `margin` apart.
+#[derive(Debug, Clone)]
+pub struct Reservations {
+    radius: f32,
+    margin: f32,
+    held: Vec<(Name, Vec<Capsule>)>,
+    waiting: VecDeque<(Name, Vec<Capsule>)>,
+}
+
+fn capsules(sweep: &Sweep, radius: f32) -> Vec<Capsule> {
+    let v = |p: [f32; 2]| Vector::new(p[0], p[1], 0.0);
+    sweep
+        .iter()
+        .flat_map(|[base, elbow, tool]| {
+            [
+                Capsule::new(v(*base), v(*elbow), radius),
+                Capsule::new(v(*elbow), v(*tool), radius),
+            ]
+        })
+        .collect()
+}
+
+impl Reservations {
+    /// Links `radius` thick, kept `margin` apart.
+    pub fn new(radius: f32, margin: f32) -> Self {
+        Self {
+            radius,
+            margin,
+            held: Vec::new(),
+            waiting: VecDeque::new(),
+        }
+    }
+
+    fn clear_of(&self, space: &[Capsule], other: &[Capsule]) -> bool {
+        space.iter().all(|a| {
+            other.iter().all(|b| {
+                query::distance(&Pose::IDENTITY, a, &Pose::IDENTITY, b)
+                    .is_ok_and(|d| d.distance >= self.margin)
+            })
+        })
+    }
+
+    /// `robot` asks for the space of `sweep`: granted now (true) if it keeps clear of every
+    /// reservation held and of every earlier request still waiting; else it waits in turn.
+    pub fn request(&mut self, robot: impl Into<Name>, sweep: &Sweep) -> bool {
+        let (robot, space) = (robot.into(), capsules(sweep, self.radius));
+        let free = self
+            .held
+            .iter()
+            .chain(&self.waiting)
+            .all(|(_, other)| self.clear_of(&space, other));
+        if free {
+            self.held.push((robot, space));
+        } else {
+            self.waiting.push_back((robot, space));
+        }
+        free
+    }
+
+    /// `robot` is done with its space; returns the waiting robots granted now, in turn.
+    pub fn release(&mut self, robot: &str) -> Vec<Name> {
+        self.held.retain(|(holder, _)| *holder != robot);
+        let mut granted = Vec::new();
+        let mut still = VecDeque::new();
+        while let Some((waiter, space)) = self.waiting.pop_front() {
+            let free = self
+                .held
+                .iter()
+                .chain(&still)
+                .all(|(_, other)| self.clear_of(&space, other));
+            if free {
+                granted.push(waiter.clone());
+                self.held.push((waiter, space));
+            } else {
+                still.push_back((waiter, space));
+            }
+        }
+        self.waiting = still;
+        granted
+    }
+
+    /// Who holds a reservation now.
+    pub fn holders(&self) -> Vec<Name> {
+        self.held.iter().map(|(robot, _)| robot.clone()).collect()
+    }
+}
