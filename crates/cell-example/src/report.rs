@@ -125,6 +125,8 @@ pub struct Report {
     pub zone_shared_seconds: f64,
     /// Contacts between robots, measured by rapier.
     pub collisions: u32,
+    /// The closest two arms came while both were in the feeder zone (rapier), in metres.
+    pub closest_in_zone: Option<f32>,
     /// The chip robots' waits for the zone.
     pub waits: [ZoneWaits; 2],
     /// The invariants.
@@ -280,6 +282,7 @@ impl Report {
             zone_conflicts,
             zone_shared_seconds: zone_shared,
             collisions: tally.collisions,
+            closest_in_zone: record.closest_in_zone,
             waits: record.waits,
             invariants,
             simulated: record.simulated.as_secs_f64(),
@@ -348,6 +351,14 @@ impl Report {
             &mut out,
             "seconds both arms in the zone",
             each(&|r| format!("{:.1}", r.zone_shared_seconds)),
+        );
+        row(
+            &mut out,
+            "closest arms in zone (rapier, mm)",
+            each(&|r| {
+                r.closest_in_zone
+                    .map_or("-".into(), |m| format!("{:.0}", m * 1000.0))
+            }),
         );
         row(
             &mut out,

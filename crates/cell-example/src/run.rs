@@ -99,6 +99,8 @@ pub struct RunRecord {
     pub feeders: Vec<(FeederId, u32, u32)>,
     /// How each robot spent its time, measured by the simulation.
     pub robot_times: Vec<(RobotId, RobotTimes)>,
+    /// The closest two arms came while both were in the feeder zone (rapier), in metres.
+    pub closest_in_zone: Option<f32>,
     /// Each line's GATE's CYCLE_TIME over the run.
     pub cycle_times: [CycleTimeHistory; 2],
     /// Simulated time.
@@ -341,6 +343,7 @@ async fn simulate(
         tree: cell.tree(),
         feeders: sim.feeders(),
         robot_times: sim.robot_times(),
+        closest_in_zone: sim.closest_in_zone(),
         cycle_times: cycle_times.each_ref().map(|history| {
             history
                 .lock()

@@ -188,6 +188,12 @@ impl Sim {
         self.world().pallet_positions()
     }
 
+    /// The closest two arms' links came while both were in the feeder zone, in metres, as
+    /// rapier measured them at each step; `None` if never two were in it together.
+    pub fn closest_in_zone(&self) -> Option<f32> {
+        self.world().closest_in_zone
+    }
+
     /// How each robot spent its time so far, as measured by the simulation.
     pub fn robot_times(&self) -> Vec<(RobotId, RobotTimes)> {
         self.world().robot_times()

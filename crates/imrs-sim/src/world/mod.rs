@@ -66,6 +66,8 @@ pub(crate) struct World {
     /// Pending faults, soonest first.
     faults: Vec<Fault>,
     in_zone: Vec<bool>,
+    /// The closest two arms came while both were in the feeder zone, in metres.
+    pub(crate) closest_in_zone: Option<f32>,
     touching: BTreeSet<(usize, usize)>,
     last_step: Option<Instant>,
     next_pallet: u32,
@@ -162,6 +164,7 @@ impl World {
             feeders,
             faults: Vec::new(),
             in_zone: vec![false; RobotId::ALL.len()],
+            closest_in_zone: None,
             touching: BTreeSet::new(),
             last_step: None,
             next_pallet: 0,
@@ -225,6 +228,21 @@ impl World {
             for b in a + 1..self.arms.len() {
                 if !self.arms[a].moved && !self.arms[b].moved {
                     continue;
+                }
+                if self.in_zone[a] && self.in_zone[b] {
+                    let apart = self.arms[a]
+                        .colliders
+                        .iter()
+                        .flat_map(|&ca| {
+                            let physics = &self.physics;
+                            self.arms[b]
+                                .colliders
+                                .iter()
+                                .map(move |&cb| physics.distance(ca, cb))
+                        })
+                        .fold(f32::INFINITY, f32::min);
+                    self.closest_in_zone =
+                        Some(self.closest_in_zone.map_or(apart, |c| c.min(apart)));
                 }
                 let contact = self.arms[a].colliders.iter().find_map(|&ca| {
                     self.arms[b]

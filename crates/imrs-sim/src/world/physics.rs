@@ -150,6 +150,13 @@ impl Physics {
     }
 
     /// Whether `collider` overlaps the feeder zone.
+    /// How far apart two colliders are (0 when they touch), by parry3d.
+    pub(crate) fn distance(&self, a: ColliderHandle, b: ColliderHandle) -> f32 {
+        let (a, b) = (&self.world.colliders[a], &self.world.colliders[b]);
+        rapier3d::parry::query::distance(a.position(), a.shape(), b.position(), b.shape())
+            .map_or(0.0, |d| d.distance)
+    }
+
     pub(crate) fn in_zone(&self, collider: ColliderHandle) -> bool {
         self.world
             .narrow_phase
