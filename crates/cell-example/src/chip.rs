@@ -137,9 +137,10 @@ enum Access {
 const SWEEP_SAMPLES: usize = 12;
 
 impl Access {
-    /// Asks to enter the zone; whether it may.
-    async fn enter(&mut self, ctx: &Ctx<ChipItState>) -> bool {
-        match self {
+    /// Asks to enter the zone, and counts the wait; whether it may.
+    async fn enter(&mut self, ctx: &Ctx<ChipItState>, waits: &SharedWaits, line: Line) -> bool {
+        let asked = ctx.now();
+        let ok = match self {
             // QUERY SHARE_FEEDER.CRIT_SECTION(OK)
             Access::Appendix(share_feeder) => {
                 matches!(ctx.query(share_feeder, ()).await, Ok(clear) if clear != 0)
@@ -148,24 +149,27 @@ impl Access {
                 ctx.send(request, ctx.module().to_string()).await.is_ok()
             }
             // The coordinator is asked per step, with the step's trajectory: see `reserve`.
-            Access::Coordinator { .. } => true,
-        }
+            Access::Coordinator { .. } => return true,
+        };
+        record_wait(waits, line, ok, (ctx.now() - asked).as_secs_f64());
+        ok
     }
 
     /// Under the coordinator, reserves the space the arm sweeps to `feeder` and on to the
-    /// card's `place`, and waits until it is granted; returns how long it waited (`None`
-    /// under the other policies, which ask in `enter`). A coordinator that cannot be
-    /// reached is asked again each second, as `left` does.
+    /// card's `place`, waits until it is granted, and counts the wait (the other policies
+    /// ask in `enter`). A coordinator that cannot be reached is asked again each second, as
+    /// `left` does.
     async fn reserve(
         &mut self,
         ctx: &Ctx<ChipItState>,
         robot: &Robot,
-        feeder: FeederId,
-        place: [f32; 2],
-    ) -> Result<Option<f64>, DeviceError> {
+        step: ChipStep,
+        waits: &SharedWaits,
+    ) -> Result<(), DeviceError> {
         let Access::Coordinator { reserve, .. } = self else {
-            return Ok(None);
+            return Ok(());
         };
+        let (feeder, place) = (step.feeder, step.place());
         let mut sweep = robot.sweep(None, Target::Feeder(feeder), SWEEP_SAMPLES)?;
         sweep.extend(robot.sweep(
             Some(Target::Feeder(feeder)),
@@ -180,7 +184,9 @@ impl Access {
         {
             ctx.delay(Duration::from_secs(1)).await;
         }
-        Ok(Some((ctx.now() - asked).as_secs_f64()))
+        let waited = (ctx.now() - asked).as_secs_f64();
+        record_wait(waits, robot.id().line, true, waited);
+        Ok(())
     }
 
     /// Says it has left the zone.
@@ -309,14 +315,7 @@ pub fn chip_it(
                 };
                 work.reinstate();
                 while work.more() > 0 {
-                    let asked = ctx.now();
-                    let ok = access.enter(&ctx).await;
-                    let waited = (ctx.now() - asked).as_secs_f64();
-                    // Under the coordinator the step's own reservation is what waits.
-                    if !matches!(access, Access::Coordinator { .. }) {
-                        record_wait(&waits, line, ok, waited);
-                    }
-                    if !ok {
+                    if !access.enter(&ctx, &waits, line).await {
                         // {Signal operator}: counted; a timeout already raised SHARE_FEEDER.TIMEOUT.
                         continue;
                     }
@@ -385,12 +384,7 @@ async fn chip_step(
     access: &mut Access,
     waits: &SharedWaits,
 ) -> Result<(), DeviceError> {
-    if let Some(waited) = access
-        .reserve(ctx, robot, step.feeder, step.place())
-        .await?
-    {
-        record_wait(waits, robot.id().line, true, waited);
-    }
+    access.reserve(ctx, robot, step, waits).await?;
     let grasped = ctx
         .section("GRASP", async {
             let grasped = async {

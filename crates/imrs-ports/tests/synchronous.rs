@@ -261,3 +261,27 @@ fn a_select_takes_the_most_urgent_ready_input() {
         assert!(closed.is_err());
     });
 }
+
+/// A sensor read by one short-lived reader after another, ten thousand times: each reader
+/// gets its value, and the output keeps no list of the readers that are gone.
+#[test]
+fn readers_that_come_and_go_leave_nothing_behind() {
+    runtime().block_on(async {
+        let position = Output::<u32>::new("position", "Jposition_7");
+        for n in 0..10_000 {
+            let reader = Input::new("Pin", "Objtest_1");
+            connect(&position, &reader);
+            let (written, read) = tokio::join!(position.write(n), reader.read());
+            written.unwrap();
+            assert_eq!(read, Ok(n));
+            assert!(
+                position.connections() <= 1,
+                "{} kept at {n}",
+                position.connections()
+            );
+        }
+        // The last reader is gone too: a write has nobody to wait for, and says so.
+        let error = position.write(0).await.unwrap_err();
+        assert!(matches!(error, WriteError::Disconnected { .. }));
+    });
+}

@@ -2,10 +2,10 @@
 //! trace of their lives.
 
 use std::fmt;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 
-use imrs_core::Processor;
 use imrs_core::imrs_ports::{Instant, Name, SharedClock};
+use imrs_core::{Log, Processor, Record};
 
 use crate::cx::Cx;
 use crate::error::SchemaError;
@@ -38,6 +38,8 @@ pub struct TraceEntry {
     pub ended: Option<Ending>,
 }
 
+impl Record for TraceEntry {}
+
 impl fmt::Display for TraceEntry {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let at = self.at.since_start().as_secs_f64();
@@ -54,20 +56,16 @@ impl fmt::Display for TraceEntry {
 pub(crate) struct Net {
     pub(crate) clock: SharedClock,
     pub(crate) processor: Processor,
-    trace: Mutex<Vec<TraceEntry>>,
+    trace: Log<TraceEntry>,
 }
 
 impl Net {
     pub(crate) fn record(&self, instance: &Name, ended: Option<Ending>) {
-        let entry = TraceEntry {
+        self.trace.record(TraceEntry {
             at: self.clock.now(),
             instance: instance.clone(),
             ended,
-        };
-        self.trace
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .push(entry);
+        });
     }
 }
 
@@ -92,7 +90,7 @@ impl Network {
         let net = Arc::new(Net {
             clock,
             processor: Processor::new(name),
-            trace: Mutex::default(),
+            trace: Log::new(),
         });
         Self {
             top: Scope::top(net),
@@ -119,14 +117,17 @@ impl Network {
         self.cx().forall()
     }
 
-    /// Every instantiation and ending so far, in order.
+    /// The instantiations and endings kept so far, in order: every one, or past the log's
+    /// capacity the most recent.
     pub fn trace(&self) -> Vec<TraceEntry> {
-        self.top
-            .net
-            .trace
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .clone()
+        self.top.net.trace.snapshot()
+    }
+
+    /// The trace as a log: bounded like the cell's event log (by default the most recent
+    /// [`Log::DEFAULT_CAPACITY`] entries), and streamed to subscribers, so that a network
+    /// that instantiates without end — `Object?` does — runs in fixed memory.
+    pub fn log(&self) -> &Log<TraceEntry> {
+        &self.top.net.trace
     }
 
     /// Deinstantiates every instance.

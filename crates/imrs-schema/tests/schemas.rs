@@ -449,3 +449,67 @@ async fn a_connection_map_is_checked_at_instantiation_and_a_refused_instance_doe
         "the refused instance's number was not freed"
     );
 }
+
+/// Takes one value and stops.
+struct TakeOne;
+
+impl Schema for TakeOne {
+    const NAME: &'static str = "TakeOne";
+    type Ports = SinkPorts;
+    fn set_up(&mut self, cx: &Cx) -> Result<SinkPorts, SchemaError> {
+        Ok(Declare::declare(cx.me()))
+    }
+    async fn behavior(&mut self, p: &SinkPorts, _: &Cx) -> Behavior {
+        p.value.read().await?;
+        Ok(Flow::Stop)
+    }
+}
+
+/// Instantiates a `TakeOne` on the counter's output, waits for it to end, and again, for
+/// ever — as `Object?` keeps making `Objtest`s.
+struct Spawner(imrs_schema::Output<u32>);
+
+impl Schema for Spawner {
+    const NAME: &'static str = "Spawner";
+    type Ports = ();
+    fn set_up(&mut self, _: &Cx) -> Result<(), SchemaError> {
+        Ok(())
+    }
+    async fn behavior(&mut self, _: &(), cx: &Cx) -> Behavior {
+        let taker = cx.instantiate(TakeOne)?;
+        cx.connect(&self.0, &taker.ports().value);
+        taker.ended().await;
+        Ok(Flow::Continue)
+    }
+}
+
+/// A network that instantiates without end runs in fixed memory: the trace keeps its
+/// capacity, the instances that ended are gone, and the counter's output keeps no list of
+/// its dead readers — the same after a run ten times longer.
+#[tokio::test(start_paused = true)]
+async fn a_network_that_instantiates_without_end_stays_in_fixed_memory() {
+    let (net, clock) = network();
+    net.log().set_capacity(100);
+    let counter = net
+        .instantiate(Count {
+            next: 0,
+            until: u32::MAX,
+        })
+        .unwrap();
+    let output = counter.ports().count.clone();
+    net.instantiate(Spawner(output.clone())).unwrap();
+    let mut seen = Vec::new();
+    for seconds in [1.0, 10.0] {
+        run_for(&clock, seconds).await;
+        assert!(net.log().len() <= 100);
+        assert!(net.forall::<TakeOne>().len() <= 1);
+        assert!(
+            output.connections() <= 1,
+            "{} readers kept",
+            output.connections()
+        );
+        seen.push(net.log().forgotten());
+    }
+    // One taker per 10 ms: 100 in the first second, 1 000 in the next ten.
+    assert!(seen[0] > 100 && seen[1] > 10 * seen[0] - 200, "{seen:?}");
+}

@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use imrs_core::imrs_ports::{Name, PortInfo};
 
-use super::{Bus, TransmitQueue};
+use super::Bus;
 
 /// What a packet adds to its message, as the seed counts it: one byte of message type and
 /// 26 bytes of frame (preamble, addresses, length, checksum).
@@ -150,11 +150,10 @@ pub fn report(
     Ok(spans
         .into_iter()
         .map(|(port, stations)| {
-            // An empty queue but for the packet that may already be in the FIFO.
-            let mut queue = TransmitQueue::new();
-            queue.push(port.priority, ());
+            // Behind at most the packet already in its station's FIFO, then its own turn:
+            // `TransmitQueue::worst_wait` with nothing else queued.
             let one_way = if stations.len() > 1 {
-                queue.worst_wait(port.priority, d_max)
+                2 * d_max
             } else {
                 Duration::ZERO
             };

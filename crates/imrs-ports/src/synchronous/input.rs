@@ -8,6 +8,7 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::task::{Context, Poll, Waker};
 
 use super::error::ReadError;
+use super::handle::{Close, Handle};
 use super::ticket::Ticket;
 use crate::meta::Name;
 use crate::priority::Priority;
@@ -18,18 +19,7 @@ use crate::select::Alternative;
 /// Cheap to clone; every clone is the same port (they share one queue). The port closes
 /// when [`Input::close`] is called or the last clone is dropped.
 pub struct Input<T> {
-    handle: Arc<Handle<T>>,
-}
-
-/// Closes the port when the last clone of the [`Input`] goes.
-struct Handle<T> {
-    shared: Arc<InputShared<T>>,
-}
-
-impl<T> Drop for Handle<T> {
-    fn drop(&mut self) {
-        self.shared.close();
-    }
+    handle: Arc<Handle<InputShared<T>>>,
 }
 
 /// What outputs connected to this input hold.
@@ -91,7 +81,9 @@ impl<T> InputShared<T> {
     pub(crate) fn lock(&self) -> MutexGuard<'_, InputState<T>> {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
+}
 
+impl<T> Close for InputShared<T> {
     fn close(&self) {
         let mut state = self.lock();
         state.closed = true;

@@ -50,6 +50,7 @@
 
 mod any;
 mod error;
+mod handle;
 mod input;
 mod output;
 mod ticket;

@@ -7,6 +7,7 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::task::{Context, Poll};
 
 use super::error::WriteError;
+use super::handle::{Close, Handle};
 use super::input::{Copy, Input, InputShared};
 use super::ticket::{Fate, Ticket};
 use crate::meta::Name;
@@ -17,18 +18,7 @@ use crate::meta::Name;
 /// Cheap to clone; every clone is the same port. The port closes when [`Output::close`] is
 /// called or the last clone is dropped.
 pub struct Output<T> {
-    handle: Arc<Handle<T>>,
-}
-
-/// Closes the port when the last clone of the [`Output`] goes.
-struct Handle<T> {
-    shared: Arc<OutputShared<T>>,
-}
-
-impl<T> Drop for Handle<T> {
-    fn drop(&mut self) {
-        self.shared.close();
-    }
+    handle: Arc<Handle<OutputShared<T>>>,
 }
 
 pub(crate) struct OutputShared<T> {
@@ -38,16 +28,26 @@ pub(crate) struct OutputShared<T> {
 }
 
 struct OutputState<T> {
+    /// The inputs connected and not known to be closed: a closed one is forgotten at the
+    /// next write or connection, so that an output whose readers come and go (a sensor
+    /// read by one short-lived instance after another) keeps no list of the dead.
     inputs: Vec<Arc<InputShared<T>>>,
+    /// Whether any input was ever connected: with all of them closed, a write is unread
+    /// for good.
+    connected: bool,
     /// The write waiting now, kept so that an input connected meanwhile gets it too.
     pending: Option<Copy<T>>,
     closed: bool,
 }
 
 impl<T> OutputState<T> {
-    /// Whether a waiting write can never be read: it has inputs, and all are closed.
+    /// Whether a waiting write can never be read: it had inputs, and all are closed.
     fn unread_for_good(&self) -> bool {
-        !self.inputs.is_empty() && self.inputs.iter().all(|input| input.lock().closed)
+        self.connected && self.inputs.iter().all(|input| input.lock().closed)
+    }
+
+    fn forget_closed(&mut self) {
+        self.inputs.retain(|input| !input.lock().closed);
     }
 
     fn take_pending(&mut self, ticket: &Arc<Ticket>) -> Option<T> {
@@ -66,6 +66,17 @@ impl<T> OutputShared<T> {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
+    /// Takes a withdrawn write's copies back from every input.
+    fn withdraw(&self, ticket: &Arc<Ticket>) -> Option<T> {
+        let mut state = self.lock();
+        for input in &state.inputs {
+            input.lock().withdraw(ticket);
+        }
+        state.take_pending(ticket)
+    }
+}
+
+impl<T> Close for OutputShared<T> {
     fn close(&self) {
         let mut state = self.lock();
         if std::mem::replace(&mut state.closed, true) {
@@ -78,15 +89,6 @@ impl<T> OutputShared<T> {
             copy.ticket.nudge();
         }
     }
-
-    /// Takes a withdrawn write's copies back from every input.
-    fn withdraw(&self, ticket: &Arc<Ticket>) -> Option<T> {
-        let mut state = self.lock();
-        for input in &state.inputs {
-            input.lock().withdraw(ticket);
-        }
-        state.take_pending(ticket)
-    }
 }
 
 impl<T: Clone + Send + 'static> Output<T> {
@@ -97,6 +99,7 @@ impl<T: Clone + Send + 'static> Output<T> {
             owner: owner.into(),
             state: Mutex::new(OutputState {
                 inputs: Vec::new(),
+                connected: false,
                 pending: None,
                 closed: false,
             }),
@@ -119,9 +122,11 @@ impl<T: Clone + Send + 'static> Output<T> {
     pub(crate) fn connect(&self, input: &Input<T>) {
         let input = input.shared();
         let mut state = self.handle.shared.lock();
+        state.forget_closed();
         if state.inputs.iter().any(|known| Arc::ptr_eq(known, input)) {
             return;
         }
+        state.connected = true;
         let mut reader = input.lock();
         reader.connected(!state.closed);
         if let Some(copy) = &state.pending
@@ -136,7 +141,8 @@ impl<T: Clone + Send + 'static> Output<T> {
         state.inputs.push(Arc::clone(input));
     }
 
-    /// How many inputs are connected (closed ones included).
+    /// How many inputs are connected: those not closed, and a closed one until the next
+    /// write or connection forgets it.
     pub fn connections(&self) -> usize {
         self.handle.shared.lock().inputs.len()
     }
@@ -192,6 +198,7 @@ impl<T: Clone> Write<'_, T> {
     fn start(&mut self, value: T) -> Arc<Ticket> {
         let ticket = Arc::new(Ticket::new());
         let mut state = self.output.lock();
+        state.forget_closed();
         for input in &state.inputs {
             input.lock().deliver(Copy {
                 ticket: Arc::clone(&ticket),

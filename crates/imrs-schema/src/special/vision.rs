@@ -22,7 +22,9 @@ pub(crate) struct Track {
 /// ([`Hand::see`]), matches each detection to the object it was last frame — the same
 /// shape, nearest, within [`Vision::GATE`] — and keeps `SEF_k` for object `k`: made when an
 /// object first appears, stopped once it has been missed [`Vision::LOST`] frames in a row.
-/// Numbers are never reused, so `SEF_k` always stands for the same object.
+/// Numbers are never reused, so `SEF_k` always stands for the same object. The price: each
+/// object ever seen keeps its name `SEF_k` for the life of the process (names are
+/// interned), so a camera that sees new objects without end grows by one name per object.
 #[derive(Debug)]
 pub struct Vision {
     hand: Hand,
