@@ -52,6 +52,7 @@ mod rng;
 pub mod scara;
 mod scene;
 mod sim;
+pub mod table;
 mod world;
 
 pub use device::{Gate, Relay, Release, Robot};
