@@ -15,7 +15,8 @@ pub enum Skill {
     Screw,
 }
 
-/// A robot: its skills, how fast it is (1 = nominal), and where it rests.
+/// A robot: its skills, how fast it is (1 = nominal), where it rests, and how far it
+/// reaches.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Robot {
     /// Its name.
@@ -26,6 +27,15 @@ pub struct Robot {
     pub speed: f64,
     /// Where it starts, in metres on the table.
     pub home: [f64; 2],
+    /// Where it stands, and how far from there it may work (infinite: anywhere).
+    pub reach: ([f64; 2], f64),
+}
+
+impl Robot {
+    /// Whether it is capable of `task`: it has the skill and reaches the place.
+    pub fn can(&self, task: &TaskSpec) -> bool {
+        self.skills.contains(&task.skill) && distance(self.reach.0, task.at) <= self.reach.1
+    }
 }
 
 /// An elementary task of a unit, independent of any robot.
@@ -45,7 +55,7 @@ pub struct TaskSpec {
     pub parts: Vec<usize>,
 }
 
-/// A region only one robot may work in at a time.
+/// A region only one robot may work in at a time, as the scheduler plans it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Zone {
     /// Its centre, in metres.
@@ -65,7 +75,7 @@ pub(crate) fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
-/// A cell: its robots, the tasks of one unit, the kinds of part, and its shared zone.
+/// A cell: its robots, the tasks of one unit, the kinds of part, and its shared zones.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Workcell {
     /// The robots.
@@ -74,8 +84,8 @@ pub struct Workcell {
     pub tasks: Vec<TaskSpec>,
     /// The kinds of part a unit needs, by name.
     pub parts: Vec<&'static str>,
-    /// The zone shared by the robots.
-    pub zone: Zone,
+    /// The zones shared by the robots, each worked in by one at a time.
+    pub zones: Vec<Zone>,
     /// How fast a robot of speed 1 travels, in m/s.
     pub travel: f64,
 }
@@ -90,6 +100,7 @@ impl Workcell {
             skills: skills.to_vec(),
             speed,
             home,
+            reach: (home, f64::INFINITY),
         };
         let task = |name, skill, work, at, after: &[usize], parts: &[usize]| TaskSpec {
             name,
@@ -115,12 +126,19 @@ impl Workcell {
                 task("screw cover", Screw, 5.0, [0.05, 0.0], &[1, 2, 4], &[]),
             ],
             parts: vec!["base", "cover", "shaft", "gear"],
-            zone: Zone {
+            zones: vec![Zone {
                 centre: [0.0, 0.0],
                 radius: 0.15,
-            },
+            }],
             travel: 0.5,
         }
+    }
+}
+
+impl Workcell {
+    /// The zone `at` lies in, if any (the first, where zones overlap).
+    pub fn zone_of(&self, at: [f64; 2]) -> Option<usize> {
+        self.zones.iter().position(|zone| zone.contains(at))
     }
 }
 

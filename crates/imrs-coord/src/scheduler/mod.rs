@@ -31,4 +31,4 @@ mod sim;
 
 pub use cell::{Arrivals, Robot, Skill, TaskSpec, Workcell, Zone};
 pub use policy::{Policy, RunTime, Static};
-pub use sim::{Estimate, Outcome, State, simulate};
+pub use sim::{Dispatch, Estimate, Outcome, Refusal, State, simulate};

@@ -58,13 +58,17 @@ impl Static {
         let mut plan = vec![Vec::new(); cell.robots.len()];
         for task in order {
             let spec = &cell.tasks[task];
-            let best = (0..cell.robots.len())
-                .filter(|&r| cell.robots[r].skills.contains(&spec.skill))
+            // A task no robot is capable of is bound to none: no unit completes, and the
+            // run's outcome says so.
+            let Some(best) = (0..cell.robots.len())
+                .filter(|&r| cell.robots[r].can(spec))
                 .min_by(|&a, &b| {
                     let after = |r: usize| load[r] + spec.work / cell.robots[r].speed;
                     after(a).total_cmp(&after(b))
                 })
-                .expect("some robot has every skill a task needs");
+            else {
+                continue;
+            };
             load[best] += spec.work / cell.robots[best].speed;
             plan[best].push(task);
         }
@@ -134,7 +138,7 @@ impl RunTime {
         let own = state.estimate(robot, task);
         // The zone is shared: time a slow robot spends in it is time every other robot
         // may wait at its border.
-        let in_zone = if cell.zone.contains(cell.tasks[task].at) {
+        let in_zone = if cell.zone_of(cell.tasks[task].at).is_some() {
             let work = cell.tasks[task].work;
             let fastest = (0..cell.robots.len())
                 .filter(|&other| state.can(other, task))

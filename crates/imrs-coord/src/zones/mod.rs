@@ -38,6 +38,6 @@ mod table;
 
 pub use deadlock::Deadlock;
 pub use detour::{Obstacle, detour, first_blocked};
-pub use pipeline::{Command, Pipeline};
+pub use pipeline::{Command, Next, Pipeline};
 pub use sweep::{Reservations, Sweep};
 pub use table::{Answer, Resources, ZoneDef, ZoneError, ZoneKind};

@@ -66,47 +66,106 @@ impl Pipeline {
         self.offset + 2
     }
 
-    /// One step: compute and check points until the queue is full, then act on its oldest.
-    /// A checked point in a zone not yet granted asks the coordinator; a `Sleep` stops the
-    /// arm (STOP_C) where it is. Leaving a zone releases it; returns who that woke too.
-    pub fn step(&mut self, table: &mut Resources) -> Result<(Command, Vec<Name>), ZoneError> {
+    /// What the arm must do next, with `zones_at` saying which zones a point lies in:
+    /// compute and check points until the queue is full, then act on its oldest.
+    ///
+    /// - [`Next::Request`]: a checked point enters a zone not yet granted. Ask the
+    ///   coordinator; on a grant tell [`Pipeline::granted`] and call again; on *sleep*
+    ///   the arm stops where it is (STOP_C) — the queue holds the points between — until
+    ///   woken, then asks again.
+    /// - [`Next::Move`]: move to the point, then release the zones it names: the arm has
+    ///   left them once there, and no point ahead needs them. (Not before: on its way to
+    ///   the point the gripper is still in them.)
+    /// - [`Next::End`]: the trajectory's end (TRAJECTORY_END).
+    ///
+    /// Free of any transport, so an arm module drives it over ports and [`Pipeline::step`]
+    /// against a [`Resources`] table directly.
+    pub fn next<Z>(&mut self, zones_at: Z) -> Next
+    where
+        Z: Fn([f32; 3]) -> Vec<Name>,
+    {
         while self.ahead.len() < self.capacity() {
             let Some(&point) = self.rest.front() else {
                 break;
             };
-            for zone in table.zones_at(point) {
-                if self.granted.contains(&zone) {
-                    continue;
-                }
-                match table.request_move(self.robot.as_str(), zone.as_str())? {
-                    Answer::Grant => {
-                        self.granted.insert(zone);
-                    }
-                    Answer::Sleep => return Ok((Command::StopC(zone), Vec::new())),
-                }
+            if let Some(zone) = zones_at(point)
+                .into_iter()
+                .find(|zone| !self.granted.contains(zone))
+            {
+                return Next::Request(zone);
             }
             self.ahead.push_back(point);
             self.rest.pop_front();
         }
         let Some(point) = self.ahead.pop_front() else {
-            table.trajectory_end(self.robot.as_str())?;
-            return Ok((Command::TrajectoryEnd, Vec::new()));
+            return Next::End;
         };
-        let now_in: BTreeSet<Name> = table.zones_at(point).into_iter().collect();
-        let mut woken = Vec::new();
-        for left in self.inside.difference(&now_in).cloned().collect::<Vec<_>>() {
+        let now_in: BTreeSet<Name> = zones_at(point).into_iter().collect();
+        let mut release = Vec::new();
+        for left in self.inside.difference(&now_in) {
             // Still needed by a point queued ahead: keep it.
-            if self
-                .ahead
-                .iter()
-                .any(|p| table.zones_at(*p).contains(&left))
-            {
+            if self.ahead.iter().any(|p| zones_at(*p).contains(left)) {
                 continue;
             }
-            self.granted.remove(&left);
-            woken.extend(table.release(self.robot.as_str(), left.as_str())?);
+            release.push(left.clone());
+        }
+        for left in &release {
+            self.granted.remove(left);
         }
         self.inside = now_in;
-        Ok((Command::Continue(point), woken))
+        Next::Move { point, release }
     }
+
+    /// The coordinator granted `zone`.
+    pub fn granted(&mut self, zone: Name) {
+        self.granted.insert(zone);
+    }
+
+    /// The zones the arm holds now: granted, for the points it is at or has queued.
+    pub fn holding(&self) -> impl Iterator<Item = &Name> {
+        self.granted.iter()
+    }
+
+    /// One step against `table` itself: [`Pipeline::next`], with every request asked of
+    /// the table and every release told to it. Returns the command for the arm's
+    /// dynamic controller, and who the releases woke.
+    pub fn step(&mut self, table: &mut Resources) -> Result<(Command, Vec<Name>), ZoneError> {
+        loop {
+            match self.next(|point| table.zones_at(point)) {
+                Next::Request(zone) => {
+                    match table.request_move(self.robot.as_str(), zone.as_str())? {
+                        Answer::Grant => self.granted(zone),
+                        Answer::Sleep => return Ok((Command::StopC(zone), Vec::new())),
+                    }
+                }
+                Next::Move { point, release } => {
+                    let mut woken = Vec::new();
+                    for zone in release {
+                        woken.extend(table.release(self.robot.as_str(), zone.as_str())?);
+                    }
+                    return Ok((Command::Continue(point), woken));
+                }
+                Next::End => {
+                    table.trajectory_end(self.robot.as_str())?;
+                    return Ok((Command::TrajectoryEnd, Vec::new()));
+                }
+            }
+        }
+    }
+}
+
+/// What [`Pipeline::next`] asks of the arm.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Next {
+    /// Ask the coordinator for this zone before going on.
+    Request(Name),
+    /// Move to the point, then release these zones.
+    Move {
+        /// The point.
+        point: [f32; 3],
+        /// The zones left behind.
+        release: Vec<Name>,
+    },
+    /// The last point is reached.
+    End,
 }

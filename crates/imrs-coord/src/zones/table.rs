@@ -40,6 +40,24 @@ impl ZoneDef {
         }
     }
 
+    /// The zone the simulation has: its box, as the simulated table's sensor is built.
+    pub fn from_sim(zone: &imrs_sim::table::ZoneSpec) -> Self {
+        let kind = match zone.usage {
+            imrs_sim::table::ZoneUse::Exclusive => ZoneKind::Exclusive,
+            imrs_sim::table::ZoneUse::Shared => ZoneKind::Shared,
+        };
+        let c = zone.centre;
+        Self::boxed(zone.name.clone(), kind, [c.x, c.y, c.z], zone.half)
+    }
+
+    /// Whether a ball of `radius` at `point` (a gripper) reaches into the zone: its
+    /// distance to the zone's box, by parry3d, is at most `radius`.
+    pub fn touches(&self, point: [f32; 3], radius: f32) -> bool {
+        self.shape
+            .distance_to_point(&self.pose, Vector::new(point[0], point[1], point[2]), true)
+            <= radius
+    }
+
     /// Whether `point` lies in the zone (a parry3d point query).
     pub fn contains(&self, point: [f32; 3]) -> bool {
         self.shape
@@ -180,7 +198,12 @@ impl Resources {
             ZoneKind::Exclusive => held.inside.iter().all(|r| *r == robot),
             ZoneKind::Shared => held.moving.as_ref().is_none_or(|r| *r == robot),
         };
-        if free && (held.sleeping.is_empty() || held.sleeping.front() == Some(&robot)) {
+        // A robot already inside goes before those queued at the border: it is on its
+        // way out, and making it wait for them would have each wait for the other.
+        let its_turn = held.inside.contains(&robot)
+            || held.sleeping.is_empty()
+            || held.sleeping.front() == Some(&robot);
+        if free && its_turn {
             held.sleeping.retain(|r| *r != robot);
             held.inside.insert(robot.clone());
             if kind == ZoneKind::Shared {
@@ -234,9 +257,10 @@ impl Resources {
             return Err(ZoneError::Unknown(tool.into()));
         }
         let held = self.held(tool)?;
-        if held.inside.iter().all(|r| *r == robot)
-            && (held.sleeping.is_empty() || held.sleeping.front() == Some(&robot))
-        {
+        let its_turn = held.inside.contains(&robot)
+            || held.sleeping.is_empty()
+            || held.sleeping.front() == Some(&robot);
+        if held.inside.iter().all(|r| *r == robot) && its_turn {
             held.sleeping.retain(|r| *r != robot);
             held.inside.insert(robot);
             Ok(Answer::Grant)
