@@ -22,4 +22,5 @@
 pub mod coordinator;
 pub mod network;
 pub mod scheduler;
+pub mod table_cell;
 pub mod zones;

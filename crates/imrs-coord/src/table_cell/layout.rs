@@ -1,0 +1,148 @@
+//! The table cell's layout: four arms at the four sides of a 1.2 m table, their elbows all
+//! bent the same way (a pinwheel, so that no two folded arms meet), an exclusive fixture in
+//! the middle, a shared parts tray in one corner, and the screwdriver's rack in another;
+//! and the unit the scheduler plans: robot-independent tasks over three kinds of part.
+
+use imrs_sim::scara::{Elbow, Scara};
+use imrs_sim::table::{ArmSpec, TableLayout, ZoneSpec, ZoneUse};
+use nalgebra::{Point2, Point3};
+
+use crate::scheduler::{Robot, Skill, TaskSpec, Workcell, Zone};
+
+/// The exclusive zone: the fixture the unit is assembled on.
+pub const FIXTURE: &str = "FIXTURE";
+/// The zone shared with restrictions: the parts tray (several arms inside, one moving).
+pub const TRAY: &str = "TRAY";
+/// The tool: always exclusive.
+pub const SCREWDRIVER: &str = "SCREWDRIVER";
+/// Where the screwdriver lies when nobody holds it.
+pub const RACK: [f32; 2] = [0.26, 0.26];
+
+/// The arms' upper arm and forearm, as in the chip cell.
+const UPPER: f32 = 0.4;
+const FORE: f32 = 0.35;
+/// How far from its base an arm takes work: within its 0.75 m reach, clear of full
+/// stretch.
+const WORK_REACH: f64 = 0.7;
+/// The nominal tool speed (a robot of speed 1), in m/s.
+const NOMINAL_SPEED: f64 = 0.5;
+
+struct Side {
+    name: &'static str,
+    base: [f32; 2],
+    skills: &'static [Skill],
+    speed: f64,
+}
+
+const SIDES: [Side; 4] = [
+    Side {
+        name: "ARM_1",
+        base: [-0.6, 0.0],
+        skills: &[Skill::Place, Skill::Insert],
+        speed: 1.0,
+    },
+    Side {
+        name: "ARM_2",
+        base: [0.6, 0.0],
+        skills: &[Skill::Place, Skill::Screw],
+        speed: 1.3,
+    },
+    Side {
+        name: "ARM_3",
+        base: [0.0, -0.6],
+        skills: &[Skill::Place, Skill::Insert],
+        speed: 0.8,
+    },
+    Side {
+        name: "ARM_4",
+        base: [0.0, 0.6],
+        skills: &[Skill::Place, Skill::Insert, Skill::Screw],
+        speed: 1.0,
+    },
+];
+
+/// Where an arm rests: 0.28 m from its base towards the middle, folded.
+fn home(base: [f32; 2]) -> Point2<f32> {
+    let base = Point2::from(base);
+    base + (Point2::origin() - base).normalize() * 0.28
+}
+
+/// The simulated table.
+pub fn layout() -> TableLayout {
+    let zone = |name: &str, usage, centre: [f32; 2], half: f32| ZoneSpec {
+        name: name.into(),
+        usage,
+        centre: Point3::new(centre[0], centre[1], 0.3),
+        half: [half, half, 0.3],
+    };
+    TableLayout {
+        arms: SIDES
+            .iter()
+            .map(|side| ArmSpec {
+                name: side.name.into(),
+                arm: Scara {
+                    base: side.base.into(),
+                    upper: UPPER,
+                    fore: FORE,
+                    side: Elbow::Right,
+                },
+                home: home(side.base),
+                speed: (NOMINAL_SPEED * side.speed) as f32,
+            })
+            .collect(),
+        zones: vec![
+            zone(FIXTURE, ZoneUse::Exclusive, [0.0, 0.0], 0.08),
+            zone(TRAY, ZoneUse::Shared, [-0.25, -0.25], 0.15),
+        ],
+        tool: RACK.into(),
+    }
+}
+
+/// The unit's tasks, as the scheduler plans them: which need the screwdriver.
+pub fn needs_tool(task: &TaskSpec) -> bool {
+    task.skill == Skill::Screw
+}
+
+/// The cell as the run-time scheduler sees it: the four arms (skills, speeds, where they
+/// stand and how far they reach), the six tasks of a unit, and the fixture as its zone.
+pub fn workcell() -> Workcell {
+    let robots = SIDES
+        .iter()
+        .map(|side| {
+            let home = home(side.base);
+            Robot {
+                name: side.name.into(),
+                skills: side.skills.to_vec(),
+                speed: side.speed,
+                home: [f64::from(home.x), f64::from(home.y)],
+                reach: (side.base.map(f64::from), WORK_REACH),
+            }
+        })
+        .collect();
+    let task = |name, skill, work, at, after: &[usize], parts: &[usize]| TaskSpec {
+        name,
+        skill,
+        work,
+        at,
+        after: after.to_vec(),
+        parts: parts.to_vec(),
+    };
+    use Skill::{Insert, Place, Screw};
+    Workcell {
+        robots,
+        tasks: vec![
+            task("place base", Place, 2.0, [0.0, 0.0], &[], &[0]),
+            task("kit cover", Place, 3.0, [-0.38, -0.16], &[], &[1]),
+            task("kit shaft", Place, 3.0, [-0.16, -0.38], &[], &[2]),
+            task("insert shaft", Insert, 4.0, [0.03, -0.02], &[0, 2], &[]),
+            task("place cover", Place, 3.0, [-0.02, 0.03], &[1, 3], &[]),
+            task("screw cover", Screw, 5.0, [0.0, 0.0], &[4], &[]),
+        ],
+        parts: vec!["base", "cover", "shaft"],
+        zones: vec![Zone {
+            centre: [0.0, 0.0],
+            radius: 0.08 * std::f64::consts::SQRT_2,
+        }],
+        travel: NOMINAL_SPEED,
+    }
+}

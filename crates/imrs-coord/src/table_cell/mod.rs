@@ -1,0 +1,227 @@
+//! The coordinated table cell: four SCARA arms on the simulated table share an exclusive
+//! fixture, a parts tray shared with restrictions (several arms inside, one moving) and one
+//! screwdriver, under the zone coordinator, fed by the run-time task scheduler — `cargo run
+//! --release --example coord_cell`.
+//!
+//! Every module talks through ports: each arm ([`arm`](self) module `ARM_1` … `ARM_4`)
+//! asks the `SCHEDULER` for its next job on `NEXT_JOB`, and the `COORDINATOR` for zones and
+//! the tool on the seed's message set. An arm's trajectory runs through its pipeline: points
+//! computed ahead, a zone requested before the arm reaches it (a *sleep* stops the arm
+//! short of the border, STOP_C), released once the arm has left it. Before every step the
+//! arm also checks its links a few points ahead against where the other arms are: a stopped
+//! arm in the way is waited for, then gone round (the alternative trajectory), and two arms
+//! in each other's way are parted by the later-named one backing off.
+//!
+//! Rapier measures the outcome: collisions between arms, the closest they came, zone
+//! conflicts (two grippers in the fixture, two moving in the tray) and grasps of a tool that
+//! was not there. The [`Report`] sets them beside the units made and what the coordinator
+//! did, deadlocks included.
+//!
+//! ```no_run
+//! use imrs_coord::table_cell::{Assignment, CellConfig, run};
+//!
+//! let report = run(&CellConfig { seed: 1, hours: 1.0, assignment: Assignment::RunTime })?;
+//! assert!(report.measured.collisions.is_empty());
+//! println!("{report}");
+//! # Ok::<(), imrs_coord::table_cell::CellError>(())
+//! ```
+
+mod arm;
+mod clearance;
+mod layout;
+mod report;
+mod schedule;
+
+use std::fmt;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
+
+use imrs_core::imrs_ports::{Instant, SharedClock, VirtualClock};
+use imrs_core::prelude::*;
+use imrs_sim::table::{Table, TableError};
+
+pub use self::layout::{FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell};
+pub use self::report::Report;
+pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
+
+use self::arm::arm_module;
+use self::schedule::{job_port, scheduler};
+use crate::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
+use crate::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
+use crate::zones::{Resources, ZoneDef};
+
+/// The coordinator module's name.
+pub const COORDINATOR: &str = "COORDINATOR";
+/// The longest run, in simulated hours.
+pub const MAX_HOURS: f64 = 24.0;
+
+/// Who decides which arm does what.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Assignment {
+    /// The run-time scheduler.
+    RunTime,
+    /// A static assignment, each arm running its program in a fixed order.
+    Programs,
+    /// The same static assignment, each arm taking its oldest ready task.
+    Dispatching,
+}
+
+impl fmt::Display for Assignment {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::RunTime => "run-time scheduler",
+            Self::Programs => "static programs",
+            Self::Dispatching => "static, dispatched",
+        })
+    }
+}
+
+/// A run of the table cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellConfig {
+    /// Seeds the parts' arrivals.
+    pub seed: u64,
+    /// How long to run, in simulated hours.
+    pub hours: f64,
+    /// Who decides which arm does what.
+    pub assignment: Assignment,
+}
+
+/// Why a run could not be made.
+#[derive(Debug)]
+pub enum CellError {
+    /// The run's length is not a number of hours in (0, [`MAX_HOURS`]].
+    Hours(f64),
+    /// The simulated table refused its layout.
+    Table(TableError),
+    /// A module could not be started.
+    Start(String),
+}
+
+impl fmt::Display for CellError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Hours(hours) => write!(
+                f,
+                "a run lasts more than 0 and at most {MAX_HOURS} hours, not {hours}"
+            ),
+            Self::Table(error) => write!(f, "{error}"),
+            Self::Start(why) => write!(f, "the cell could not start: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for CellError {}
+
+/// What the arms did, beside what the coordinator and rapier saw.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CellStats {
+    /// Jobs each arm finished.
+    pub jobs: Vec<u32>,
+    /// How long each arm spent on its jobs, travel and waits included.
+    pub busy: Vec<Duration>,
+    /// Times an arm found another in its way and stopped.
+    pub geometric_blocks: u32,
+    /// Times it went round a stopped arm instead (the alternative trajectory).
+    pub detours: u32,
+    /// Times one of two arms in each other's way backed off.
+    pub back_offs: u32,
+    /// Arms that stopped working, and why.
+    pub failures: Vec<String>,
+}
+
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Each critical section is a few field updates: a panic cannot leave it half-changed.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Runs the cell for `config.hours` of simulated time on a virtual clock, as fast as it
+/// computes; the same config gives the same report.
+pub fn run(config: &CellConfig) -> Result<Report, CellError> {
+    if !(config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS) {
+        return Err(CellError::Hours(config.hours));
+    }
+    let wall = std::time::Instant::now();
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .start_paused(true)
+        .build()
+        .map_err(|error| CellError::Start(error.to_string()))?;
+    let mut report = runtime.block_on(simulate(config))?;
+    report.wall = wall.elapsed();
+    Ok(report)
+}
+
+async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
+    let clock = VirtualClock::new();
+    let shared: SharedClock = Arc::new(clock.clone());
+    let cell = Cell::new(Arc::clone(&shared));
+    let layout = layout();
+    let table = Table::new(layout.clone(), Arc::clone(&shared)).map_err(CellError::Table)?;
+    let names: Vec<&str> = layout.arms.iter().map(|arm| arm.name.as_str()).collect();
+    let zones: Arc<Vec<ZoneDef>> = Arc::new(layout.zones.iter().map(ZoneDef::from_sim).collect());
+
+    let plan = workcell();
+    // Enough units that parts keep coming for the whole run (a window opens every 12 s on
+    // average).
+    let units = (config.hours * 3600.0 / 12.0 * 1.5).ceil() as usize;
+    let arrivals = Arrivals::random(&plan, units, config.seed);
+    let policy: Box<dyn Policy + Send> = match config.assignment {
+        Assignment::RunTime => Box::new(RunTime::default()),
+        Assignment::Programs => Box::new(Static::programs(&plan)),
+        Assignment::Dispatching => Box::new(Static::dispatching(&plan)),
+    };
+    let completions: schedule::Completions = Arc::default();
+    let jobs = job_port(&shared);
+    let coordinator_ports = CoordinatorPorts::new(COORDINATOR, &names, &shared);
+    let coordinator_log = Arc::new(Mutex::new(CoordinatorLog::default()));
+    let stats = Arc::new(Mutex::new(CellStats {
+        jobs: vec![0; names.len()],
+        busy: vec![Duration::ZERO; names.len()],
+        ..CellStats::default()
+    }));
+
+    table.spawn();
+    let start = |spec: ModuleSpec<()>| {
+        cell.start(spec)
+            .map(drop)
+            .map_err(|error| CellError::Start(error.to_string()))
+    };
+    start(coordinator(
+        COORDINATOR,
+        Resources::new(zones.iter().cloned(), [SCREWDRIVER], names.iter().copied()),
+        &coordinator_ports,
+        Arc::clone(&coordinator_log),
+    ))?;
+    start(scheduler(
+        &jobs,
+        Dispatch::new(plan.clone(), arrivals),
+        policy,
+        Arc::clone(&completions),
+    ))?;
+    for (index, name) in names.iter().enumerate() {
+        start(arm_module(
+            name,
+            index,
+            &table,
+            &coordinator_ports,
+            &jobs,
+            Arc::clone(&zones),
+            Arc::clone(&stats),
+        ))?;
+    }
+
+    let end = Instant::from_start(Duration::from_secs_f64(config.hours * 3600.0));
+    imrs_core::time::drive(&clock, end).await;
+
+    let completed = lock(&completions).iter().filter(|at| **at <= end).count();
+    Ok(Report {
+        config: config.clone(),
+        arms: names.iter().map(|name| (*name).into()).collect(),
+        units: completed,
+        measured: table.measured(),
+        coordinator: lock(&coordinator_log).clone(),
+        stats: lock(&stats).clone(),
+        wall: Duration::ZERO,
+    })
+}

@@ -1,0 +1,122 @@
+//! What a run of the table cell made, and what rapier and the coordinator saw.
+
+use std::fmt;
+use std::time::Duration;
+
+use imrs_core::imrs_ports::Name;
+use imrs_sim::table::Measured;
+
+use super::{CellConfig, CellStats};
+use crate::coordinator::CoordinatorLog;
+
+/// A run's report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Report {
+    /// The run.
+    pub config: CellConfig,
+    /// The arms, in the scheduler's order.
+    pub arms: Vec<Name>,
+    /// Units completed.
+    pub units: usize,
+    /// What rapier measured.
+    pub measured: Measured,
+    /// What the coordinator did.
+    pub coordinator: CoordinatorLog,
+    /// What the arms did.
+    pub stats: CellStats,
+    /// How long the run took on the wall clock.
+    pub wall: Duration,
+}
+
+impl Report {
+    /// Units per simulated hour.
+    pub fn per_hour(&self) -> f64 {
+        self.units as f64 / self.config.hours
+    }
+
+    /// Whether rapier saw neither a collision nor a zone or tool conflict, and every arm
+    /// kept working.
+    pub fn is_clean(&self) -> bool {
+        self.measured.collisions.is_empty()
+            && self.measured.zone_conflicts.is_empty()
+            && self.measured.tool_conflicts.is_empty()
+            && self.stats.failures.is_empty()
+    }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (config, measured, log, stats) =
+            (&self.config, &self.measured, &self.coordinator, &self.stats);
+        writeln!(
+            f,
+            "coord_cell: seed {}, {} h simulated, {}",
+            config.seed, config.hours, config.assignment
+        )?;
+        writeln!(
+            f,
+            "  units made              {} ({:.1} per hour)",
+            self.units,
+            self.per_hour()
+        )?;
+        for (index, arm) in self.arms.iter().enumerate() {
+            let busy = stats.busy.get(index).copied().unwrap_or_default();
+            writeln!(
+                f,
+                "  {arm:<6} jobs {:>5}, busy {:>5.1} %",
+                stats.jobs.get(index).copied().unwrap_or_default(),
+                100.0 * busy.as_secs_f64() / (config.hours * 3600.0)
+            )?;
+        }
+        writeln!(f, "measured by rapier")?;
+        writeln!(f, "  collisions between arms {}", measured.collisions.len())?;
+        if let Some(closest) = measured.closest {
+            writeln!(f, "  closest two arms came   {:.0} mm", closest * 1000.0)?;
+        }
+        writeln!(
+            f,
+            "  zone conflicts          {}",
+            measured.zone_conflicts.len()
+        )?;
+        writeln!(
+            f,
+            "  tool conflicts          {}",
+            measured.tool_conflicts.len()
+        )?;
+        for (zone, time) in &measured.zone_time {
+            writeln!(
+                f,
+                "  {zone:<8} occupied        {:>5.1} %",
+                100.0 * time.as_secs_f64() / (config.hours * 3600.0)
+            )?;
+        }
+        writeln!(f, "coordination")?;
+        writeln!(
+            f,
+            "  requests granted / slept {} / {}",
+            log.granted, log.slept
+        )?;
+        writeln!(
+            f,
+            "  deadlocks (zones, tool)  {} found, {} resolved",
+            log.deadlocks.len(),
+            log.deadlocks.len()
+        )?;
+        writeln!(
+            f,
+            "  geometric: blocked {}, went round {}, backed off {}",
+            stats.geometric_blocks, stats.detours, stats.back_offs
+        )?;
+        for (a, b, at) in measured.collisions.iter().take(5) {
+            writeln!(f, "  COLLISION {a} and {b} at {at}")?;
+        }
+        for (zone, at, arms) in measured.zone_conflicts.iter().take(5) {
+            let arms: Vec<&str> = arms.iter().map(Name::as_str).collect();
+            writeln!(f, "  ZONE CONFLICT in {zone} at {at}: {}", arms.join(", "))?;
+        }
+        for failure in &stats.failures {
+            writeln!(f, "  FAILED {failure}")?;
+        }
+        Ok(())
+    }
+}

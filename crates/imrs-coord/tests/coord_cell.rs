@@ -1,0 +1,143 @@
+//! The coordinated table cell, run as the example runs it: ten seeds of a simulated hour
+//! each with neither a collision nor a zone or tool conflict measured by rapier, while the
+//! zones, the tool and the arms' space are really contested; the same seed, the same run;
+//! the run-time scheduler against a static assignment on the same arrivals.
+
+use std::thread;
+
+use imrs_coord::table_cell::{Assignment, CellConfig, CellError, Report, run};
+
+fn config(seed: u64, hours: f64, assignment: Assignment) -> CellConfig {
+    CellConfig {
+        seed,
+        hours,
+        assignment,
+    }
+}
+
+/// Runs `configs` on two threads (the cell itself runs on one).
+fn run_all(configs: Vec<CellConfig>) -> Vec<Report> {
+    let (first, second): (Vec<_>, Vec<_>) = configs
+        .into_iter()
+        .enumerate()
+        .partition(|(index, _)| index % 2 == 0);
+    let spawn = |half: Vec<(usize, CellConfig)>| {
+        thread::spawn(move || {
+            half.into_iter()
+                .map(|(index, config)| (index, run(&config).expect("the cell runs")))
+                .collect::<Vec<_>>()
+        })
+    };
+    let (a, b) = (spawn(first), spawn(second));
+    let mut reports: Vec<(usize, Report)> = a.join().unwrap();
+    reports.extend(b.join().unwrap());
+    reports.sort_by_key(|(index, _)| *index);
+    reports.into_iter().map(|(_, report)| report).collect()
+}
+
+#[test]
+fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
+    let reports = run_all(
+        (1..=10)
+            .map(|seed| config(seed, 1.0, Assignment::RunTime))
+            .collect(),
+    );
+    for report in &reports {
+        let measured = &report.measured;
+        assert!(measured.collisions.is_empty(), "{report}");
+        assert!(measured.zone_conflicts.is_empty(), "{report}");
+        assert!(measured.tool_conflicts.is_empty(), "{report}");
+        assert!(report.stats.failures.is_empty(), "{report}");
+        // The links of two arms never touched: rapier's closest approach is positive.
+        assert!(measured.closest.is_some_and(|c| c > 0.0), "{report}");
+        // Not a cell that is clean because nothing happened: units were made by every arm,
+        // both zones were used, and the arms met at their borders and in each other's way.
+        assert!(report.units >= 150, "{report}");
+        assert!(report.stats.jobs.iter().all(|&jobs| jobs > 50), "{report}");
+        assert!(
+            measured
+                .zone_time
+                .iter()
+                .all(|(_, time)| time.as_secs() > 600),
+            "{report}"
+        );
+        assert!(report.coordinator.slept > 100, "{report}");
+        assert!(report.stats.geometric_blocks > 100, "{report}");
+        // Two arms in each other's way: one backed off, and the work went on.
+        assert!(report.stats.back_offs > 0, "{report}");
+    }
+    let per_hour: Vec<f64> = reports.iter().map(Report::per_hour).collect();
+    println!("units per hour over ten seeds: {per_hour:?}");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_run() {
+    let reports = run_all(vec![
+        config(7, 0.1, Assignment::RunTime),
+        config(7, 0.1, Assignment::RunTime),
+    ]);
+    let strip = |report: &Report| Report {
+        wall: std::time::Duration::ZERO,
+        ..report.clone()
+    };
+    assert_eq!(strip(&reports[0]), strip(&reports[1]));
+    assert!(reports[0].units > 0);
+}
+
+/// The goal is 15 % more units per hour than a static assignment. Against each arm's fixed
+/// program it is met in the median over six seeds (not on every seed: on some arrivals the
+/// programs' fixed order happens to suit the fixture); against the same assignment
+/// dispatched it is not, and the test asserts only that the run-time scheduler is never
+/// behind either. The figures are printed.
+#[test]
+fn the_run_time_scheduler_makes_more_than_a_static_assignment_on_the_same_arrivals() {
+    let configs = (1..=6)
+        .flat_map(|seed| {
+            [
+                Assignment::RunTime,
+                Assignment::Programs,
+                Assignment::Dispatching,
+            ]
+            .map(|assignment| config(seed, 0.5, assignment))
+        })
+        .collect();
+    let reports = run_all(configs);
+    let mut over_programs = Vec::new();
+    for runs in reports.chunks(3) {
+        let [run_time, programs, dispatching] = [&runs[0], &runs[1], &runs[2]];
+        for report in runs {
+            assert!(report.is_clean(), "{report}");
+        }
+        assert!(
+            run_time.per_hour() >= programs.per_hour(),
+            "{run_time}\n{programs}"
+        );
+        assert!(
+            run_time.per_hour() >= dispatching.per_hour(),
+            "{run_time}\n{dispatching}"
+        );
+        let gain = |other: &Report| 100.0 * (run_time.per_hour() / other.per_hour() - 1.0);
+        println!(
+            "seed {}: run-time {:.0}/h, static programs {:.0}/h ({:+.1} %), dispatched {:.0}/h ({:+.1} %)",
+            run_time.config.seed,
+            run_time.per_hour(),
+            programs.per_hour(),
+            gain(programs),
+            dispatching.per_hour(),
+            gain(dispatching),
+        );
+        over_programs.push(gain(programs));
+    }
+    over_programs.sort_by(f64::total_cmp);
+    let median = (over_programs[2] + over_programs[3]) / 2.0;
+    assert!(median >= 15.0, "{over_programs:?}");
+}
+
+#[test]
+fn a_run_of_no_length_is_refused_by_its_value() {
+    for hours in [0.0, -1.0, f64::NAN, 100.0] {
+        let error = run(&config(1, hours, Assignment::RunTime)).unwrap_err();
+        assert!(matches!(error, CellError::Hours(h) if h.to_bits() == hours.to_bits()));
+        assert!(error.to_string().contains("hours"), "{error}");
+    }
+}
