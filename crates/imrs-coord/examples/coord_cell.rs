@@ -7,9 +7,21 @@
 //! fixed program, and the same assignment dispatched), and the units made are set side by
 //! side.
 
+use std::process::ExitCode;
+
 use imrs_coord::table_cell::{Assignment, CellConfig, run};
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> ExitCode {
+    match cell() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("coord_cell: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn cell() -> Result<(), Box<dyn std::error::Error>> {
     let mut config = CellConfig {
         seed: 1,
         hours: 1.0,

@@ -12,9 +12,9 @@
 //!   detection among exclusive resources and its resolution, the alternative trajectory
 //!   round a stopped robot, and the arm's pipeline of points checked ahead;
 //! - [`coordinator`]: the zone coordinator as a module, speaking the seed's message set over
-//!   typed ports.
-//!
-//! Not yet: the coordinator driving the simulated arms, and the cells that use it.
+//!   typed ports;
+//! - [`table_cell`]: a cell of four arms on the simulated table under the coordinator, fed
+//!   by the run-time scheduler (`cargo run --release --example coord_cell`).
 //!
 //! Why a crate of its own: the layer uses the core and the simulation but the core must not
 //! depend on it; a robot crate embedding `imrs-core` does not compile it.

@@ -50,6 +50,24 @@ fn an_exclusive_zone_takes_one_robot_and_wakes_the_next_when_it_leaves() -> Resu
 }
 
 #[test]
+fn a_robot_inside_asking_again_is_not_queued_behind_those_at_the_border() -> Result<(), ZoneError> {
+    // A robot that stopped inside and sets off again asks for the zone again. Queued behind
+    // the sleepers at the border, it would wait for them while they wait for it to leave.
+    let mut t = table();
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Grant);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Sleep);
+    t.trajectory_end("ARM_A")?;
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Grant);
+    assert_eq!(t.release("ARM_A", "FIXTURE")?, ["ARM_B"]);
+    // So with a tool: its holder asking again keeps it.
+    assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Grant);
+    assert_eq!(t.request_tool("ARM_C", "GRIPPER")?, Answer::Sleep);
+    assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Grant);
+    assert_eq!(t.deadlock(), None);
+    Ok(())
+}
+
+#[test]
 fn a_shared_zone_holds_several_robots_but_lets_one_move() -> Result<(), ZoneError> {
     let mut t = table();
     assert_eq!(t.request_move("ARM_A", "FEEDERS")?, Answer::Grant);

@@ -63,7 +63,7 @@ impl fmt::Display for Report {
             let busy = stats.busy.get(index).copied().unwrap_or_default();
             writeln!(
                 f,
-                "  {arm:<6} jobs {:>5}, busy {:>5.1} %",
+                "  {arm:<6} jobs {:>5}, on jobs {:>5.1} % of the time (travel and waits included)",
                 stats.jobs.get(index).copied().unwrap_or_default(),
                 100.0 * busy.as_secs_f64() / (config.hours * 3600.0)
             )?;
@@ -98,13 +98,13 @@ impl fmt::Display for Report {
         )?;
         writeln!(
             f,
-            "  deadlocks (zones, tool)  {} found, {} resolved",
-            log.deadlocks.len(),
+            "  deadlocks over zones and the tool, found and resolved  {}",
             log.deadlocks.len()
         )?;
         writeln!(
             f,
-            "  geometric: blocked {}, went round {}, backed off {}",
+            "  an arm in another's way: stopped {}, went round {}, \
+             two in each other's way parted by a back-off {}",
             stats.geometric_blocks, stats.detours, stats.back_offs
         )?;
         for (a, b, at) in measured.collisions.iter().take(5) {
