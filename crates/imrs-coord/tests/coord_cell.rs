@@ -65,6 +65,8 @@ fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
         assert!(report.stats.geometric_blocks > 100, "{report}");
         // Two arms in each other's way: one backed off, and the work went on.
         assert!(report.stats.back_offs > 0, "{report}");
+        // A stopped arm in the way: gone round on the alternative trajectory.
+        assert!(report.stats.detours > 0, "{report}");
     }
     let per_hour: Vec<f64> = reports.iter().map(Report::per_hour).collect();
     println!("units per hour over ten seeds: {per_hour:?}");

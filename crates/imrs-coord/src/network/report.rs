@@ -114,7 +114,7 @@ impl fmt::Display for PortBound {
 ///
 /// A port's users are those on its user list; a port with none may be used by any placed
 /// module, and is judged as if it were. Each station's longest packet is the longest
-/// message (request or reply, plus [`PACKET_OVERHEAD`]) of the ports that leave it; a
+/// message (request or reply, plus `PACKET_OVERHEAD`) of the ports that leave it; a
 /// station with none still takes its turn in a resolution period, with an empty packet.
 pub fn report(
     ports: &[PortInfo],

@@ -2,6 +2,17 @@
 //! job out through the coordinator — its trajectory's points checked ahead in the
 //! pipeline (zones requested before the arm reaches them, released once it has left them),
 //! and its links checked against the other arms' before every step.
+//!
+//! The seed's messages between an arm's two controllers, here:
+//!
+//! | seed | here |
+//! |---|---|
+//! | TRAJECTORY | a straight leg, its points spaced 2 cm |
+//! | TRAJECTORY_POINT (check a point) | [`Pipeline::next`] checking the point `offset` ahead |
+//! | STOP_C (an unavailable zone ahead) | the coordinator's *sleep*: the arm waits, short of the border |
+//! | CONTINUE | the grant that follows the wake-up |
+//! | STOP_D (the trajectory cannot be completed) | a leg given up for another arm in the way: round it, or back |
+//! | TRAJECTORY_END | [`Next::End`], told to the coordinator |
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -228,7 +239,7 @@ impl Driver {
                 }
                 Next::Move { point, release } => {
                     let ahead = &points[at..(at + LOOKAHEAD).min(points.len())];
-                    if let Some(leg) = self.clear(ahead, &pipeline, may_back_off).await? {
+                    if let Some(leg) = self.clear(ahead, &to, &pipeline, may_back_off).await? {
                         self.abandon(&pipeline).await?;
                         return Ok(leg);
                     }
@@ -263,6 +274,7 @@ impl Driver {
     async fn clear(
         &mut self,
         ahead: &[Point2<f32>],
+        leg_end: &Point2<f32>,
         pipeline: &Pipeline,
         may_back_off: bool,
     ) -> Result<Option<Leg>, String> {
@@ -302,7 +314,7 @@ impl Driver {
                 }
             }
             if waited >= DETOUR_AFTER
-                && let Some(points) = self.round(&blocking, &others, ahead)
+                && let Some(points) = self.round(&blocking, &others, leg_end)
             {
                 lock(&self.stats).detours += 1;
                 return Ok(Some(Leg::Via(points)));
@@ -324,16 +336,16 @@ impl Driver {
         }
     }
 
-    /// An alternative trajectory round the arms in the way, from here to the end of what
-    /// was ahead, whose every point keeps this arm's links clear of every other arm.
+    /// An alternative trajectory round the arms in the way, from here to the leg's end,
+    /// whose every point keeps this arm's links clear of every other arm.
     fn round(
         &self,
         blocking: &[Name],
         others: &[(Name, [Point2<f32>; 3])],
-        ahead: &[Point2<f32>],
+        leg_end: &Point2<f32>,
     ) -> Option<Vec<Point2<f32>>> {
         let here = self.arm.at();
-        let end = *ahead.last()?;
+        let end = *leg_end;
         let path = [[here.x, here.y, 0.0], [end.x, end.y, 0.0]];
         let radius = imrs_sim::table::LINK_RADIUS;
         let around = detour(&path, radius, &obstacles(blocking, others), MARGIN, 0.25)?;
