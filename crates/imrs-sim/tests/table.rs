@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use imrs_core::imrs_ports::{Instant, VirtualClock};
 use imrs_sim::scara::{Elbow, Scara};
-use imrs_sim::table::{ArmSpec, Table, TableError, TableLayout, ZoneSpec, ZoneUse};
+use imrs_sim::table::{ArmSpec, Table, TableArm, TableError, TableLayout, ZoneSpec, ZoneUse};
 use nalgebra::{Point2, Point3};
 
 fn arm(name: &str, base: [f32; 2], home: [f32; 2]) -> ArmSpec {
@@ -50,6 +50,15 @@ fn runtime() -> tokio::runtime::Runtime {
         .unwrap()
 }
 
+/// The table of `layout(usage)` on a new virtual clock, stepping; its two arms.
+fn start(usage: ZoneUse) -> (VirtualClock, Table, TableArm, TableArm) {
+    let clock = VirtualClock::new();
+    let table = Table::new(layout(usage), Arc::new(clock.clone())).unwrap();
+    table.spawn();
+    let (left, right) = (table.arm("LEFT").unwrap(), table.arm("RIGHT").unwrap());
+    (clock, table, left, right)
+}
+
 async fn until(clock: &VirtualClock, seconds: u64) {
     imrs_core::time::drive(clock, Instant::from_start(Duration::from_secs(seconds))).await;
 }
@@ -57,10 +66,7 @@ async fn until(clock: &VirtualClock, seconds: u64) {
 #[test]
 fn arms_driven_into_each_other_are_a_collision_rapier_sees() {
     runtime().block_on(async {
-        let clock = VirtualClock::new();
-        let table = Table::new(layout(ZoneUse::Shared), Arc::new(clock.clone())).unwrap();
-        table.spawn();
-        let (left, right) = (table.arm("LEFT").unwrap(), table.arm("RIGHT").unwrap());
+        let (clock, table, left, right) = start(ZoneUse::Shared);
         let a = tokio::spawn(async move { left.move_to(Point2::new(0.02, 0.0)).await });
         let b = tokio::spawn(async move { right.move_to(Point2::new(-0.02, 0.0)).await });
         until(&clock, 3).await;
@@ -79,10 +85,7 @@ fn arms_driven_into_each_other_are_a_collision_rapier_sees() {
 #[test]
 fn apart_arms_are_no_collision_and_the_closest_approach_is_measured() {
     runtime().block_on(async {
-        let clock = VirtualClock::new();
-        let table = Table::new(layout(ZoneUse::Shared), Arc::new(clock.clone())).unwrap();
-        table.spawn();
-        let left = table.arm("LEFT").unwrap();
+        let (clock, table, left, _) = start(ZoneUse::Shared);
         let moving = tokio::spawn(async move { left.move_to(Point2::new(-0.1, 0.0)).await });
         until(&clock, 3).await;
         moving.await.unwrap().unwrap();
@@ -98,10 +101,7 @@ fn apart_arms_are_no_collision_and_the_closest_approach_is_measured() {
 #[test]
 fn two_grippers_in_an_exclusive_zone_are_a_conflict_even_when_still() {
     runtime().block_on(async {
-        let clock = VirtualClock::new();
-        let table = Table::new(layout(ZoneUse::Exclusive), Arc::new(clock.clone())).unwrap();
-        table.spawn();
-        let (left, right) = (table.arm("LEFT").unwrap(), table.arm("RIGHT").unwrap());
+        let (clock, table, left, right) = start(ZoneUse::Exclusive);
         let driving = tokio::spawn(async move {
             left.move_to(Point2::new(-0.12, 0.0)).await?;
             right.move_to(Point2::new(0.12, 0.0)).await
@@ -120,10 +120,7 @@ fn two_grippers_in_an_exclusive_zone_are_a_conflict_even_when_still() {
 #[test]
 fn in_a_shared_zone_two_inside_one_moving_is_no_conflict() {
     runtime().block_on(async {
-        let clock = VirtualClock::new();
-        let table = Table::new(layout(ZoneUse::Shared), Arc::new(clock.clone())).unwrap();
-        table.spawn();
-        let (left, right) = (table.arm("LEFT").unwrap(), table.arm("RIGHT").unwrap());
+        let (clock, table, left, right) = start(ZoneUse::Shared);
         let driving = tokio::spawn(async move {
             left.move_to(Point2::new(-0.12, 0.0)).await?;
             right.move_to(Point2::new(0.12, 0.0)).await?;
@@ -140,10 +137,7 @@ fn in_a_shared_zone_two_inside_one_moving_is_no_conflict() {
 #[test]
 fn a_tool_another_arm_holds_cannot_be_grasped_and_the_attempt_is_counted() {
     runtime().block_on(async {
-        let clock = VirtualClock::new();
-        let table = Table::new(layout(ZoneUse::Shared), Arc::new(clock.clone())).unwrap();
-        table.spawn();
-        let (left, right) = (table.arm("LEFT").unwrap(), table.arm("RIGHT").unwrap());
+        let (clock, table, left, right) = start(ZoneUse::Shared);
         let driving = tokio::spawn(async move {
             // Too far from the tool: refused.
             let far = left.grasp_tool();

@@ -55,6 +55,27 @@ pub struct TaskSpec {
     pub parts: Vec<usize>,
 }
 
+impl TaskSpec {
+    /// A task: what it needs, how long, where, after which tasks and parts.
+    pub fn new(
+        name: &'static str,
+        skill: Skill,
+        work: f64,
+        at: [f64; 2],
+        after: &[usize],
+        parts: &[usize],
+    ) -> Self {
+        Self {
+            name,
+            skill,
+            work,
+            at,
+            after: after.to_vec(),
+            parts: parts.to_vec(),
+        }
+    }
+}
+
 /// A region only one robot may work in at a time, as the scheduler plans it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Zone {
@@ -102,14 +123,7 @@ impl Workcell {
             home,
             reach: (home, f64::INFINITY),
         };
-        let task = |name, skill, work, at, after: &[usize], parts: &[usize]| TaskSpec {
-            name,
-            skill,
-            work,
-            at,
-            after: after.to_vec(),
-            parts: parts.to_vec(),
-        };
+        let task = TaskSpec::new;
         use Skill::{Insert, Place, Screw};
         Self {
             robots: vec![

@@ -119,14 +119,7 @@ pub fn workcell() -> Workcell {
             }
         })
         .collect();
-    let task = |name, skill, work, at, after: &[usize], parts: &[usize]| TaskSpec {
-        name,
-        skill,
-        work,
-        at,
-        after: after.to_vec(),
-        parts: parts.to_vec(),
-    };
+    let task = TaskSpec::new;
     use Skill::{Insert, Place, Screw};
     Workcell {
         robots,
