@@ -1,0 +1,73 @@
+//! A peer process for the crate's tests: it owns or uses a port across processes.
+//!
+//! - `ipc_peer owner CELL PORT`: exports PORT (users ASKER and ASKER_2, two at most), and
+//!   answers each number with its double, after waiting the number's milliseconds if it is
+//!   over 1000 (so that a test can catch it mid-rendezvous). Prints `ready` once exported.
+//! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
+//!   1..=N, printing each; prints the error and exits with 2 if refused.
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_ipc::{Remote, ZeroCopySend, export, import};
+
+/// The tests' message: the same type, by name, size and alignment, as theirs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_ipc_tests::Number")]
+struct Number {
+    value: u64,
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .expect("a tokio runtime starts");
+    let result = runtime.block_on(async {
+        match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
+            ["owner", cell, port] => owner(cell, port).await,
+            ["user", cell, port, module, n] => user(cell, port, module, n).await,
+            _ => Err("usage: ipc_peer owner CELL PORT | user CELL PORT MODULE N".into()),
+        }
+    });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            println!("error: {error}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+type Error = Box<dyn std::error::Error>;
+
+async fn owner(cell: &str, port: &str) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::Receive, AnyUser, 2> =
+        Port::declare(PortSpec::new(port, "DOUBLER").user_list(["ASKER", "ASKER_2"]));
+    let _exported = export(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut owner = port.owner()?;
+    loop {
+        let (number, reply) = owner.receive().await?;
+        if number.value > 1000 {
+            tokio::time::sleep(Duration::from_millis(number.value)).await;
+        }
+        reply.reply(Number {
+            value: 2 * number.value,
+        });
+    }
+}
+
+async fn user(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
+    let imported = import::<Number, Number>(&Remote::new(cell)?, port, "DOUBLER", module)?;
+    let mut asker = imported.port().user_named(module)?;
+    for value in 1..=n.parse::<u64>()? {
+        let double = asker.send(Number { value }).await?;
+        println!("{}", double.value);
+    }
+    Ok(())
+}

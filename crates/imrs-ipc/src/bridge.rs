@@ -1,0 +1,131 @@
+//! What both sides of a crossing port share: the iceoryx2 node, the request-response
+//! service, and the two event services that wake whoever waits (requests for the owner,
+//! replies for the users) — so that nobody polls.
+
+use std::time::Duration;
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{event, request_response};
+use imrs_core::imrs_ports::Name;
+
+use crate::wire::{ReplyMeta, RequestMeta};
+use crate::{IpcError, Remote, Wire};
+
+/// Ports usable from any thread: the bridges hand requests to tokio tasks.
+pub(crate) type Svc = ipc_threadsafe::Service;
+
+/// How many user processes a port admits (iceoryx2's clients, beside the owner's server).
+pub(crate) const MAX_USERS: usize = 16;
+/// How many requests one user process may have pending at once.
+pub(crate) const MAX_PENDING: usize = 16;
+/// How often a waiting bridge thread looks up from its wait: to see whether it should stop
+/// and whether a peer died. A wake-up, not a poll of the data: data wakes it at once.
+pub(crate) const TICK: Duration = Duration::from_millis(50);
+
+pub(crate) type Service<Req, Rep> =
+    request_response::PortFactory<Svc, Req, RequestMeta, Rep, ReplyMeta>;
+
+/// The iceoryx2 side of one port, opened (or created) by either process.
+pub(crate) struct Channel<Req: Wire, Rep: Wire> {
+    pub(crate) port: Name,
+    /// Keeps the services open while the port crosses.
+    _node: Node<Svc>,
+    pub(crate) service: Service<Req, Rep>,
+    pub(crate) requested: event::PortFactory<Svc>,
+    pub(crate) replied: event::PortFactory<Svc>,
+}
+
+fn transport(port: &Name, what: &str, error: impl std::fmt::Debug) -> IpcError {
+    IpcError::Transport {
+        port: port.clone(),
+        detail: format!("{what}: {error:?}"),
+    }
+}
+
+impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
+    /// Opens port `port` of `remote`, creating its services if this process is first.
+    pub(crate) fn open(remote: &Remote, port: &Name) -> Result<Self, IpcError> {
+        // Defaults need no configuration file; iceoryx2 says so at every start unless told
+        // to keep its warnings for what matters (`IOX2_LOG_LEVEL` still overrides).
+        static QUIET: std::sync::Once = std::sync::Once::new();
+        QUIET.call_once(|| set_log_level_from_env_or(LogLevel::Error));
+        // The framework's own processes decide when to stop: no signal handlers.
+        let node = NodeBuilder::new()
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<Svc>()
+            .map_err(|error| transport(port, "creating the node", error))?;
+        let service = node
+            .service_builder(&remote.service(port.as_str(), "messages")?)
+            .request_response::<Req, Rep>()
+            .request_user_header::<RequestMeta>()
+            .response_user_header::<ReplyMeta>()
+            .max_servers(1)
+            .max_clients(MAX_USERS)
+            .max_nodes(MAX_USERS + 1)
+            .max_active_requests_per_client(MAX_PENDING)
+            .max_loaned_requests(MAX_PENDING)
+            .max_response_buffer_size(2)
+            .open_or_create()
+            .map_err(|error| {
+                let detail = format!("{error:?}");
+                if detail.contains("Incompatible") || detail.contains("TypeDefinition") {
+                    IpcError::TypeMismatch {
+                        port: port.clone(),
+                        detail,
+                    }
+                } else {
+                    transport(port, "opening its service", detail)
+                }
+            })?;
+        let event = |part: &str| {
+            node.service_builder(&remote.service(port.as_str(), part)?)
+                .event()
+                .max_notifiers(MAX_USERS + 2)
+                .max_listeners(MAX_USERS + 2)
+                .max_nodes(MAX_USERS + 1)
+                .open_or_create()
+                .map_err(|error| transport(port, "opening its events", error))
+        };
+        let (requested, replied) = (event("requested")?, event("replied")?);
+        Ok(Self {
+            port: port.clone(),
+            _node: node,
+            service,
+            requested,
+            replied,
+        })
+    }
+
+    pub(crate) fn listener(
+        &self,
+        events: &event::PortFactory<Svc>,
+    ) -> Result<Listener<Svc>, IpcError> {
+        events
+            .listener_builder()
+            .create()
+            .map_err(|error| transport(&self.port, "listening", error))
+    }
+
+    pub(crate) fn notifier(
+        &self,
+        events: &event::PortFactory<Svc>,
+    ) -> Result<Notifier<Svc>, IpcError> {
+        events
+            .notifier_builder()
+            .create()
+            .map_err(|error| transport(&self.port, "notifying", error))
+    }
+}
+
+/// Removes what dead processes left behind: their nodes, and their ports' places in the
+/// services, so that the living see them gone.
+pub(crate) fn sweep_dead() {
+    let _ = Node::<Svc>::list(Config::global_config(), |state| {
+        if let NodeState::Dead(view) = state {
+            let _ = view.try_remove_stale_resources();
+        }
+        CallbackProgression::Continue
+    });
+}

@@ -1,0 +1,229 @@
+//! A user's side: a port of another process, imported. Locally it is a port of the same
+//! name and types whose owner is a bridge: a tokio task takes each local send into shared
+//! memory, and a thread waiting on iceoryx2's reply events hands each reply back.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::client::Client;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use imrs_core::imrs_ports::{AnyUser, Name, Port, PortSpec, ReplyHandle, WireError, usage};
+
+use crate::bridge::{Channel, Svc, TICK, sweep_dead};
+use crate::wire::{
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TOO_MANY_USERS,
+};
+use crate::{IpcError, Remote, Wire};
+
+type Pending<Req, Rep> = PendingResponse<Svc, Req, RequestMeta, Rep, ReplyMeta>;
+type Asker<Req, Rep> = Client<Svc, Req, RequestMeta, Rep, ReplyMeta>;
+/// A request sent, and the local sender's right to its reply (taken when answered).
+type Waiting<Req, Rep> = (Pending<Req, Rep>, Option<ReplyHandle<Rep>>);
+
+/// How long the owner may take to accept the connection.
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// A port imported from another process, and its bridge: usable while this is held.
+pub struct Imported<Req: Wire, Rep: Wire> {
+    port: Port<Req, Rep, usage::Receive, AnyUser, 1>,
+    stop: Arc<AtomicBool>,
+    waiter: Option<JoinHandle<()>>,
+    forwarder: tokio::task::JoinHandle<()>,
+}
+
+impl<Req: Wire, Rep: Wire> Imported<Req, Rep> {
+    /// The local port: attach the importing module to it as to any port.
+    pub fn port(&self) -> &Port<Req, Rep, usage::Receive, AnyUser, 1> {
+        &self.port
+    }
+}
+
+impl<Req: Wire, Rep: Wire> Drop for Imported<Req, Rep> {
+    fn drop(&mut self) {
+        self.forwarder.abort();
+        self.stop.store(true, Ordering::Release);
+        if let Some(waiter) = self.waiter.take() {
+            let _ = waiter.join();
+        }
+    }
+}
+
+/// Imports port `port`, owned by module `owner` in another process of `remote`'s cell, for
+/// module `module` of this one. Connects at once: refused with the port's own
+/// [`WireError`] if `module` is not on its user list or the port has no room for it, and
+/// with [`IpcError::TypeMismatch`] if the processes disagree on its types. Call it within
+/// the tokio runtime the cell runs on.
+pub fn import<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep>, IpcError> {
+    let name = Name::from(port);
+    let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
+        port: name.clone(),
+        detail: "import it from within the tokio runtime its cell runs on".into(),
+    })?;
+    let channel = Channel::<Req, Rep>::open(remote, &name)?;
+    let client =
+        channel
+            .service
+            .client_builder()
+            .create()
+            .map_err(|error| IpcError::Transport {
+                port: name.clone(),
+                detail: format!("no room for another process ({error:?})"),
+            })?;
+    let listener = channel.listener(&channel.replied)?;
+    let wake_owner = channel.notifier(&channel.requested)?;
+    let wake_self = channel.notifier(&channel.replied)?;
+    connect(&client, &listener, &wake_owner, &name, module)?;
+
+    let local: Port<Req, Rep, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
+    let mut taken = local.owner().map_err(IpcError::Local)?;
+    let (pending_tx, pending_rx) = mpsc::channel::<(Pending<Req, Rep>, ReplyHandle<Rep>)>();
+    let stop = Arc::new(AtomicBool::new(false));
+
+    let halt = Arc::clone(&stop);
+    let waiter = std::thread::Builder::new()
+        .name(format!("imrs-ipc {name} replies"))
+        .spawn(move || {
+            // The channel lives as long as the waiter: its node keeps the services open.
+            let _channel = channel;
+            wait_for_replies(&listener, &pending_rx, &halt);
+        })
+        .map_err(|error| IpcError::Transport {
+            port: name.clone(),
+            detail: format!("starting its bridge thread: {error}"),
+        })?;
+
+    let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
+    let wake = Arc::new(Mutex::new((wake_owner, wake_self)));
+    let forwarder = runtime.spawn(async move {
+        while let Ok((request, reply)) = taken.receive().await {
+            let sent = {
+                let client = client.lock().unwrap_or_else(PoisonError::into_inner);
+                client.loan_uninit().ok().and_then(|mut loan| {
+                    *loan.user_header_mut() = RequestMeta::new(SEND, &module);
+                    loan.write_payload(request).send().ok()
+                })
+            };
+            // Not sent (no room, no owner): the reply handle is dropped, and the local
+            // sender gets `SendError::NoReply` at once.
+            let Some(pending) = sent else { continue };
+            if pending_tx.send((pending, reply)).is_err() {
+                break;
+            }
+            let wake = wake.lock().unwrap_or_else(PoisonError::into_inner);
+            let _ = wake.0.notify();
+            // The reply may have come before the waiter had the pending request: wake it
+            // to look.
+            let _ = wake.1.notify();
+        }
+    });
+    Ok(Imported {
+        port: local,
+        stop,
+        waiter: Some(waiter),
+        forwarder,
+    })
+}
+
+/// The handshake: the owner attaches `module` to its port, or refuses it by name.
+fn connect<Req: Wire, Rep: Wire>(
+    client: &Asker<Req, Rep>,
+    listener: &Listener<Svc>,
+    wake_owner: &Notifier<Svc>,
+    port: &Name,
+    module: &str,
+) -> Result<(), IpcError> {
+    let transport = |detail: String| IpcError::Transport {
+        port: port.clone(),
+        detail,
+    };
+    let mut loan = client
+        .loan_uninit()
+        .map_err(|error| transport(format!("connecting: {error:?}")))?;
+    *loan.user_header_mut() = RequestMeta::new(CONNECT, module);
+    let pending = loan
+        .write_payload(Req::default())
+        .send()
+        .map_err(|error| transport(format!("connecting: {error:?}")))?;
+    let _ = wake_owner.notify();
+    let deadline = Instant::now() + CONNECT_TIMEOUT;
+    while Instant::now() < deadline {
+        if let Ok(Some(response)) = pending.receive() {
+            let meta = *response.user_header();
+            let (port, module) = (port.clone(), Name::from(module));
+            return match meta.status {
+                OK => Ok(()),
+                NOT_ON_USER_LIST => {
+                    Err(IpcError::Refused(WireError::NotOnUserList { port, module }))
+                }
+                TOO_MANY_USERS => Err(IpcError::Refused(WireError::TooManyUsers {
+                    port,
+                    module,
+                    capacity: meta.detail as usize,
+                })),
+                REFUSED => Err(transport(format!("the owner refused {module}"))),
+                status => Err(transport(format!("the owner answered status {status}"))),
+            };
+        }
+        let _ = listener.timed_wait(|_| {}, TICK);
+        let _ = wake_owner.notify();
+    }
+    Err(IpcError::NoOwner { port: port.clone() })
+}
+
+/// The waiter: hands each reply to its local sender; drops the handles of requests whose
+/// owner is gone, so that their senders fail at once.
+fn wait_for_replies<Req: Wire, Rep: Wire>(
+    listener: &Listener<Svc>,
+    incoming: &mpsc::Receiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
+    stop: &AtomicBool,
+) {
+    let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
+    let mut ticks = 0_u32;
+    while !stop.load(Ordering::Acquire) {
+        // Blocks until a reply event or the tick.
+        if listener.timed_wait(|_| {}, TICK).is_err() {
+            break;
+        }
+        waiting.extend(
+            incoming
+                .try_iter()
+                .map(|(pending, reply)| (pending, Some(reply))),
+        );
+        ticks += 1;
+        // Every half second while something waits: see whether a peer died.
+        if !waiting.is_empty() && ticks.is_multiple_of(10) {
+            sweep_dead();
+        }
+        waiting.retain_mut(|(pending, reply)| {
+            // Whether the owner still holds the request, read before looking for its
+            // reply: an owner replies, then lets the request go, so a reply sent before
+            // it let go is there to be received now.
+            let connected = pending.is_connected();
+            match pending.receive() {
+                Ok(Some(response)) => {
+                    if let Some(reply) = reply.take()
+                        && response.user_header().status == OK
+                    {
+                        reply.reply(*response.payload());
+                    }
+                    false
+                }
+                // The owner is gone (or let the request go unanswered): the reply handle
+                // drops, and the sender fails at once.
+                Ok(None) => connected,
+                Err(_) => false,
+            }
+        });
+    }
+}

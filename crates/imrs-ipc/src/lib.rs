@@ -1,0 +1,55 @@
+//! Ports across processes: a port's owner in one process, its users in others, the messages
+//! carried through shared memory by iceoryx2.
+//!
+//! Module code does not change. The owner's process *exports* its port; a user's process
+//! *imports* it, getting a port of the same name and types whose owner is a bridge to the
+//! other process. The user module sends on it exactly as it would in one process. Which
+//! ports cross is decided where the cell is wired, not in the modules.
+//!
+//! ```no_run
+//! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+//! use imrs_ipc::{Remote, export, import};
+//!
+//! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
+//! // The owner's process: the port, declared as ever, and exported.
+//! let port: Port<u64, u64, usage::Receive, AnyUser, 4> = Port::declare(PortSpec::new("DOUBLE", "DOUBLER"));
+//! let _bridge = export(&Remote::new("my_cell")?, &port)?;
+//! let mut owner = port.owner()?;
+//! let (n, reply) = owner.receive().await?;
+//! reply.reply(2 * n);
+//! # Ok(()) }
+//! # async fn user() -> Result<(), Box<dyn std::error::Error>> {
+//! // A user's process: the same port, imported for module "ASKER".
+//! let imported = import::<u64, u64>(&Remote::new("my_cell")?, "DOUBLE", "DOUBLER", "ASKER")?;
+//! let mut asker = imported.port().user_named("ASKER")?;
+//! assert_eq!(asker.send(21).await?, 42);
+//! # Ok(()) }
+//! ```
+//!
+//! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
+//! processes must agree on it — iceoryx2 compares its name, size and alignment when the
+//! port connects — and a mismatch is refused, naming the port.
+//!
+//! The restrictions hold across processes: an importing module not on the port's user
+//! list, or beyond its number of users, is refused when it connects, with the port's own
+//! [`WireError`](imrs_core::imrs_ports::WireError). A process that dies does not hang its
+//! peers: a user's pending sends to a dead owner fail with
+//! [`SendError::NoReply`](imrs_core::imrs_ports::SendError::NoReply), and a new copy of
+//! the owner that exports the port again is served.
+//!
+//! Service names are derived from the cell's name and the port's, so two cells on one
+//! host never meet; no iceoryx2 configuration file is needed. Across processes the ports
+//! run on real time: each process has its own clock.
+
+mod bridge;
+mod error;
+mod export;
+mod import;
+mod wire;
+
+pub use error::IpcError;
+pub use export::{Exported, export};
+pub use import::{Imported, import};
+pub use wire::{Remote, Wire};
+
+pub use iceoryx2::prelude::ZeroCopySend;

@@ -1,0 +1,306 @@
+//! Ports across processes, wired as a user wires them: the owner in a child process (the
+//! crate's `ipc_peer`), users here or in more children. Every test has its own cell name,
+//! so the tests run in parallel without meeting; across processes the ports run on real
+//! time, and the timeouts here only keep a failing test from hanging.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use imrs_core::imrs_ports::{SendError, WireError};
+use imrs_ipc::{IpcError, Remote, ZeroCopySend, import};
+
+/// The peer's message: the same by name, size and alignment.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_ipc_tests::Number")]
+struct Number {
+    value: u64,
+}
+
+/// A message the peer does not know.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_ipc_tests::Wide")]
+struct Wide {
+    value: u64,
+    more: u64,
+}
+
+fn cell(test: &str) -> String {
+    let nanos = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    format!("t{}-{test}-{nanos}", std::process::id())
+}
+
+/// A child process, killed when the test ends however it ends.
+struct Peer(Child);
+
+impl Drop for Peer {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn peer(args: &[&str]) -> Peer {
+    Peer(
+        Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("the peer starts"),
+    )
+}
+
+/// Starts an owner of `port` in `cell` and waits until it has exported it.
+fn owner(cell: &str, port: &str) -> Peer {
+    let mut owner = peer(&["owner", cell, port]);
+    let stdout = owner.0.stdout.take().expect("piped");
+    let mut line = String::new();
+    BufReader::new(stdout)
+        .read_line(&mut line)
+        .expect("the owner speaks");
+    assert_eq!(line.trim(), "ready", "the owner failed: {line}");
+    owner
+}
+
+async fn within<T>(seconds: u64, future: impl Future<Output = T>) -> T {
+    tokio::time::timeout(Duration::from_secs(seconds), future)
+        .await
+        .expect("no hang")
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_send_crosses_to_the_owners_process_and_its_reply_comes_back() {
+    let cell = cell("send");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    // The module's code is what it would be in one process.
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    for value in 1..=200 {
+        let reply = within(5, asker.send(Number { value })).await.unwrap();
+        assert_eq!(reply.value, 2 * value);
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn two_user_processes_are_served_at_once() {
+    let cell = cell("users");
+    let _owner = owner(&cell, "DOUBLE");
+    let users: Vec<Child> = ["ASKER", "ASKER_2"]
+        .iter()
+        .map(|module| {
+            Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
+                .args(["user", &cell, "DOUBLE", module, "100"])
+                .stdout(Stdio::piped())
+                .spawn()
+                .expect("the user starts")
+        })
+        .collect();
+    for user in users {
+        let output = within(30, async {
+            tokio::task::spawn_blocking(move || user.wait_with_output()).await
+        })
+        .await
+        .unwrap()
+        .unwrap();
+        let text = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{text}");
+        let doubles: Vec<u64> = text.lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(doubles, (1..=100).map(|v| 2 * v).collect::<Vec<_>>());
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_module_not_on_the_user_list_is_refused_by_name() {
+    let cell = cell("unlisted");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let error = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "STRANGER")
+        .err()
+        .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::Refused(WireError::NotOnUserList {
+            port: "DOUBLE".into(),
+            module: "STRANGER".into(),
+        })
+    );
+    assert!(error.to_string().contains("STRANGER"), "{error}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_type_the_other_process_does_not_share_is_refused_naming_the_port() {
+    let cell = cell("types");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let error = import::<Wide, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER")
+        .err()
+        .expect("refused");
+    assert!(
+        matches!(&error, IpcError::TypeMismatch { port, .. } if port == "DOUBLE"),
+        "{error:?}"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_killed_mid_rendezvous_fails_the_sender_and_its_restart_is_served() {
+    let cell = cell("kill");
+    let mut first = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(
+        within(5, asker.send(Number { value: 1 }))
+            .await
+            .unwrap()
+            .value,
+        2
+    );
+    // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile.
+    let sending = tokio::spawn(async move {
+        let result = asker.send(Number { value: 4000 }).await;
+        (asker, result)
+    });
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    let (mut asker, result) = within(3, sending).await.unwrap();
+    assert!(
+        matches!(result, Err(SendError::NoReply { ref port }) if port == "DOUBLE"),
+        "{result:?}"
+    );
+    // A new copy of the owner exports the port again; the same importer is served.
+    let _second = owner(&cell, "DOUBLE");
+    let reply = within(10, async {
+        loop {
+            match asker.send(Number { value: 21 }).await {
+                Ok(reply) => break reply,
+                // Until the new owner's server is seen, a send finds nobody.
+                Err(SendError::NoReply { .. }) => {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+                Err(other) => panic!("{other:?}"),
+            }
+        }
+    })
+    .await;
+    assert_eq!(reply.value, 42);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn two_cells_with_the_same_port_names_never_meet() {
+    let (a, b) = (cell("cell-a"), cell("cell-b"));
+    // Were their services one, the second owner would be refused: one owner per port.
+    let _owner_a = owner(&a, "DOUBLE");
+    let _owner_b = owner(&b, "DOUBLE");
+    for cell in [&a, &b] {
+        let remote = Remote::new(cell).unwrap();
+        let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+        let mut asker = imported.port().user_named("ASKER").unwrap();
+        assert_eq!(
+            within(5, asker.send(Number { value: 8 }))
+                .await
+                .unwrap()
+                .value,
+            16
+        );
+    }
+}
+
+#[test]
+fn a_cell_name_that_cannot_name_a_service_is_refused_by_name() {
+    let error = Remote::new("my cell/../x").unwrap_err();
+    assert!(error.to_string().contains("my cell/../x"), "{error}");
+}
+
+/// The request header as the bridge lays it out, for a peer that writes garbage into it.
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_ipc::RequestMeta")]
+struct ForgedMeta {
+    kind: u32,
+    module_len: u32,
+    module: [u8; 64],
+}
+
+impl Default for ForgedMeta {
+    fn default() -> Self {
+        Self {
+            kind: 0,
+            module_len: 0,
+            module: [0; 64],
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_ipc::ReplyMeta")]
+struct ReplyMeta {
+    status: u32,
+    detail: u32,
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_malformed_request_is_refused_and_the_owner_keeps_serving() {
+    use iceoryx2::prelude::*;
+
+    let cell = cell("garbage");
+    let _owner = owner(&cell, "DOUBLE");
+    let node = NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc_threadsafe::Service>()
+        .unwrap();
+    let name = format!("imrs/{cell}/DOUBLE/messages");
+    let service = node
+        .service_builder(&ServiceName::new(&name).unwrap())
+        .request_response::<Number, Number>()
+        .request_user_header::<ForgedMeta>()
+        .response_user_header::<ReplyMeta>()
+        .open()
+        .unwrap();
+    let client = service.client_builder().create().unwrap();
+    // A module name 999 bytes long in a 64-byte buffer; then a kind that does not exist.
+    let forged = [
+        ForgedMeta {
+            kind: 2,
+            module_len: 999,
+            module: [b'A'; 64],
+        },
+        ForgedMeta {
+            kind: 77,
+            module_len: 5,
+            module: [b'A'; 64],
+        },
+    ];
+    for meta in forged {
+        let mut loan = client.loan_uninit().unwrap();
+        *loan.user_header_mut() = meta;
+        let pending = loan.write_payload(Number { value: 1 }).send().unwrap();
+        let response = within(5, async {
+            loop {
+                if let Some(response) = pending.receive().unwrap() {
+                    break *response.user_header();
+                }
+                tokio::time::sleep(Duration::from_millis(10)).await;
+            }
+        })
+        .await;
+        assert_ne!(response.status, 0, "a forged request was served");
+    }
+    // The owner still serves its real users.
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(
+        within(5, asker.send(Number { value: 4 }))
+            .await
+            .unwrap()
+            .value,
+        8
+    );
+}
