@@ -304,3 +304,93 @@ async fn a_malformed_request_is_refused_and_the_owner_keeps_serving() {
         8
     );
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_user_timeout_holds_across_processes_and_the_late_reply_harms_nothing() {
+    let cell = cell("timeout");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported
+        .port()
+        .user_named("ASKER")
+        .unwrap()
+        .with_timeout(Duration::from_millis(300));
+    // The owner takes 1.5 s over 1500: past the user's timeout.
+    let late = within(5, asker.send(Number { value: 1500 })).await;
+    assert!(
+        matches!(late, Err(SendError::ReplyTimeout { ref port }) if port == "DOUBLE"),
+        "{late:?}"
+    );
+    // Until the owner answers 1500, the user's one outstanding request holds its place in
+    // the port, as it would in one process: the next sends time out, untaken. Then the late
+    // reply goes nowhere, and each later send gets its own reply.
+    for value in [3, 4, 5] {
+        let reply = within(5, async {
+            loop {
+                match asker.send(Number { value }).await {
+                    Ok(reply) => break reply,
+                    // The owner is still busy with 1500: this one times out too.
+                    Err(SendError::ReplyTimeout { .. } | SendError::Timeout { .. }) => {}
+                    Err(other) => panic!("{other:?}"),
+                }
+            }
+        })
+        .await;
+        assert_eq!(reply.value, 2 * value);
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
+    use std::os::unix::fs::PermissionsExt;
+
+    let cell = cell("permissions");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(
+        within(5, asker.send(Number { value: 1 }))
+            .await
+            .unwrap()
+            .value,
+        2
+    );
+    // Every file iceoryx2 keeps for services and their data, but its one host-wide
+    // bookkeeping file, is readable and writable by its owner alone.
+    let mut files = Vec::new();
+    let mut look = vec![std::path::PathBuf::from("/tmp/iceoryx2")];
+    while let Some(dir) = look.pop() {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                look.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.extend(
+        std::fs::read_dir("/dev/shm")
+            .unwrap()
+            .flatten()
+            .map(|entry| entry.path())
+            .filter(|path| {
+                let name = path.file_name().unwrap().to_string_lossy().into_owned();
+                name.starts_with("iox2_") && !name.ends_with("global_mgmt")
+            }),
+    );
+    assert!(
+        !files.is_empty(),
+        "no iceoryx2 files found: the test looks in the wrong place"
+    );
+    for path in files {
+        // Files of other tests may come and go meanwhile.
+        let Ok(metadata) = std::fs::metadata(&path) else {
+            continue;
+        };
+        let mode = metadata.permissions().mode() & 0o777;
+        assert_eq!(mode & 0o077, 0, "{} is {mode:o}", path.display());
+    }
+}

@@ -1,0 +1,261 @@
+//! The rendezvous round trip between two processes: an IMRS port carried by `imrs-ipc`
+//! (the user's send, through the bridges, to the owner's receive and back), beside a raw
+//! iceoryx2 request-response round trip that waits on iceoryx2 events — the same payloads,
+//! the same two processes, the same run. Each case: p50, p99 and p99.9 over its round
+//! trips, and the ratios the targets are stated in.
+//!
+//! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
+//! that the benchmark cannot rot. The peer is this same binary, started again with
+//! `IMRS_IPC_BENCH_PEER` set.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use iceoryx2::prelude::*;
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_ipc::{Remote, Wire, export, import};
+
+type Svc = ipc_threadsafe::Service;
+
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_benches::Small")]
+struct Small {
+    value: u64,
+}
+
+#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[repr(C)]
+#[type_name("imrs_benches::Large")]
+struct Large {
+    bytes: [u8; 65536],
+}
+
+impl Default for Large {
+    fn default() -> Self {
+        Self { bytes: [0; 65536] }
+    }
+}
+
+const PEER: &str = "IMRS_IPC_BENCH_PEER";
+
+fn main() {
+    if let Ok(cell) = std::env::var(PEER) {
+        peer(&cell);
+        return;
+    }
+    let rounds = if std::env::args().any(|arg| arg == "--bench") {
+        20_000
+    } else {
+        200
+    };
+    let cell = format!("bench-{}", std::process::id());
+    let mut child = Command::new(std::env::current_exe().expect("this binary"))
+        .env(PEER, &cell)
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the peer starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("piped"))
+        .read_line(&mut line)
+        .expect("the peer speaks");
+    assert_eq!(line.trim(), "ready", "the peer failed: {line}");
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        // A 64 KiB message is copied by value through the bridges' futures: more than
+        // tokio's 2 MiB default stack holds in a debug build.
+        .thread_stack_size(32 << 20)
+        .enable_all()
+        .build()
+        .expect("a tokio runtime");
+    let raw_small = raw_round_trips::<Small>(&cell, "small", rounds);
+    let raw_large = raw_round_trips::<Large>(&cell, "large", rounds);
+    let (imrs_small, imrs_large) = runtime.block_on(async {
+        (
+            imrs_round_trips::<Small>(&cell, "SMALL", rounds).await,
+            imrs_round_trips::<Large>(&cell, "LARGE", rounds).await,
+        )
+    });
+    let _ = child.kill();
+    let _ = child.wait();
+
+    println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
+    for (name, times) in [
+        ("raw iceoryx2, events, 8 B", &raw_small),
+        ("IMRS port over iceoryx2, 8 B", &imrs_small),
+        ("raw iceoryx2, events, 64 KiB", &raw_large),
+        ("IMRS port over iceoryx2, 64 KiB", &imrs_large),
+    ] {
+        let [p50, p99, p999] = percentiles(times);
+        println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
+    }
+    let ratio = |a: &[Duration], b: &[Duration]| {
+        let (a, b) = (percentiles(a), percentiles(b));
+        (0..3).map(move |i| a[i].as_secs_f64() / b[i].as_secs_f64())
+    };
+    let show = |ratios: Vec<f64>| format!("{:.2} / {:.2} / {:.2}", ratios[0], ratios[1], ratios[2]);
+    println!(
+        "  IMRS 8 B vs raw 8 B (target: no worse than raw on a parked port)   {}",
+        show(ratio(&imrs_small, &raw_small).collect())
+    );
+    println!(
+        "  IMRS 64 KiB vs IMRS 8 B (target: within 1.5)                       {}",
+        show(ratio(&imrs_large, &imrs_small).collect())
+    );
+}
+
+fn percentiles(times: &[Duration]) -> [Duration; 3] {
+    let mut sorted = times.to_vec();
+    sorted.sort_unstable();
+    let at = |q: f64| sorted[((sorted.len() as f64 * q) as usize).min(sorted.len() - 1)];
+    [at(0.5), at(0.99), at(0.999)]
+}
+
+/// The peer: owns both IMRS ports (echoing), and serves both raw services.
+fn peer(cell: &str) {
+    for part in ["small", "large"] {
+        let cell = cell.to_owned();
+        std::thread::spawn(move || match part {
+            "small" => raw_server::<Small>(&cell, part),
+            _ => raw_server::<Large>(&cell, part),
+        });
+    }
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        // A 64 KiB message is copied by value through the bridges' futures: more than
+        // tokio's 2 MiB default stack holds in a debug build.
+        .thread_stack_size(32 << 20)
+        .enable_all()
+        .build()
+        .expect("a tokio runtime");
+    runtime.block_on(async {
+        let remote = Remote::new(cell).expect("a cell name");
+        let small = echo::<Small>(&remote, "SMALL");
+        let large = echo::<Large>(&remote, "LARGE");
+        // Give the raw servers a moment to open their services.
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        println!("ready");
+        let _ = tokio::join!(small, large);
+    });
+}
+
+fn echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
+    let port: Port<T, T, usage::Receive, AnyUser, 1> = Port::declare(PortSpec::new(name, "ECHO"));
+    let exported = export(remote, &port).expect("exported");
+    let mut owner = port.owner().expect("the owner's end");
+    tokio::spawn(async move {
+        let _exported = exported;
+        while let Ok((message, reply)) = owner.receive().await {
+            reply.reply(message);
+        }
+    })
+}
+
+async fn imrs_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
+    let remote = Remote::new(cell).expect("a cell name");
+    let imported = import::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
+    let mut asker = imported.port().user_named("ASKER").expect("the user's end");
+    for _ in 0..rounds / 10 {
+        asker
+            .send(T::default())
+            .await
+            .expect("a warm-up round trip");
+    }
+    let mut times = Vec::with_capacity(rounds);
+    for _ in 0..rounds {
+        let start = Instant::now();
+        std::hint::black_box(asker.send(T::default()).await.expect("a round trip"));
+        times.push(start.elapsed());
+    }
+    times
+}
+
+fn raw_names(cell: &str, part: &str) -> [ServiceName; 3] {
+    ["messages", "requested", "replied"]
+        .map(|what| ServiceName::new(&format!("raw/{cell}/{part}/{what}")).expect("a service name"))
+}
+
+/// A raw iceoryx2 server: waits on its request event, answers a copy, notifies.
+fn raw_server<T: Wire>(cell: &str, part: &str) {
+    let node = NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<Svc>()
+        .expect("a node");
+    let [messages, requested, replied] = raw_names(cell, part);
+    let service = node
+        .service_builder(&messages)
+        .request_response::<T, T>()
+        .open_or_create()
+        .expect("the service");
+    let server = service.server_builder().create().expect("a server");
+    let requested = node
+        .service_builder(&requested)
+        .event()
+        .open_or_create()
+        .expect("events");
+    let replied = node
+        .service_builder(&replied)
+        .event()
+        .open_or_create()
+        .expect("events");
+    let listener = requested.listener_builder().create().expect("a listener");
+    let notifier = replied.notifier_builder().create().expect("a notifier");
+    loop {
+        if listener.blocking_wait(|_| {}).is_err() {
+            return;
+        }
+        while let Ok(Some(request)) = server.receive() {
+            let payload = *request.payload();
+            let _ = request.send_copy(payload);
+            let _ = notifier.notify();
+        }
+    }
+}
+
+fn raw_round_trips<T: Wire>(cell: &str, part: &str, rounds: usize) -> Vec<Duration> {
+    let node = NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<Svc>()
+        .expect("a node");
+    let [messages, requested, replied] = raw_names(cell, part);
+    let service = node
+        .service_builder(&messages)
+        .request_response::<T, T>()
+        .open_or_create()
+        .expect("the service");
+    let client = service.client_builder().create().expect("a client");
+    let requested = node
+        .service_builder(&requested)
+        .event()
+        .open_or_create()
+        .expect("events");
+    let replied = node
+        .service_builder(&replied)
+        .event()
+        .open_or_create()
+        .expect("events");
+    let listener = replied.listener_builder().create().expect("a listener");
+    let notifier = requested.notifier_builder().create().expect("a notifier");
+    let round_trip = || {
+        let pending = client.send_copy(T::default()).expect("sent");
+        let _ = notifier.notify();
+        loop {
+            if let Ok(Some(response)) = pending.receive() {
+                return std::hint::black_box(*response.payload());
+            }
+            let _ = listener.timed_wait(|_| {}, Duration::from_millis(50));
+        }
+    };
+    for _ in 0..rounds / 10 {
+        round_trip();
+    }
+    (0..rounds)
+        .map(|_| {
+            let start = Instant::now();
+            round_trip();
+            start.elapsed()
+        })
+        .collect()
+}
