@@ -394,3 +394,59 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
         assert_eq!(mode & 0o077, 0, "{} is {mode:o}", path.display());
     }
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, select, usage};
+
+    let cell = cell("select");
+    // This process owns both: DOUBLE, used from another process, and LOCAL, from here.
+    let remote_port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::declare(
+        PortSpec::new("DOUBLE", "DOUBLER")
+            .user_list(["ASKER"])
+            .priority(2),
+    );
+    let local_port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new("LOCAL", "DOUBLER").priority(1));
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &remote_port).unwrap();
+    let user = Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
+        .args(["user", &cell, "DOUBLE", "ASKER", "50"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the user starts");
+    let mut local = local_port.user_named("HERE").unwrap();
+    let local_sends = tokio::spawn(async move {
+        for value in 1..=50 {
+            assert_eq!(local.send(Number { value }).await.unwrap().value, 2 * value);
+        }
+    });
+    let (mut from_there, mut from_here) =
+        (remote_port.owner().unwrap(), local_port.owner().unwrap());
+    let mut served = [0, 0];
+    within(30, async {
+        while served != [50, 50] {
+            let (which, number, reply) = select()
+                .or(&mut from_there, |(number, reply)| (0, number, reply))
+                .or(&mut from_here, |(number, reply)| (1, number, reply))
+                .await
+                .unwrap();
+            served[which] += 1;
+            reply.reply(Number {
+                value: 2 * number.value,
+            });
+        }
+    })
+    .await;
+    within(5, local_sends).await.unwrap();
+    let output = within(10, async {
+        tokio::task::spawn_blocking(move || user.wait_with_output()).await
+    })
+    .await
+    .unwrap()
+    .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stdout)
+    );
+}
