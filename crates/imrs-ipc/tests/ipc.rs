@@ -450,3 +450,53 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
         String::from_utf8_lossy(&output.stdout)
     );
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    let cell = cell("user-killed");
+    let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut owner = port.owner().unwrap();
+    let user = |n: &str| {
+        Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
+            .args(["user", &cell, "DOUBLE", "ASKER", n])
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("the user starts")
+    };
+    // The user's first request is here; kill -9 it before the reply.
+    let mut first = Peer(user("5"));
+    let (number, reply) = within(10, owner.receive()).await.unwrap();
+    assert_eq!(number.value, 1);
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    // The reply goes to nobody; the owner's side goes on.
+    reply.reply(Number { value: 2 });
+    // A new copy of the user, under the same module name, is served in full.
+    let second = user("3");
+    for value in 1..=3 {
+        let (number, reply) = within(10, owner.receive()).await.unwrap();
+        assert_eq!(number.value, value);
+        reply.reply(Number { value: 2 * value });
+    }
+    let output = within(10, async {
+        tokio::task::spawn_blocking(move || second.wait_with_output()).await
+    })
+    .await
+    .unwrap()
+    .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stdout)
+    );
+    assert_eq!(
+        String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .collect::<Vec<_>>(),
+        ["2", "4", "6"]
+    );
+}
