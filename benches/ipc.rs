@@ -172,34 +172,42 @@ async fn imrs_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec
     times
 }
 
-fn raw_names(cell: &str, part: &str) -> [ServiceName; 3] {
-    ["messages", "requested", "replied"]
-        .map(|what| ServiceName::new(&format!("raw/{cell}/{part}/{what}")).expect("a service name"))
-}
+type RawService<T> =
+    iceoryx2::service::port_factory::request_response::PortFactory<Svc, T, (), T, ()>;
+type RawEvents = iceoryx2::service::port_factory::event::PortFactory<Svc>;
 
-/// A raw iceoryx2 server: waits on its request event, answers a copy, notifies.
-fn raw_server<T: Wire>(cell: &str, part: &str) {
+/// The raw services of `part`: the request-response service and its two events, on a node
+/// that must live as long as they are used.
+fn raw_services<T: Wire>(
+    cell: &str,
+    part: &str,
+) -> (Node<Svc>, RawService<T>, RawEvents, RawEvents) {
     let node = NodeBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<Svc>()
         .expect("a node");
-    let [messages, requested, replied] = raw_names(cell, part);
+    let name = |what: &str| {
+        ServiceName::new(&format!("raw/{cell}/{part}/{what}")).expect("a service name")
+    };
     let service = node
-        .service_builder(&messages)
+        .service_builder(&name("messages"))
         .request_response::<T, T>()
         .open_or_create()
         .expect("the service");
+    let event = |what: &str| {
+        node.service_builder(&name(what))
+            .event()
+            .open_or_create()
+            .expect("events")
+    };
+    let (requested, replied) = (event("requested"), event("replied"));
+    (node, service, requested, replied)
+}
+
+/// A raw iceoryx2 server: waits on its request event, answers a copy, notifies.
+fn raw_server<T: Wire>(cell: &str, part: &str) {
+    let (_node, service, requested, replied) = raw_services::<T>(cell, part);
     let server = service.server_builder().create().expect("a server");
-    let requested = node
-        .service_builder(&requested)
-        .event()
-        .open_or_create()
-        .expect("events");
-    let replied = node
-        .service_builder(&replied)
-        .event()
-        .open_or_create()
-        .expect("events");
     let listener = requested.listener_builder().create().expect("a listener");
     let notifier = replied.notifier_builder().create().expect("a notifier");
     loop {
@@ -215,27 +223,8 @@ fn raw_server<T: Wire>(cell: &str, part: &str) {
 }
 
 fn raw_round_trips<T: Wire>(cell: &str, part: &str, rounds: usize) -> Vec<Duration> {
-    let node = NodeBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<Svc>()
-        .expect("a node");
-    let [messages, requested, replied] = raw_names(cell, part);
-    let service = node
-        .service_builder(&messages)
-        .request_response::<T, T>()
-        .open_or_create()
-        .expect("the service");
+    let (_node, service, requested, replied) = raw_services::<T>(cell, part);
     let client = service.client_builder().create().expect("a client");
-    let requested = node
-        .service_builder(&requested)
-        .event()
-        .open_or_create()
-        .expect("events");
-    let replied = node
-        .service_builder(&replied)
-        .event()
-        .open_or_create()
-        .expect("events");
     let listener = replied.listener_builder().create().expect("a listener");
     let notifier = requested.notifier_builder().create().expect("a notifier");
     let round_trip = || {

@@ -66,6 +66,28 @@ fn owner(cell: &str, port: &str) -> Peer {
     owner
 }
 
+/// Starts a user process: module `module` asks the doubles of 1..=`n` on `cell`'s DOUBLE.
+fn user(cell: &str, module: &str, n: &str) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
+        .args(["user", cell, "DOUBLE", module, n])
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the user starts")
+}
+
+/// Waits for a user process to end; its answers, one a line. Fails the test if it failed.
+async fn answers(user: Child) -> Vec<u64> {
+    let output = within(30, async {
+        tokio::task::spawn_blocking(move || user.wait_with_output()).await
+    })
+    .await
+    .unwrap()
+    .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(output.status.success(), "{text}");
+    text.lines().map(|line| line.parse().unwrap()).collect()
+}
+
 async fn within<T>(seconds: u64, future: impl Future<Output = T>) -> T {
     tokio::time::timeout(Duration::from_secs(seconds), future)
         .await
@@ -92,25 +114,13 @@ async fn two_user_processes_are_served_at_once() {
     let _owner = owner(&cell, "DOUBLE");
     let users: Vec<Child> = ["ASKER", "ASKER_2"]
         .iter()
-        .map(|module| {
-            Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
-                .args(["user", &cell, "DOUBLE", module, "100"])
-                .stdout(Stdio::piped())
-                .spawn()
-                .expect("the user starts")
-        })
+        .map(|module| user(&cell, module, "100"))
         .collect();
     for user in users {
-        let output = within(30, async {
-            tokio::task::spawn_blocking(move || user.wait_with_output()).await
-        })
-        .await
-        .unwrap()
-        .unwrap();
-        let text = String::from_utf8_lossy(&output.stdout);
-        assert!(output.status.success(), "{text}");
-        let doubles: Vec<u64> = text.lines().map(|l| l.parse().unwrap()).collect();
-        assert_eq!(doubles, (1..=100).map(|v| 2 * v).collect::<Vec<_>>());
+        assert_eq!(
+            answers(user).await,
+            (1..=100).map(|v| 2 * v).collect::<Vec<_>>()
+        );
     }
 }
 
@@ -409,11 +419,7 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
     let local_port: Port<Number, Number, usage::Receive, AnyUser, 1> =
         Port::declare(PortSpec::new("LOCAL", "DOUBLER").priority(1));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &remote_port).unwrap();
-    let user = Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
-        .args(["user", &cell, "DOUBLE", "ASKER", "50"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("the user starts");
+    let asking = user(&cell, "ASKER", "50");
     let mut local = local_port.user_named("HERE").unwrap();
     let local_sends = tokio::spawn(async move {
         for value in 1..=50 {
@@ -438,17 +444,7 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
     })
     .await;
     within(5, local_sends).await.unwrap();
-    let output = within(10, async {
-        tokio::task::spawn_blocking(move || user.wait_with_output()).await
-    })
-    .await
-    .unwrap()
-    .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stdout)
-    );
+    assert_eq!(answers(asking).await.len(), 50);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -460,15 +456,8 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
         Port::declare(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut owner = port.owner().unwrap();
-    let user = |n: &str| {
-        Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
-            .args(["user", &cell, "DOUBLE", "ASKER", n])
-            .stdout(Stdio::piped())
-            .spawn()
-            .expect("the user starts")
-    };
     // The user's first request is here; kill -9 it before the reply.
-    let mut first = Peer(user("5"));
+    let mut first = Peer(user(&cell, "ASKER", "5"));
     let (number, reply) = within(10, owner.receive()).await.unwrap();
     assert_eq!(number.value, 1);
     first.0.kill().unwrap();
@@ -476,27 +465,11 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
     // The reply goes to nobody; the owner's side goes on.
     reply.reply(Number { value: 2 });
     // A new copy of the user, under the same module name, is served in full.
-    let second = user("3");
+    let second = user(&cell, "ASKER", "3");
     for value in 1..=3 {
         let (number, reply) = within(10, owner.receive()).await.unwrap();
         assert_eq!(number.value, value);
         reply.reply(Number { value: 2 * value });
     }
-    let output = within(10, async {
-        tokio::task::spawn_blocking(move || second.wait_with_output()).await
-    })
-    .await
-    .unwrap()
-    .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stdout)
-    );
-    assert_eq!(
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .collect::<Vec<_>>(),
-        ["2", "4", "6"]
-    );
+    assert_eq!(answers(second).await, [2, 4, 6]);
 }
