@@ -40,6 +40,11 @@
 //! Service names are derived from the cell's name and the port's, so two cells on one
 //! host never meet; no iceoryx2 configuration file is needed. Across processes the ports
 //! run on real time: each process has its own clock.
+//!
+//! A message is copied once into shared memory and moved by value through the bridges'
+//! tasks: there is no loan yet to build it in place. Large messages (tens of KiB) therefore
+//! cost copies, and in a debug build they can overflow tokio's default 2 MiB worker stack;
+//! give such a cell's runtime larger stacks (`thread_stack_size`).
 
 mod bridge;
 mod error;
