@@ -1,6 +1,7 @@
 //! The owner's side: a port exported to other processes. A bridge thread waits on
-//! iceoryx2's request events; each request goes into the real port as a send from the
-//! remote module's own end, on tokio, and its reply goes back through shared memory.
+//! iceoryx2's request events; each request goes into the real port from the remote module's
+//! own end — a send, or a query its owner's order answers — on tokio, and its reply goes
+//! back through shared memory.
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -19,7 +20,24 @@ use crate::wire::{
 use crate::{IpcError, Remote, Wire};
 
 type Active<Req, Rep> = ActiveRequest<Svc, Req, RequestMeta, Rep, ReplyMeta>;
-type UserEnd<Req, Rep> = Arc<tokio::sync::Mutex<End<Req, Rep, usage::Send>>>;
+
+/// A remote module's end of the real port, through which its requests go in.
+trait Forward<Req, Rep>: Send + 'static {
+    /// The request, as the module's primitive on this port; its reply, or `None`.
+    fn forward(&mut self, request: Req) -> impl Future<Output = Option<Rep>> + Send + '_;
+}
+
+impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
+    async fn forward(&mut self, request: Req) -> Option<Rep> {
+        self.send(request).await.ok()
+    }
+}
+
+impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
+    async fn forward(&mut self, request: Req) -> Option<Rep> {
+        self.query(request).await.ok()
+    }
+}
 
 /// A port exported to other processes: served while this is held, withdrawn when dropped.
 pub struct Exported {
@@ -45,14 +63,39 @@ impl Drop for Exported {
 }
 
 /// Exports `port` (a port its owner receives on) to the other processes of `remote`'s
-/// cell. Call it within the tokio runtime the cell runs on: the remote users' sends run
-/// there. Refused if another process already exports the port, or if the processes
-/// disagree on its types.
+/// cell: their modules' sends arrive at its owner's `receive`. Call it within the tokio
+/// runtime the cell runs on: the remote users' sends run there. Refused if another process
+/// already exports the port, or if the processes disagree on its types.
 pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
-    let name = Name::from(port);
+    let port = port.clone();
+    bridge(remote, Name::from(&port), move |module: &str| {
+        port.user_named(module)
+    })
+}
+
+/// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
+/// modules' queries wait for its owner's response handler, which runs when the owner's
+/// order says, as for a query from its own process.
+pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Req, Rep, usage::Response, L, N>,
+) -> Result<Exported, IpcError> {
+    let port = port.clone();
+    bridge(remote, Name::from(&port), move |module: &str| {
+        port.user_named(module)
+    })
+}
+
+fn bridge<Req, Rep, E, A>(remote: &Remote, name: Name, mut attach: A) -> Result<Exported, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    E: Forward<Req, Rep>,
+    A: FnMut(&str) -> Result<E, WireError> + Send + 'static,
+{
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
         detail: "export it from within the tokio runtime its cell runs on".into(),
@@ -70,25 +113,22 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     let listener = channel.listener(&channel.requested)?;
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
-    let (port, halt) = (port.clone(), Arc::clone(&stop));
+    let halt = Arc::clone(&stop);
     let thread = std::thread::Builder::new()
         .name(format!("imrs-ipc {name}"))
         .spawn(move || {
             // The channel lives as long as the thread: its node keeps the services open.
             let _channel = channel;
-            let mut users: HashMap<String, UserEnd<Req, Rep>> = HashMap::new();
+            let mut users: Users<E> = HashMap::new();
             while !halt.load(Ordering::Acquire) {
                 // Blocks until a request event or the tick: no polling of the data.
                 if listener.timed_wait(|_| {}, TICK).is_err() {
                     break;
                 }
-                loop {
-                    match server.receive() {
-                        Ok(Some(active)) => take(active, &port, &mut users, &runtime, &notifier),
-                        Ok(None) => break,
-                        // A connection iceoryx2 could not make yet: the next wake-up retries.
-                        Err(_) => break,
-                    }
+                // An error is a connection iceoryx2 could not make yet: the next wake-up
+                // retries.
+                while let Ok(Some(active)) = server.receive() {
+                    take(active, &mut attach, &mut users, &runtime, &notifier);
                 }
             }
         })
@@ -103,11 +143,14 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     })
 }
 
+/// The remote modules' ends, by module.
+type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
+
 /// One request from another process.
-fn take<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     active: Active<Req, Rep>,
-    port: &Port<Req, Rep, usage::Receive, L, N>,
-    users: &mut HashMap<String, UserEnd<Req, Rep>>,
+    attach: &mut impl FnMut(&str) -> Result<E, WireError>,
+    users: &mut Users<E>,
     runtime: &tokio::runtime::Handle,
     notifier: &Arc<Mutex<Notifier<Svc>>>,
 ) {
@@ -117,30 +160,27 @@ fn take<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
         respond(active, MALFORMED, 0, Rep::default(), notifier);
         return;
     };
+    // A module this copy of the owner has not seen yet — the owner was restarted since the
+    // module connected — is attached now, as at its connection.
+    let end = match user(attach, users, &module) {
+        Ok(end) => end,
+        Err((status, detail)) => {
+            respond(active, status, detail, Rep::default(), notifier);
+            return;
+        }
+    };
     match meta.kind {
-        CONNECT => match attach(port, users, &module) {
-            Ok(_) => respond(active, OK, 0, Rep::default(), notifier),
-            Err((status, detail)) => respond(active, status, detail, Rep::default(), notifier),
-        },
+        CONNECT => respond(active, OK, 0, Rep::default(), notifier),
         SEND => {
-            // A module this copy of the owner has not seen yet — the owner was restarted
-            // since the module connected — is attached now, as at its connection.
-            let end = match attach(port, users, &module) {
-                Ok(end) => end,
-                Err((status, detail)) => {
-                    respond(active, status, detail, Rep::default(), notifier);
-                    return;
-                }
-            };
             let request = *active.payload();
             let notifier = Arc::clone(notifier);
-            // Each send waits on tokio, so that several remote modules' sends are pending at
-            // once and the owner's order decides which it takes.
+            // Each request waits on tokio, so that several remote modules' requests are
+            // pending at once and the owner's order decides which it takes.
             runtime.spawn(async move {
-                let result = end.lock().await.send(request).await;
-                match result {
-                    Ok(reply) => respond(active, OK, 0, reply, &notifier),
-                    Err(_) => respond(active, NO_REPLY, 0, Rep::default(), &notifier),
+                let reply = end.lock().await.forward(request).await;
+                match reply {
+                    Some(reply) => respond(active, OK, 0, reply, &notifier),
+                    None => respond(active, NO_REPLY, 0, Rep::default(), &notifier),
                 }
             });
         }
@@ -148,17 +188,17 @@ fn take<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     }
 }
 
-/// The end of remote module `module`, attached at its first request; or the status of
-/// the port's refusal.
-fn attach<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
-    port: &Port<Req, Rep, usage::Receive, L, N>,
-    users: &mut HashMap<String, UserEnd<Req, Rep>>,
+/// The end of remote module `module`, attached at its first request; or the status of the
+/// port's refusal.
+fn user<E>(
+    attach: &mut impl FnMut(&str) -> Result<E, WireError>,
+    users: &mut Users<E>,
     module: &str,
-) -> Result<UserEnd<Req, Rep>, (u32, u32)> {
+) -> Result<Arc<tokio::sync::Mutex<E>>, (u32, u32)> {
     if let Some(end) = users.get(module) {
         return Ok(Arc::clone(end));
     }
-    match port.user_named(module) {
+    match attach(module) {
         Ok(end) => {
             let end = Arc::new(tokio::sync::Mutex::new(end));
             users.insert(module.to_owned(), Arc::clone(&end));

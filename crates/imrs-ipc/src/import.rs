@@ -12,7 +12,10 @@ use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::{AnyUser, Name, Port, PortSpec, ReplyHandle, WireError, usage};
+use imrs_core::imrs_ports::usage::Usage;
+use imrs_core::imrs_ports::{
+    AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
+};
 
 use crate::bridge::{Channel, Svc, TICK, sweep_dead};
 use crate::wire::{
@@ -29,21 +32,21 @@ type Waiting<Req, Rep> = (Pending<Req, Rep>, Option<ReplyHandle<Rep>>);
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// A port imported from another process, and its bridge: usable while this is held.
-pub struct Imported<Req: Wire, Rep: Wire> {
-    port: Port<Req, Rep, usage::Receive, AnyUser, 1>,
+pub struct Imported<Req: Wire, Rep: Wire, U: Usage = usage::Receive> {
+    port: Port<Req, Rep, U, AnyUser, 1>,
     stop: Arc<AtomicBool>,
     waiter: Option<JoinHandle<()>>,
     forwarder: tokio::task::JoinHandle<()>,
 }
 
-impl<Req: Wire, Rep: Wire> Imported<Req, Rep> {
+impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
     /// The local port: attach the importing module to it as to any port.
-    pub fn port(&self) -> &Port<Req, Rep, usage::Receive, AnyUser, 1> {
+    pub fn port(&self) -> &Port<Req, Rep, U, AnyUser, 1> {
         &self.port
     }
 }
 
-impl<Req: Wire, Rep: Wire> Drop for Imported<Req, Rep> {
+impl<Req: Wire, Rep: Wire, U: Usage> Drop for Imported<Req, Rep, U> {
     fn drop(&mut self) {
         self.forwarder.abort();
         self.stop.store(true, Ordering::Release);
@@ -54,16 +57,86 @@ impl<Req: Wire, Rep: Wire> Drop for Imported<Req, Rep> {
 }
 
 /// Imports port `port`, owned by module `owner` in another process of `remote`'s cell, for
-/// module `module` of this one. Connects at once: refused with the port's own
-/// [`WireError`] if `module` is not on its user list or the port has no room for it, and
-/// with [`IpcError::TypeMismatch`] if the processes disagree on its types. Call it within
-/// the tokio runtime the cell runs on.
+/// module `module` of this one: a port its owner receives on, to which `module` sends.
+/// Connects at once: refused with the port's own [`WireError`] if `module` is not on its
+/// user list or the port has no room for it, and with [`IpcError::TypeMismatch`] if the
+/// processes disagree on its types. Call it within the tokio runtime the cell runs on.
 pub fn import<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep>, IpcError> {
+    bridge(
+        remote,
+        port,
+        module,
+        |local: &Port<Req, Rep, usage::Receive, AnyUser, 1>| local.owner(),
+        owner,
+    )
+}
+
+/// Imports a `RESPONSE` port of another process, as [`import`] does a port its owner
+/// receives on: `module` queries it, and the owner's response handler answers when the
+/// owner's order says.
+pub fn import_response<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, usage::Response>, IpcError> {
+    bridge(
+        remote,
+        port,
+        module,
+        // The handler never runs: the bridge takes each query and answers it with the
+        // other process's reply.
+        |local: &Port<Req, Rep, usage::Response, AnyUser, 1>| {
+            local.owner_responder(|_: &(), _: Req| Rep::default())
+        },
+        owner,
+    )
+}
+
+/// The local owner's side of an imported port: where the bridge takes each request, and
+/// the right to answer it.
+trait Take<Req, Rep>: Send + 'static {
+    /// The next request, or `None` once the port is done.
+    fn next(&mut self) -> impl Future<Output = Option<(Req, ReplyHandle<Rep>)>> + Send + '_;
+}
+
+impl<Req: Wire, Rep: Wire> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
+    async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+        self.receive().await.ok()
+    }
+}
+
+impl<Req: Wire, Rep: Wire> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
+    async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+        loop {
+            std::future::poll_fn(|cx| self.poll_pending(cx))
+                .await
+                .ok()?;
+            if let Some(taken) = self.take() {
+                return Some(taken);
+            }
+        }
+    }
+}
+
+fn bridge<Req, Rep, U, T>(
+    remote: &Remote,
+    port: &str,
+    module: &str,
+    own: impl FnOnce(&Port<Req, Rep, U, AnyUser, 1>) -> Result<T, WireError>,
+    owner: &str,
+) -> Result<Imported<Req, Rep, U>, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    U: Usage,
+    T: Take<Req, Rep>,
+{
     let name = Name::from(port);
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
@@ -84,9 +157,9 @@ pub fn import<Req: Wire, Rep: Wire>(
     let wake_self = channel.notifier(&channel.replied)?;
     connect(&client, &listener, &wake_owner, &name, module)?;
 
-    let local: Port<Req, Rep, usage::Receive, AnyUser, 1> =
+    let local: Port<Req, Rep, U, AnyUser, 1> =
         Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
-    let mut taken = local.owner().map_err(IpcError::Local)?;
+    let mut taken = own(&local).map_err(IpcError::Local)?;
     let (pending_tx, pending_rx) = mpsc::channel::<(Pending<Req, Rep>, ReplyHandle<Rep>)>();
     let stop = Arc::new(AtomicBool::new(false));
 
@@ -106,7 +179,7 @@ pub fn import<Req: Wire, Rep: Wire>(
     let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
     let wake = Arc::new(Mutex::new((wake_owner, wake_self)));
     let forwarder = runtime.spawn(async move {
-        while let Ok((request, reply)) = taken.receive().await {
+        while let Some((request, reply)) = taken.next().await {
             let sent = {
                 let client = client.lock().unwrap_or_else(PoisonError::into_inner);
                 client.loan_uninit().ok().and_then(|mut loan| {

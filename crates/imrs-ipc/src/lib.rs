@@ -26,6 +26,10 @@
 //! # Ok(()) }
 //! ```
 //!
+//! Ports whose owner receives cross with [`export`] and [`import`]; `RESPONSE` ports, whose
+//! users query them, with [`export_response`] and [`import_response`] — a remote query
+//! waits for the owner's response handler, which runs when the owner's order says.
+//!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
 //! port connects — and a mismatch is refused, naming the port.
@@ -53,8 +57,8 @@ mod import;
 mod wire;
 
 pub use error::IpcError;
-pub use export::{Exported, export};
-pub use import::{Imported, import};
+pub use export::{Exported, export, export_response};
+pub use import::{Imported, import, import_response};
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;

@@ -473,3 +473,35 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
     }
     assert_eq!(answers(second).await, [2, 4, 6]);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
+    let cell = cell("query");
+    let mut responder = peer(&["responder", &cell, "TRIPLE"]);
+    let stdout = responder.0.stdout.take().expect("piped");
+    let mut line = String::new();
+    BufReader::new(stdout)
+        .read_line(&mut line)
+        .expect("the responder speaks");
+    assert_eq!(line.trim(), "ready", "the responder failed: {line}");
+    let remote = Remote::new(&cell).unwrap();
+    let imported =
+        imrs_ipc::import_response::<Number, Number>(&remote, "TRIPLE", "TRIPLER", "ASKER").unwrap();
+    // The module queries, as it would a port of its own process.
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    for value in 1..=50 {
+        let answer = within(5, asker.query(Number { value })).await.unwrap();
+        assert_eq!(answer.value, 3 * value);
+    }
+    // And the owner's list holds: a module it does not know is refused by name.
+    let error = imrs_ipc::import_response::<Number, Number>(&remote, "TRIPLE", "TRIPLER", "OTHER")
+        .err()
+        .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::Refused(WireError::NotOnUserList {
+            port: "TRIPLE".into(),
+            module: "OTHER".into(),
+        })
+    );
+}

@@ -103,6 +103,16 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> ResponseEnd<Req, Rep, S> {
         true
     }
 
+    /// Takes the oldest waiting query without running the handler, with the right to answer
+    /// it later: for a transport that answers from elsewhere (another process). Dropping the
+    /// handle unanswered fails the querier with
+    /// [`QueryError::NoResponse`](crate::QueryError::NoResponse), as a panicking handler
+    /// does.
+    pub fn take(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+        let (query, from) = self.attachment.try_take()?;
+        Some((query, ReplyHandle::new(&self.attachment, from)))
+    }
+
     /// Waits for one query (up to this end's timeout) and answers it: for a module that has
     /// nothing else to do.
     pub async fn serve(&mut self, state: &S) -> Result<(), ReceiveError> {

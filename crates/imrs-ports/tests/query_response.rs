@@ -180,3 +180,40 @@ fn call_all_returns_the_first_answer_and_keeps_the_later_ones() {
         (&mut cells_task).await.unwrap();
     });
 }
+
+#[test]
+fn a_transport_takes_a_query_and_answers_it_later_or_fails_the_querier_by_dropping_it() {
+    on_both_runtimes(|| async {
+        // A RESPONSE port whose answers come from elsewhere: its handler never runs.
+        let port = Port::<u32, u32, usage::Response>::declare(PortSpec::new("REMOTE", "BRIDGE"));
+        let mut bridge = port
+            .owner_responder(|_: &(), _: u32| unreachable!("the bridge takes every query"))
+            .unwrap();
+        let mut asker = port.user_named("ASKER").unwrap();
+        let asking = tokio::spawn(async move {
+            let first = asker.query(20).await;
+            let second = asker.query(30).await;
+            (first, second)
+        });
+        std::future::poll_fn(|cx| bridge.poll_pending(cx))
+            .await
+            .unwrap();
+        let (query, reply) = bridge.take().unwrap();
+        assert_eq!(query, 20);
+        assert!(bridge.take().is_none(), "one query waits, and it is taken");
+        // Answered later, from elsewhere.
+        tokio::task::yield_now().await;
+        reply.reply(query + 1);
+        std::future::poll_fn(|cx| bridge.poll_pending(cx))
+            .await
+            .unwrap();
+        let (_, unanswered) = bridge.take().unwrap();
+        drop(unanswered);
+        let (first, second) = asking.await.unwrap();
+        assert_eq!(first.unwrap(), 21);
+        assert!(
+            matches!(second, Err(QueryError::NoResponse { ref port }) if port == "REMOTE"),
+            "{second:?}"
+        );
+    });
+}

@@ -3,6 +3,8 @@
 //! - `ipc_peer owner CELL PORT`: exports PORT (users ASKER and ASKER_2, two at most), and
 //!   answers each number with its double, after waiting the number's milliseconds if it is
 //!   over 1000 (so that a test can catch it mid-rendezvous). Prints `ready` once exported.
+//! - `ipc_peer responder CELL PORT`: exports the `RESPONSE` port PORT (user ASKER), whose
+//!   response handler answers each number with its triple. Prints `ready` once exported.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -10,7 +12,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
-use imrs_ipc::{Remote, ZeroCopySend, export, import};
+use imrs_ipc::{Remote, ZeroCopySend, export, export_response, import};
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
@@ -30,8 +32,12 @@ fn main() -> ExitCode {
     let result = runtime.block_on(async {
         match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
             ["owner", cell, port] => owner(cell, port).await,
+            ["responder", cell, port] => responder(cell, port).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
-            _ => Err("usage: ipc_peer owner CELL PORT | user CELL PORT MODULE N".into()),
+            _ => Err(
+                "usage: ipc_peer owner CELL PORT | responder CELL PORT | user CELL PORT MODULE N"
+                    .into(),
+            ),
         }
     });
     match result {
@@ -59,6 +65,21 @@ async fn owner(cell: &str, port: &str) -> Result<(), Error> {
         reply.reply(Number {
             value: 2 * number.value,
         });
+    }
+}
+
+async fn responder(cell: &str, port: &str) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::Response, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "TRIPLER").user_list(["ASKER"]));
+    let _exported = export_response(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    // The module's state: the factor its handler answers with.
+    let factor = 3;
+    let mut responder = port.owner_responder(|factor: &u64, number: Number| Number {
+        value: factor * number.value,
+    })?;
+    loop {
+        responder.serve(&factor).await?;
     }
 }
 
