@@ -71,7 +71,6 @@ struct Driver {
 }
 
 /// The arm module for `name` (the scheduler's robot `index`).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn arm_module(
     name: &str,
     index: usize,
