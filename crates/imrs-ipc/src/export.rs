@@ -22,7 +22,7 @@ use crate::{IpcError, Remote, Wire};
 type Active<Req, Rep> = ActiveRequest<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 
 /// A remote module's end of the real port, through which its requests go in.
-trait Forward<Req, Rep>: Send + 'static {
+pub(crate) trait Forward<Req, Rep>: Send + 'static {
     /// The request, as the module's primitive on this port; its reply, or `None`.
     fn forward(&mut self, request: Req) -> impl Future<Output = Option<Rep>> + Send + '_;
 }
@@ -36,6 +36,20 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
         self.query(request).await.ok()
+    }
+}
+
+/// Why a remote module could not be attached.
+pub(crate) enum Refusal {
+    /// The port's own wiring error.
+    Wire(WireError),
+    /// Something else failed (a relay back to the module's process).
+    Failed,
+}
+
+impl From<WireError> for Refusal {
+    fn from(error: WireError) -> Self {
+        Self::Wire(error)
     }
 }
 
@@ -72,7 +86,7 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
     bridge(remote, Name::from(&port), move |module: &str| {
-        port.user_named(module)
+        Ok(port.user_named(module)?)
     })
 }
 
@@ -85,16 +99,20 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
     bridge(remote, Name::from(&port), move |module: &str| {
-        port.user_named(module)
+        Ok(port.user_named(module)?)
     })
 }
 
-fn bridge<Req, Rep, E, A>(remote: &Remote, name: Name, mut attach: A) -> Result<Exported, IpcError>
+pub(crate) fn bridge<Req, Rep, E, A>(
+    remote: &Remote,
+    name: Name,
+    mut attach: A,
+) -> Result<Exported, IpcError>
 where
     Req: Wire,
     Rep: Wire,
     E: Forward<Req, Rep>,
-    A: FnMut(&str) -> Result<E, WireError> + Send + 'static,
+    A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
 {
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
@@ -149,7 +167,7 @@ type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 /// One request from another process.
 fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     active: Active<Req, Rep>,
-    attach: &mut impl FnMut(&str) -> Result<E, WireError>,
+    attach: &mut impl FnMut(&str) -> Result<E, Refusal>,
     users: &mut Users<E>,
     runtime: &tokio::runtime::Handle,
     notifier: &Arc<Mutex<Notifier<Svc>>>,
@@ -191,7 +209,7 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
 /// The end of remote module `module`, attached at its first request; or the status of the
 /// port's refusal.
 fn user<E>(
-    attach: &mut impl FnMut(&str) -> Result<E, WireError>,
+    attach: &mut impl FnMut(&str) -> Result<E, Refusal>,
     users: &mut Users<E>,
     module: &str,
 ) -> Result<Arc<tokio::sync::Mutex<E>>, (u32, u32)> {
@@ -204,8 +222,8 @@ fn user<E>(
             users.insert(module.to_owned(), Arc::clone(&end));
             Ok(end)
         }
-        Err(WireError::NotOnUserList { .. }) => Err((NOT_ON_USER_LIST, 0)),
-        Err(WireError::TooManyUsers { capacity, .. }) => {
+        Err(Refusal::Wire(WireError::NotOnUserList { .. })) => Err((NOT_ON_USER_LIST, 0)),
+        Err(Refusal::Wire(WireError::TooManyUsers { capacity, .. })) => {
             Err((TOO_MANY_USERS, u32::try_from(capacity).unwrap_or(u32::MAX)))
         }
         Err(_) => Err((REFUSED, 0)),

@@ -34,19 +34,33 @@ const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 /// A port imported from another process, and its bridge: usable while this is held.
 pub struct Imported<Req: Wire, Rep: Wire, U: Usage = usage::Receive> {
     port: Port<Req, Rep, U, AnyUser, 1>,
+    /// Whatever keeps the bridge working: dropped, it stops.
+    _bridge: Mutex<Box<dyn Send>>,
+}
+
+/// The forwarder and the waiter of one port's requests into another process: working
+/// while this is held.
+pub(crate) struct Relay {
     stop: Arc<AtomicBool>,
     waiter: Option<JoinHandle<()>>,
     forwarder: tokio::task::JoinHandle<()>,
 }
 
 impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
+    pub(crate) fn new(port: Port<Req, Rep, U, AnyUser, 1>, bridge: impl Send + 'static) -> Self {
+        Self {
+            port,
+            _bridge: Mutex::new(Box::new(bridge)),
+        }
+    }
+
     /// The local port: attach the importing module to it as to any port.
     pub fn port(&self) -> &Port<Req, Rep, U, AnyUser, 1> {
         &self.port
     }
 }
 
-impl<Req: Wire, Rep: Wire, U: Usage> Drop for Imported<Req, Rep, U> {
+impl Drop for Relay {
     fn drop(&mut self) {
         self.forwarder.abort();
         self.stop.store(true, Ordering::Release);
@@ -100,7 +114,7 @@ pub fn import_response<Req: Wire, Rep: Wire>(
 
 /// The local owner's side of an imported port: where the bridge takes each request, and
 /// the right to answer it.
-trait Take<Req, Rep>: Send + 'static {
+pub(crate) trait Take<Req, Rep>: Send + 'static {
     /// The next request, or `None` once the port is done.
     fn next(&mut self) -> impl Future<Output = Option<(Req, ReplyHandle<Rep>)>> + Send + '_;
 }
@@ -138,6 +152,27 @@ where
     T: Take<Req, Rep>,
 {
     let name = Name::from(port);
+    let local: Port<Req, Rep, U, AnyUser, 1> =
+        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
+    let taken = own(&local).map_err(IpcError::Local)?;
+    let relay = relay(remote, &name, module, taken)?;
+    Ok(Imported::new(local, relay))
+}
+
+/// Relays what `taken` takes to port `name`'s owner in another process, as module
+/// `module`, and hands each reply back; connects first. Call it within a tokio runtime.
+pub(crate) fn relay<Req, Rep, T>(
+    remote: &Remote,
+    name: &Name,
+    module: &str,
+    mut taken: T,
+) -> Result<Relay, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    T: Take<Req, Rep>,
+{
+    let name = name.clone();
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
         detail: "import it from within the tokio runtime its cell runs on".into(),
@@ -157,9 +192,6 @@ where
     let wake_self = channel.notifier(&channel.replied)?;
     connect(&client, &listener, &wake_owner, &name, module)?;
 
-    let local: Port<Req, Rep, U, AnyUser, 1> =
-        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
-    let mut taken = own(&local).map_err(IpcError::Local)?;
     let (pending_tx, pending_rx) = mpsc::channel::<(Pending<Req, Rep>, ReplyHandle<Rep>)>();
     let stop = Arc::new(AtomicBool::new(false));
 
@@ -200,8 +232,7 @@ where
             let _ = wake.1.notify();
         }
     });
-    Ok(Imported {
-        port: local,
+    Ok(Relay {
         stop,
         waiter: Some(waiter),
         forwarder,
@@ -209,7 +240,7 @@ where
 }
 
 /// The handshake: the owner attaches `module` to its port, or refuses it by name.
-fn connect<Req: Wire, Rep: Wire>(
+pub(crate) fn connect<Req: Wire, Rep: Wire>(
     client: &Asker<Req, Rep>,
     listener: &Listener<Svc>,
     wake_owner: &Notifier<Svc>,

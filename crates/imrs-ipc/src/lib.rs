@@ -28,7 +28,9 @@
 //!
 //! Ports whose owner receives cross with [`export`] and [`import`]; `RESPONSE` ports, whose
 //! users query them, with [`export_response`] and [`import_response`] — a remote query
-//! waits for the owner's response handler, which runs when the owner's order says.
+//! waits for the owner's response handler, which runs when the owner's order says. `SENDALL`
+//! ports cross with [`export_send_all`] and [`import_send_all`]: the owner's broadcast
+//! reaches modules in other processes, and their replies come back.
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
@@ -54,11 +56,13 @@ mod bridge;
 mod error;
 mod export;
 mod import;
+mod send_all;
 mod wire;
 
 pub use error::IpcError;
 pub use export::{Exported, export, export_response};
 pub use import::{Imported, import, import_response};
+pub use send_all::{export_send_all, import_send_all};
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;

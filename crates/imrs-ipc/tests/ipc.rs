@@ -67,24 +67,27 @@ fn owner(cell: &str, port: &str) -> Peer {
 }
 
 /// Starts a user process: module `module` asks the doubles of 1..=`n` on `cell`'s DOUBLE.
-fn user(cell: &str, module: &str, n: &str) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_ipc_peer"))
-        .args(["user", cell, "DOUBLE", module, n])
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("the user starts")
+fn user(cell: &str, module: &str, n: &str) -> Peer {
+    peer(&["user", cell, "DOUBLE", module, n])
 }
 
-/// Waits for a user process to end; its answers, one a line. Fails the test if it failed.
-async fn answers(user: Child) -> Vec<u64> {
-    let output = within(30, async {
-        tokio::task::spawn_blocking(move || user.wait_with_output()).await
-    })
-    .await
-    .unwrap()
-    .unwrap();
-    let text = String::from_utf8_lossy(&output.stdout).into_owned();
-    assert!(output.status.success(), "{text}");
+/// Waits for a peer process to end; its answers, one a line. Fails the test if it failed,
+/// or if it is still running after 30 s — then it is killed, so nothing hangs.
+async fn answers(mut peer: Peer) -> Vec<u64> {
+    let deadline = tokio::time::Instant::now() + Duration::from_secs(30);
+    let status = loop {
+        if let Some(status) = peer.0.try_wait().unwrap() {
+            break status;
+        }
+        assert!(
+            tokio::time::Instant::now() < deadline,
+            "a peer process hung"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut peer.0.stdout.take().unwrap(), &mut text).unwrap();
+    assert!(status.success(), "{text}");
     text.lines().map(|line| line.parse().unwrap()).collect()
 }
 
@@ -112,7 +115,7 @@ async fn a_send_crosses_to_the_owners_process_and_its_reply_comes_back() {
 async fn two_user_processes_are_served_at_once() {
     let cell = cell("users");
     let _owner = owner(&cell, "DOUBLE");
-    let users: Vec<Child> = ["ASKER", "ASKER_2"]
+    let users: Vec<Peer> = ["ASKER", "ASKER_2"]
         .iter()
         .map(|module| user(&cell, module, "100"))
         .collect();
@@ -457,7 +460,7 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut owner = port.owner().unwrap();
     // The user's first request is here; kill -9 it before the reply.
-    let mut first = Peer(user(&cell, "ASKER", "5"));
+    let mut first = user(&cell, "ASKER", "5");
     let (number, reply) = within(10, owner.receive()).await.unwrap();
     assert_eq!(number.value, 1);
     first.0.kill().unwrap();
@@ -504,4 +507,39 @@ async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
             module: "OTHER".into(),
         })
     );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_back() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    let cell = cell("send-all");
+    let port: Port<Number, Number, usage::SendAll, AnyUser, 2> =
+        Port::declare(PortSpec::new("NEWS", "BROADCASTER").user_list(["ASKER", "ASKER_2"]));
+    let _exported = imrs_ipc::export_send_all(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut broadcaster = port.owner().unwrap();
+    let listeners: Vec<Peer> = ["ASKER", "ASKER_2"]
+        .iter()
+        .map(|module| peer(&["listener", &cell, "NEWS", module, "20"]))
+        .collect();
+    // Both listeners' ends are attached when their processes connect.
+    within(10, async {
+        while broadcaster.peers().len() < 2 {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    for value in 1..=20 {
+        let mut broadcast = within(5, broadcaster.send_all(Number { value }))
+            .await
+            .unwrap();
+        assert_eq!(broadcast.first.value, 2 * value);
+        let (second, reply) = within(5, broadcast.next_reply()).await.unwrap();
+        assert_ne!(second, broadcast.from, "each listener answers once");
+        assert_eq!(reply.value, 2 * value);
+        assert!(within(5, broadcast.next_reply()).await.is_none());
+    }
+    for listener in listeners {
+        assert_eq!(answers(listener).await, (1..=20).collect::<Vec<_>>());
+    }
 }

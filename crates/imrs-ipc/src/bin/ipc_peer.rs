@@ -5,6 +5,8 @@
 //!   over 1000 (so that a test can catch it mid-rendezvous). Prints `ready` once exported.
 //! - `ipc_peer responder CELL PORT`: exports the `RESPONSE` port PORT (user ASKER), whose
 //!   response handler answers each number with its triple. Prints `ready` once exported.
+//! - `ipc_peer listener CELL PORT MODULE N`: imports the `SENDALL` port PORT (owner
+//!   BROADCASTER) for MODULE, answers N broadcasts with their doubles, printing each.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -12,7 +14,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
-use imrs_ipc::{Remote, ZeroCopySend, export, export_response, import};
+use imrs_ipc::{Remote, ZeroCopySend, export, export_response, import, import_send_all};
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
@@ -33,9 +35,10 @@ fn main() -> ExitCode {
         match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
             ["owner", cell, port] => owner(cell, port).await,
             ["responder", cell, port] => responder(cell, port).await,
+            ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
-                "usage: ipc_peer owner CELL PORT | responder CELL PORT | user CELL PORT MODULE N"
+                "usage: ipc_peer owner|responder CELL PORT | user|listener CELL PORT MODULE N"
                     .into(),
             ),
         }
@@ -81,6 +84,20 @@ async fn responder(cell: &str, port: &str) -> Result<(), Error> {
     loop {
         responder.serve(&factor).await?;
     }
+}
+
+async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
+    let imported =
+        import_send_all::<Number, Number>(&Remote::new(cell)?, port, "BROADCASTER", module)?;
+    let mut listening = imported.port().user_named(module)?;
+    for _ in 0..n.parse::<u64>()? {
+        let (number, reply) = listening.receive().await?;
+        println!("{}", number.value);
+        reply.reply(Number {
+            value: 2 * number.value,
+        });
+    }
+    Ok(())
 }
 
 async fn user(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {

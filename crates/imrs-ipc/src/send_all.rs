@@ -1,0 +1,117 @@
+//! `SENDALL` ports across processes: the owner's broadcast reaches user modules in other
+//! processes. Here the owner starts each rendezvous, so the bridges swap roles: a user
+//! module's process serves a service of its own, `PORT/to/MODULE`, and the owner's process
+//! relays to it whatever that module's end of the real port receives.
+
+use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireError, usage};
+
+use crate::bridge::Channel;
+use crate::export::{Forward, Refusal, bridge};
+use crate::import::{Relay, connect, relay};
+use crate::{Exported, Imported, IpcError, Remote, Wire};
+
+/// The service a remote user module is served on.
+fn to_module(port: &Name, module: &str) -> Name {
+    Name::from(format!("{port}/to/{module}"))
+}
+
+/// On the owner's side, a remote user module's relay. Users of a `SENDALL` port do not
+/// send on it: a request from one is answered with no reply.
+struct Relayed {
+    /// Relays while held.
+    _relay: Relay,
+}
+
+impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for Relayed {
+    async fn forward(&mut self, _: Req) -> Option<Rep> {
+        None
+    }
+}
+
+/// On a user's side, the local port's owner end: each broadcast from the other process is
+/// sent to the one local user, whose reply goes back.
+impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::SendAll> {
+    async fn forward(&mut self, request: Req) -> Option<Rep> {
+        // The owner counts the module attached from its connection; here it attaches to the
+        // local port a moment later. A broadcast that comes in between waits for it, as it
+        // would have reached it in one process. (A short wait, checked each millisecond:
+        // only between the connection and the module's attaching.)
+        while self.peers().is_empty() {
+            tokio::time::sleep(std::time::Duration::from_millis(1)).await;
+        }
+        let broadcast = self.send_all(request).await.ok()?;
+        Some(broadcast.first)
+    }
+}
+
+/// Exports `port`, a `SENDALL` port, to the other processes of `remote`'s cell: its owner's
+/// broadcasts reach their modules too, each of which answers as a user in this process
+/// would. Call it within the tokio runtime the cell runs on.
+pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Req, Rep, usage::SendAll, L, N>,
+) -> Result<Exported, IpcError> {
+    let name = Name::from(port);
+    let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
+        port: name.clone(),
+        detail: "export it from within the tokio runtime its cell runs on".into(),
+    })?;
+    let (port, owner, cell) = (port.clone(), port.owner_module().clone(), remote.clone());
+    let served = name.clone();
+    bridge::<Req, Rep, _, _>(remote, name, move |module: &str| {
+        // The module's own end of the real port: what it receives goes to its process.
+        let end = port.user_named(module)?;
+        let _entered = runtime.enter();
+        relay(&cell, &to_module(&served, module), owner.as_str(), end)
+            .map(|relay| Relayed { _relay: relay })
+            .map_err(|_| Refusal::Failed)
+    })
+}
+
+/// Imports a `SENDALL` port of another process for module `module` of this one: a port of
+/// the same name and types, to which `module` attaches and receives the owner's
+/// broadcasts as in one process. Connects at once, refused as [`crate::import`] is. Call it
+/// within the tokio runtime the cell runs on.
+pub fn import_send_all<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, usage::SendAll>, IpcError> {
+    let name = Name::from(port);
+    let local: Port<Req, Rep, usage::SendAll, AnyUser, 1> =
+        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
+    // First the service the owner's process will relay to, so that it is there when the
+    // owner answers the connection by relaying.
+    let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
+    let server = bridge(
+        remote,
+        to_module(&name, module),
+        move |relay_module: &str| {
+            if relay_module != expected.as_str() {
+                return Err(Refusal::Wire(WireError::NotOnUserList {
+                    port: port_name.clone(),
+                    module: relay_module.into(),
+                }));
+            }
+            Ok(serving.owner()?)
+        },
+    )?;
+    let channel = Channel::<Req, Rep>::open(remote, &name)?;
+    let client =
+        channel
+            .service
+            .client_builder()
+            .create()
+            .map_err(|error| IpcError::Transport {
+                port: name.clone(),
+                detail: format!("no room for another process ({error:?})"),
+            })?;
+    let listener = channel.listener(&channel.replied)?;
+    let wake_owner = channel.notifier(&channel.requested)?;
+    connect(&client, &listener, &wake_owner, &name, module)?;
+    Ok(Imported::new(
+        local,
+        (server, channel, client, listener, wake_owner),
+    ))
+}
