@@ -62,14 +62,7 @@ fn main() {
         .expect("the peer speaks");
     assert_eq!(line.trim(), "ready", "the peer failed: {line}");
 
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        // A 64 KiB message is copied by value through the bridges' futures: more than
-        // tokio's 2 MiB default stack holds in a debug build.
-        .thread_stack_size(32 << 20)
-        .enable_all()
-        .build()
-        .expect("a tokio runtime");
+    let runtime = runtime();
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds);
     let (imrs_small, imrs_large) = runtime.block_on(async {
@@ -106,6 +99,18 @@ fn main() {
     );
 }
 
+/// Each process's runtime: two workers, with stacks large enough for 64 KiB messages, which
+/// the bridges' futures copy by value — more than tokio's 2 MiB default holds in a debug
+/// build.
+fn runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .thread_stack_size(32 << 20)
+        .enable_all()
+        .build()
+        .expect("a tokio runtime")
+}
+
 fn percentiles(times: &[Duration]) -> [Duration; 3] {
     let mut sorted = times.to_vec();
     sorted.sort_unstable();
@@ -122,14 +127,7 @@ fn peer(cell: &str) {
             _ => raw_server::<Large>(&cell, part),
         });
     }
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        // A 64 KiB message is copied by value through the bridges' futures: more than
-        // tokio's 2 MiB default stack holds in a debug build.
-        .thread_stack_size(32 << 20)
-        .enable_all()
-        .build()
-        .expect("a tokio runtime");
+    let runtime = runtime();
     runtime.block_on(async {
         let remote = Remote::new(cell).expect("a cell name");
         let small = echo::<Small>(&remote, "SMALL");

@@ -177,20 +177,13 @@ where
         port: name.clone(),
         detail: "import it from within the tokio runtime its cell runs on".into(),
     })?;
-    let channel = Channel::<Req, Rep>::open(remote, &name)?;
-    let client =
-        channel
-            .service
-            .client_builder()
-            .create()
-            .map_err(|error| IpcError::Transport {
-                port: name.clone(),
-                detail: format!("no room for another process ({error:?})"),
-            })?;
-    let listener = channel.listener(&channel.replied)?;
-    let wake_owner = channel.notifier(&channel.requested)?;
+    let Connection {
+        channel,
+        client,
+        listener,
+        wake_owner,
+    } = connect(remote, &name, module)?;
     let wake_self = channel.notifier(&channel.replied)?;
-    connect(&client, &listener, &wake_owner, &name, module)?;
 
     let (pending_tx, pending_rx) = mpsc::channel::<(Pending<Req, Rep>, ReplyHandle<Rep>)>();
     let stop = Arc::new(AtomicBool::new(false));
@@ -239,8 +232,45 @@ where
     })
 }
 
-/// The handshake: the owner attaches `module` to its port, or refuses it by name.
+/// A user process's connection to a port's owner: the services, the client, and the
+/// event ports to wait for replies and to wake the owner.
+pub(crate) struct Connection<Req: Wire, Rep: Wire> {
+    pub(crate) channel: Channel<Req, Rep>,
+    pub(crate) client: Asker<Req, Rep>,
+    pub(crate) listener: Listener<Svc>,
+    pub(crate) wake_owner: Notifier<Svc>,
+}
+
+/// Opens port `name` of `remote` as a client and connects as module `module`: the owner
+/// attaches it to its port, or refuses it by name.
 pub(crate) fn connect<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    name: &Name,
+    module: &str,
+) -> Result<Connection<Req, Rep>, IpcError> {
+    let channel = Channel::<Req, Rep>::open(remote, name)?;
+    let client =
+        channel
+            .service
+            .client_builder()
+            .create()
+            .map_err(|error| IpcError::Transport {
+                port: name.clone(),
+                detail: format!("no room for another process ({error:?})"),
+            })?;
+    let listener = channel.listener(&channel.replied)?;
+    let wake_owner = channel.notifier(&channel.requested)?;
+    handshake(&client, &listener, &wake_owner, name, module)?;
+    Ok(Connection {
+        channel,
+        client,
+        listener,
+        wake_owner,
+    })
+}
+
+/// The handshake: the owner attaches `module` to its port, or refuses it by name.
+fn handshake<Req: Wire, Rep: Wire>(
     client: &Asker<Req, Rep>,
     listener: &Listener<Svc>,
     wake_owner: &Notifier<Svc>,

@@ -5,7 +5,6 @@
 
 use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireError, usage};
 
-use crate::bridge::Channel;
 use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
@@ -97,21 +96,7 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
             Ok(serving.owner()?)
         },
     )?;
-    let channel = Channel::<Req, Rep>::open(remote, &name)?;
-    let client =
-        channel
-            .service
-            .client_builder()
-            .create()
-            .map_err(|error| IpcError::Transport {
-                port: name.clone(),
-                detail: format!("no room for another process ({error:?})"),
-            })?;
-    let listener = channel.listener(&channel.replied)?;
-    let wake_owner = channel.notifier(&channel.requested)?;
-    connect(&client, &listener, &wake_owner, &name, module)?;
-    Ok(Imported::new(
-        local,
-        (server, channel, client, listener, wake_owner),
-    ))
+    // Then the connection, which keeps the module attached on the owner's side.
+    let connection = connect::<Req, Rep>(remote, &name, module)?;
+    Ok(Imported::new(local, (server, connection)))
 }

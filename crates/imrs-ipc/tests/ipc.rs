@@ -543,3 +543,47 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
         assert_eq!(answers(listener).await, (1..=20).collect::<Vec<_>>());
     }
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    let cell = cell("full");
+    // Room for one user, whoever it is.
+    let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new("SINGLE", "OWNER"));
+    let remote = Remote::new(&cell).unwrap();
+    let _exported = imrs_ipc::export(&remote, &port).unwrap();
+    let _first = import::<Number, Number>(&remote, "SINGLE", "OWNER", "FIRST").unwrap();
+    let error = import::<Number, Number>(&remote, "SINGLE", "OWNER", "SECOND")
+        .err()
+        .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::Refused(WireError::TooManyUsers {
+            port: "SINGLE".into(),
+            module: "SECOND".into(),
+            capacity: 1,
+        })
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() {
+    let cell = cell("dropped");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    // The owner takes 1.2 s over 1200; the sender gives up after 200 ms, dropping the send.
+    let gave_up = tokio::time::timeout(
+        Duration::from_millis(200),
+        asker.send(Number { value: 1200 }),
+    )
+    .await;
+    assert!(gave_up.is_err(), "{gave_up:?}");
+    // The next send waits for the owner to be done with the dropped one, then gets its own
+    // reply, not the late 2400.
+    let reply = within(5, asker.send(Number { value: 7 })).await.unwrap();
+    assert_eq!(reply.value, 14);
+}
