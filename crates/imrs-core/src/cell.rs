@@ -140,6 +140,22 @@ impl Cell {
         lock(&self.shared.wiring).declare(port)
     }
 
+    /// Makes known to the cell a port whose owner runs in another process (a port imported
+    /// by a transport such as `imrs-ipc`): the modules of this process that use it are
+    /// checked as for any port, and its owner is checked in the process it runs in.
+    pub fn declare_imported<Req, Rep, U, L, const N: usize>(
+        &self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<(), WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        L: UserList,
+    {
+        lock(&self.shared.wiring).declare_elsewhere(port)
+    }
+
     /// Makes a filtered port known to the cell: the users' side under the port's name, and
     /// the owner's side as `PORT.FILTER`.
     pub fn declare_filtered<Req, Rep, F, FReq, FRep, O, L, const N: usize>(

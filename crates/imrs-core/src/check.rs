@@ -287,7 +287,7 @@ fn check_owners(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<Cell
         let owner_side_of_filter = port.as_str().ends_with(".FILTER");
         let claimed = owners.get(port).map(Vec::as_slice).unwrap_or_default();
         match claimed {
-            [] if owner_side_of_filter => {}
+            [] if owner_side_of_filter || wiring.owned_elsewhere(port.as_str()) => {}
             [] => problems.push(CellError::NoOwner {
                 port: port.clone(),
                 declared_owner: info.owner,

@@ -193,3 +193,28 @@ fn two_modules_of_one_name_are_refused() {
         }]
     );
 }
+
+#[test]
+fn a_port_owned_in_another_process_needs_no_owner_here_but_its_users_are_still_checked() {
+    let cell = cell();
+    // As a transport imports it: the owner, ARBITER, runs in another process.
+    let imported = Port::<u32, (), usage::Receive>::declare(
+        PortSpec::new("ZONE", "ARBITER").user_list(["ROBOT"]),
+    );
+    cell.declare_imported(&imported).unwrap();
+    // A port of this process that nobody owns is still a problem.
+    cell.declare(&Port::<u32, (), usage::Receive>::declare(PortSpec::new(
+        "ORPHAN", "GHOST",
+    )))
+    .unwrap();
+    let modules = [
+        decl(ModuleSpec::new("ROBOT", ()).uses_named("ZONE", UsageKind::Send)),
+        // Not on the imported port's user list: refused here, as in one process.
+        decl(ModuleSpec::new("INTRUDER", ()).uses_named("ZONE", UsageKind::Send)),
+    ];
+    let problems = cell.check(&modules).unwrap_err().to_string();
+    assert!(!problems.contains("port ZONE has no owner"), "{problems}");
+    assert!(problems.contains("port ORPHAN has no owner"), "{problems}");
+    assert!(problems.contains("INTRUDER"), "{problems}");
+    assert!(!problems.contains("module ROBOT"), "{problems}");
+}

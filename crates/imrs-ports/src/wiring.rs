@@ -2,7 +2,7 @@
 //! time"), for modules compiled apart from the ports they use.
 
 use std::any::{Any, TypeId, type_name};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::sync::Arc;
 
@@ -65,6 +65,8 @@ where
 #[derive(Default)]
 pub struct Wiring {
     ports: BTreeMap<Name, Box<dyn Declared>>,
+    /// Ports whose owner runs in another process: their owner is checked there.
+    elsewhere: BTreeSet<Name>,
     problems: Vec<WireError>,
 }
 
@@ -95,6 +97,29 @@ impl Wiring {
         }
         self.ports.insert(name, Box::new(port.clone()));
         Ok(())
+    }
+
+    /// Makes `port` known by its name, as [`Wiring::declare`] does, for a port whose owner
+    /// runs in another process (a transport's imported port): its users are checked here,
+    /// its owner in its own process.
+    pub fn declare_elsewhere<Req, Rep, U, L, const N: usize>(
+        &mut self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<(), WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        L: UserList,
+    {
+        self.declare(port)?;
+        self.elsewhere.insert(port.name().clone());
+        Ok(())
+    }
+
+    /// Whether `port` was declared as owned in another process.
+    pub fn owned_elsewhere(&self, port: &str) -> bool {
+        self.elsewhere.iter().any(|name| name.as_str() == port)
     }
 
     /// Attaches module `module` to port `port` with usage `U` and message types `Req`/`Rep`,
