@@ -4,6 +4,7 @@
 //! cargo run --release --example chip_cell -- [--hours H] [--seed S]
 //!     [--feeder arbiter|appendix] [--realtime] [--tree] [--fault KIND[:WHICH]@TIME]...
 //!     [--record FILE.mcap] [--timeline FILE.svg [--timeline-from S] [--timeline-span S]]
+//!     [--processes [--speed X]]
 //! ```
 //!
 //! `--help` lists every flag. `RUST_LOG=imrs=debug` shows the events and spans the core
@@ -13,6 +14,7 @@ use std::process::ExitCode;
 
 use std::io::{self, IsTerminal, Write};
 
+use cell_example::processes::run_line;
 use cell_example::{CellConfig, FeederPolicy, Report, parse, run, speed_line};
 use tracing_subscriber::EnvFilter;
 
@@ -35,6 +37,16 @@ fn main() -> ExitCode {
             return ExitCode::from(refused.status);
         }
     };
+    // A line's process of a run across processes: the world that started it reports.
+    if let Some(line) = &config.line_process {
+        return match run_line(&config, line) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(problem) => {
+                eprintln!("{problem}");
+                ExitCode::FAILURE
+            }
+        };
+    }
     let (report, tree) = match run(&config) {
         Ok(record) => (
             Report::of(&record),
@@ -80,6 +92,12 @@ fn main() -> ExitCode {
 /// Writes the report, then the other feeder policies' beside it, to `out`.
 fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::Result<()> {
     write!(out, "{report}")?;
+    if config.processes {
+        // The other policies do not run across processes: see `cell_example::processes`.
+        writeln!(out)?;
+        writeln!(out, "{}", speed_line(report))?;
+        return out.flush();
+    }
     // The other feeder policies, same seed, hours and faults, for the side-by-side table.
     let mut reports = Vec::new();
     for policy in [

@@ -8,17 +8,16 @@ use imrs_coord::zones::{Reservations, Sweep};
 use imrs_sim::imrs_core::imrs_ports::{End, ReplyHandle, select, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::layout::LINK_RADIUS;
-use imrs_sim::{
-    DeviceError, FEEDER_CHIPS, FeederId, Line, Robot, RobotId, Role, Sim, Station, Target,
-};
+use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station, Target};
 
 use crate::alarms::{AlarmKind, alarm};
+use crate::devices::{Devices, RobotDevice};
 use crate::help::{drive_relay, insisted, retried};
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
 };
-use crate::ports::{CellPorts, ZonePort};
+use crate::ports::{CellPorts, ModuleName, ZoneLink};
 
 /// How the two chip robots share the feeder zone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -124,12 +123,12 @@ pub struct ChipItState {
 enum Access {
     Appendix(End<(), i32, usage::Query>),
     Arbiter {
-        request: End<String, (), usage::Send>,
-        release: End<String, (), usage::Send>,
+        request: End<ModuleName, (), usage::Send>,
+        release: End<ModuleName, (), usage::Send>,
     },
     Coordinator {
         reserve: End<(String, Sweep), (), usage::Send>,
-        free: End<String, (), usage::Send>,
+        free: End<ModuleName, (), usage::Send>,
     },
 }
 
@@ -145,9 +144,10 @@ impl Access {
             Access::Appendix(share_feeder) => {
                 matches!(ctx.query(share_feeder, ()).await, Ok(clear) if clear != 0)
             }
-            Access::Arbiter { request, .. } => {
-                ctx.send(request, ctx.module().to_string()).await.is_ok()
-            }
+            Access::Arbiter { request, .. } => ctx
+                .send(request, ModuleName::new(ctx.module().as_str()))
+                .await
+                .is_ok(),
             // The coordinator is asked per step, with the step's trajectory: see `reserve`.
             Access::Coordinator { .. } => return true,
         };
@@ -162,7 +162,7 @@ impl Access {
     async fn reserve(
         &mut self,
         ctx: &Ctx<ChipItState>,
-        robot: &Robot,
+        robot: &RobotDevice,
         step: ChipStep,
         waits: &SharedWaits,
     ) -> Result<(), DeviceError> {
@@ -196,7 +196,11 @@ impl Access {
             Access::Coordinator { free, .. } => free,
             Access::Appendix(_) => return,
         };
-        while ctx.send(release, ctx.module().to_string()).await.is_err() {
+        while ctx
+            .send(release, ModuleName::new(ctx.module().as_str()))
+            .await
+            .is_err()
+        {
             ctx.delay(Duration::from_secs(1)).await;
         }
     }
@@ -207,7 +211,7 @@ pub fn chip_it(
     line: Line,
     policy: FeederPolicy,
     ports: &CellPorts,
-    sim: &Sim,
+    devices: &Devices,
     waits: SharedWaits,
 ) -> ModuleSpec<ChipItState> {
     let n = LineNames::of(line);
@@ -276,7 +280,7 @@ pub fn chip_it(
     );
     let (zone_request, zone_release) = (ports.zone_request.clone(), ports.zone_release.clone());
     let (zone_reserve, zone_free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
-    let robot = sim.robot(RobotId::new(line, Role::ChipIt));
+    let robot = devices.robot(RobotId::new(line, Role::ChipIt));
     let name = n.chip_it.clone();
     let background = move |ctx: Ctx<ChipItState>| {
         let (ready_port, share_feeder, frequency) =
@@ -295,8 +299,8 @@ pub fn chip_it(
             let mut access = match policy {
                 FeederPolicy::Appendix => Access::Appendix(share_feeder.owner()?),
                 FeederPolicy::Arbiter => Access::Arbiter {
-                    request: zone_request.user_named(name.clone())?,
-                    release: zone_release.user_named(name.clone())?,
+                    request: zone_request.user_named(&name)?,
+                    release: zone_release.user_named(&name)?,
                 },
                 FeederPolicy::Coordinator => Access::Coordinator {
                     reserve: zone_reserve.user_named(name.clone())?,
@@ -345,7 +349,7 @@ pub fn chip_it(
     };
     let (freeze_port, relay) = (
         line_ports.ready_to_chip.clone(),
-        sim.relay(line, Station::Chip),
+        devices.relay(line, Station::Chip),
     );
     spec.task(n.chip_it.clone(), background)
         .task("FREEZE_CARD", move |ctx| {
@@ -379,7 +383,7 @@ fn record_wait(waits: &SharedWaits, line: Line, ok: bool, waited: f64) {
 /// One step: GRASP (enter the zone, grasp from the feeder, leave the zone), then INSERT.
 async fn chip_step(
     ctx: &Ctx<ChipItState>,
-    robot: &Robot,
+    robot: &RobotDevice,
     step: ChipStep,
     access: &mut Access,
     waits: &SharedWaits,
@@ -440,7 +444,7 @@ pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
                 loop {
                     enum Event {
                         Reserve(String, Sweep, ReplyHandle<()>),
-                        Free(String, ReplyHandle<()>),
+                        Free(ModuleName, ReplyHandle<()>),
                     }
                     let event = select()
                         .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
@@ -458,7 +462,7 @@ pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
                         }
                         Event::Free(robot, reply) => {
                             reply.reply(());
-                            for granted in space.release(&robot) {
+                            for granted in space.release(robot.as_str()) {
                                 if let Some(at) =
                                     asleep.iter().position(|(r, _)| granted == r.as_str())
                                 {
@@ -477,7 +481,7 @@ const SWEEP_MARGIN: f32 = 0.03;
 
 /// FEEDER_MONITOR: hands the feeder zone to one chip robot at a time.
 pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {
-    let (request, release): (ZonePort, ZonePort) =
+    let (request, release): (ZoneLink, ZoneLink) =
         (ports.zone_request.clone(), ports.zone_release.clone());
     ModuleSpec::new(FEEDER_MONITOR, ())
         .owns(ZONE_REQUEST)

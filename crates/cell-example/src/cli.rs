@@ -4,12 +4,15 @@
 use std::ffi::OsString;
 use std::fmt;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, UNIX_EPOCH};
 
 use clap::Parser;
+use imrs_sim::Line;
+use imrs_sim::imrs_core::imrs_ports::RealClock;
 
 use crate::chip::FeederPolicy;
 use crate::faults::CellFault;
+use crate::processes::{DEFAULT_SPEED, LineProcess};
 use crate::run::{CellConfig, MAX_HOURS, TimelineConfig};
 
 /// The chip-insertion cell of Shin (1985), Appendix, on two lines, with a report.
@@ -53,6 +56,39 @@ struct Flags {
     /// Show no progress bar (it is shown only on a terminal anyway).
     #[arg(long)]
     no_progress: bool,
+    /// Run across three processes: the world (simulation, devices, feeder arbiter) in this
+    /// one, each line's modules in its own, talking over iceoryx2; on the wall clock sped
+    /// up by --speed.
+    #[arg(long)]
+    processes: bool,
+    /// With --processes: how many times as fast as the wall clock the cell runs.
+    #[arg(long, value_name = "X", default_value_t = DEFAULT_SPEED, value_parser = speed, requires = "processes")]
+    speed: f64,
+    /// Set by the world on a line's process it starts: the line.
+    #[arg(long, hide = true, value_parser = line, requires_all = ["processes", "remote", "epoch"])]
+    line_process: Option<Line>,
+    /// Set by the world on a line's process: the cell's name on this host.
+    #[arg(long, hide = true, requires = "line_process")]
+    remote: Option<String>,
+    /// Set by the world on a line's process: when the cell's time is zero, in nanoseconds
+    /// since 1970.
+    #[arg(long, hide = true, requires = "line_process")]
+    epoch: Option<u64>,
+}
+
+fn speed(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|speed| speed.is_finite() && (1.0..=RealClock::MAX_SPEED).contains(speed))
+        .ok_or_else(|| format!("expected a speed-up from 1 to {}", RealClock::MAX_SPEED))
+}
+
+fn line(text: &str) -> Result<Line, String> {
+    match text {
+        "A" => Ok(Line::A),
+        "B" => Ok(Line::B),
+        _ => Err("expected A or B".into()),
+    }
 }
 
 fn hours(text: &str) -> Result<f64, String> {
@@ -116,6 +152,14 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         from: Duration::from_secs_f64(flags.timeline_from),
         span: Duration::from_secs_f64(flags.timeline_span),
     });
+    let line_process = match (flags.line_process, flags.remote, flags.epoch) {
+        (Some(line), Some(remote), Some(epoch)) => Some(LineProcess {
+            line,
+            remote,
+            epoch: UNIX_EPOCH + Duration::from_nanos(epoch),
+        }),
+        _ => None,
+    };
     Ok(CellConfig {
         hours: flags.hours,
         seed: flags.seed,
@@ -126,6 +170,9 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         show_tree: flags.tree,
         record: flags.record,
         timeline,
+        processes: flags.processes,
+        speed: flags.speed,
+        line_process,
         ..CellConfig::default()
     })
 }

@@ -4,9 +4,11 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
+use imrs_sim::Line;
 use imrs_sim::imrs_core::imrs_ports::{BoundedBuffer, Instant};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::{Line, Sim};
+
+use crate::devices::Devices;
 
 use crate::alarms::{AlarmKind, alarm};
 use crate::names::LineNames;
@@ -70,7 +72,7 @@ pub type SharedCycleTimes = Arc<Mutex<CycleTimeHistory>>;
 pub fn gate(
     line: Line,
     ports: &LinePorts,
-    sim: &Sim,
+    devices: &Devices,
     death: ReleaseDeath,
     history: SharedCycleTimes,
 ) -> ModuleSpec<GateState> {
@@ -84,7 +86,7 @@ pub fn gate(
     };
     let (let_1_go, frequency) = (ports.let_1_go.clone(), ports.frequency.clone());
     let (release_port, buffer_port) = (ports.let_1_go.clone(), ports.frequency.clone());
-    let device = sim.gate(line);
+    let device = devices.gate(line);
     ModuleSpec::new(n.gate.clone(), state)
         .order([timeout.clone(), n.gate.as_str().into()])
         .hardware([format!("gate relay and photocell of line {line:?}")])

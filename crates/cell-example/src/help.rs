@@ -5,9 +5,10 @@ use std::time::Duration;
 
 use imrs_sim::imrs_core::Ctx;
 use imrs_sim::imrs_core::imrs_ports::{End, usage};
-use imrs_sim::{DeviceError, PalletId, Relay};
+use imrs_sim::{DeviceError, PalletId};
 
 use crate::alarms::{AlarmKind, alarm};
+use crate::devices::RelayDevice;
 
 /// How long an operator takes to reset a faulted robot.
 pub const RESET_TIME: Duration = Duration::from_secs(1);
@@ -61,7 +62,7 @@ where
 /// A jammed pallet is taken off the line, with an alarm.
 pub async fn drive_relay<S>(
     ctx: &Ctx<S>,
-    relay: &Relay,
+    relay: &RelayDevice,
     port: &mut End<PalletId, (), usage::Send>,
 ) -> Result<(), DeviceError>
 where
@@ -79,13 +80,13 @@ where
                     );
                     ctx.delay(RESET_TIME).await;
                 }
-                if let Err(error @ DeviceError::Jam { .. }) = relay.release() {
+                if let Err(error @ DeviceError::Jam { .. }) = relay.release().await {
                     alarm(
                         ctx,
                         AlarmKind::Jam,
                         format!("{error}: taking the pallet off the line"),
                     );
-                    relay.clear_jam();
+                    relay.clear_jam().await;
                 }
             }
             Err(error @ DeviceError::Jam { .. }) => {
@@ -94,7 +95,7 @@ where
                     AlarmKind::Jam,
                     format!("{error}: taking the pallet off the line"),
                 );
-                relay.clear_jam();
+                relay.clear_jam().await;
             }
             Err(error) => return Err(error),
         }

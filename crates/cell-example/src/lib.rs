@@ -16,12 +16,14 @@
 pub mod alarms;
 pub mod chip;
 pub mod cli;
+pub mod devices;
 pub mod faults;
 pub mod gate;
 pub mod help;
 pub mod load;
 pub mod names;
 pub mod ports;
+pub mod processes;
 pub mod report;
 pub mod run;
 pub mod tally;

@@ -4,7 +4,9 @@
 use std::time::Duration;
 
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::{Line, RobotId, Role, Sim, Station, Target};
+use imrs_sim::{Line, RobotId, Role, Station, Target};
+
+use crate::devices::Devices;
 
 use crate::alarms::{AlarmKind, alarm};
 use crate::help::{drive_relay, insisted, retried};
@@ -33,14 +35,14 @@ pub struct LoadCardState {
 }
 
 /// The LOAD_IT module of `line`, which costarts LOAD_CARD and SCREW_IN_CARD.
-pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItState> {
+pub fn load_it(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<LoadItState> {
     let n = LineNames::of(line);
     let (timeout1, timeout2) = (
         ports.ask_child1.handler("TIMEOUT"),
         ports.ask_child2.handler("TIMEOUT"),
     );
     let ports = ports.clone();
-    let sim = sim.clone();
+    let devices = devices.clone();
     let (load_card_name, screw_name) = (n.load_card.clone(), n.screw_in_card.clone());
     ModuleSpec::new(n.load_it.clone(), LoadItState::default())
         .order([
@@ -52,15 +54,15 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
         .owns(&ports.ask_child2)
         .uses_named(n.frequency.clone(), UsageKind::Send)
         .task(n.load_it.clone(), move |ctx| {
-            let (ports, sim, n) = (ports.clone(), sim.clone(), n.clone());
+            let (ports, devices, n) = (ports.clone(), devices.clone(), n.clone());
             async move {
-                let (child_ports, child_sim) = (ports.clone(), sim.clone());
+                let (child_ports, child_devices) = (ports.clone(), devices.clone());
                 ctx.costart_supervised(CHILD_RESTARTS, move || {
-                    load_card(line, &child_ports, &child_sim)
+                    load_card(line, &child_ports, &child_devices)
                 })?;
-                let (child_ports, child_sim) = (ports.clone(), sim.clone());
+                let (child_ports, child_devices) = (ports.clone(), devices.clone());
                 ctx.costart_supervised(CHILD_RESTARTS, move || {
-                    screw_in_card(line, &child_ports, &child_sim)
+                    screw_in_card(line, &child_ports, &child_devices)
                 })?;
                 let mut ask_child1 = ports.ask_child1.owner()?;
                 let mut ask_child2 = ports.ask_child2.owner()?;
@@ -125,7 +127,7 @@ pub fn load_it(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadItSta
 }
 
 /// The LOAD_CARD module of `line`: its robot lays a card on each pallet.
-pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCardState> {
+pub fn load_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<LoadCardState> {
     let n = LineNames::of(line);
     let spec = ModuleSpec::new(n.load_card.clone(), LoadCardState::default())
         .order([
@@ -144,9 +146,9 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
             (0, card.num_loaded, card.cycle_time)
         });
     let (pallet_port, card_port) = (ports.pallet_in_place.clone(), ports.card_in_place.clone());
-    let robot = sim.robot(RobotId::new(line, Role::LoadCard));
+    let robot = devices.robot(RobotId::new(line, Role::LoadCard));
     let freeze_port = ports.pallet_in_place.clone();
-    let relay = sim.relay(line, Station::Load);
+    let relay = devices.relay(line, Station::Load);
     spec.task(n.load_card.clone(), move |ctx| {
         let (pallet_port, card_port, robot) =
             (pallet_port.clone(), card_port.clone(), robot.clone());
@@ -243,7 +245,7 @@ pub fn load_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<LoadCar
 }
 
 /// The SCREW_IN_CARD module of `line`: its robot screws each laid card to its pallet.
-pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()> {
+pub fn screw_in_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<()> {
     let n = LineNames::of(line);
     let timeout = ports.card_in_place.handler("TIMEOUT");
     let spec = ModuleSpec::new(n.screw_in_card.clone(), ())
@@ -257,7 +259,7 @@ pub fn screw_in_card(line: Line, ports: &LinePorts, sim: &Sim) -> ModuleSpec<()>
         // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
         .respond(&ports.ask_child2, "STATUS", |_: &(), ()| 0);
     let port = ports.card_in_place.clone();
-    let robot = sim.robot(RobotId::new(line, Role::ScrewInCard));
+    let robot = devices.robot(RobotId::new(line, Role::ScrewInCard));
     let name = n.screw_in_card.clone();
     spec.task(n.screw_in_card.clone(), move |ctx| {
         let (port, robot, name) = (port.clone(), robot.clone(), name.clone());

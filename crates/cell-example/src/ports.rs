@@ -1,11 +1,14 @@
 //! Every port of the cell, declared as the Appendix declares it, each showing its messages
 //! and replies in a recording (`--record`).
 
+use std::fmt;
+use std::sync::Arc;
 use std::time::Duration;
 
+use imrs_ipc::{Imported, ZeroCopySend};
 use imrs_sim::imrs_core::Cell;
 use imrs_sim::imrs_core::imrs_ports::{
-    AnyUser, BoundedBufferPort, Port, PortSpec, SharedClock, WireError, usage,
+    AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage,
 };
 use imrs_sim::{Line, PalletId};
 
@@ -31,8 +34,106 @@ pub type CardInPlace = Port<PalletId, i32, usage::Send>;
 pub type ReadyToChip = Port<PalletId, (), usage::Receive, AnyUser, 1>;
 /// SHARE_FEEDER(CLEAR: INTEGER): USAGE=QUERY, USERLIST=(twin), TIMEOUT=3 SEC.
 pub type ShareFeeder = Port<(), i32, usage::Query>;
-/// The arbiter's ports: a chip robot sends and waits until it may enter (or has left).
-pub type ZonePort = Port<String, (), usage::Receive, AnyUser, 2>;
+/// The arbiter's ports: a chip robot sends its name and waits until it may enter (or has
+/// left).
+pub type ZonePort = Port<ModuleName, (), usage::Receive, AnyUser, 2>;
+
+/// The longest module name a [`ModuleName`] holds.
+const MODULE_NAME: usize = 32;
+
+/// A module's name as a message that can cross processes: fixed-size and self-contained.
+#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("cell_example::ModuleName")]
+pub struct ModuleName {
+    len: u32,
+    bytes: [u8; MODULE_NAME],
+}
+
+impl ModuleName {
+    /// `name`, cut to its first 32 bytes (at a character's boundary).
+    pub fn new(name: &str) -> Self {
+        let mut len = name.len().min(MODULE_NAME);
+        while !name.is_char_boundary(len) {
+            len -= 1;
+        }
+        let mut bytes = [0; MODULE_NAME];
+        bytes[..len].copy_from_slice(&name.as_bytes()[..len]);
+        Self {
+            len: len as u32,
+            bytes,
+        }
+    }
+
+    /// The name; empty if a peer wrote a record that is not one.
+    pub fn as_str(&self) -> &str {
+        let len = usize::try_from(self.len).unwrap_or(usize::MAX);
+        self.bytes
+            .get(..len)
+            .and_then(|bytes| std::str::from_utf8(bytes).ok())
+            .unwrap_or("")
+    }
+}
+
+impl fmt::Debug for ModuleName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.as_str(), f)
+    }
+}
+
+impl fmt::Display for ModuleName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Where a chip robot finds the arbiter's port: declared in this process, or imported from
+/// the process the arbiter runs in.
+#[derive(Clone)]
+pub enum ZoneLink {
+    /// The port itself.
+    Here(ZonePort),
+    /// The port of another process, through its bridge.
+    Imported(Arc<Imported<ModuleName, ()>>),
+}
+
+impl fmt::Debug for ZoneLink {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ZoneLink::Here(port) => f.debug_tuple("Here").field(port.name()).finish(),
+            ZoneLink::Imported(port) => {
+                f.debug_tuple("Imported").field(port.port().name()).finish()
+            }
+        }
+    }
+}
+
+impl ZoneLink {
+    /// `module`'s end to send on.
+    pub fn user_named(&self, module: &str) -> Result<End<ModuleName, (), usage::Send>, WireError> {
+        match self {
+            ZoneLink::Here(port) => port.user_named(module),
+            ZoneLink::Imported(port) => port.port().user_named(module),
+        }
+    }
+
+    /// The owner's end: refused with the port's own error if the port was imported (its
+    /// owner runs in another process).
+    pub fn owner(&self) -> Result<End<ModuleName, (), usage::Receive>, WireError> {
+        match self {
+            ZoneLink::Here(port) => port.owner(),
+            ZoneLink::Imported(port) => port.port().owner(),
+        }
+    }
+
+    /// The port in this process, to own and to declare; `None` if it was imported.
+    pub fn here(&self) -> Option<&ZonePort> {
+        match self {
+            ZoneLink::Here(port) => Some(port),
+            ZoneLink::Imported(_) => None,
+        }
+    }
+}
 
 /// The coordinator's reservation port: a chip robot sends the space its trajectory will
 /// sweep and waits until that space is its own.
@@ -65,9 +166,9 @@ pub struct CellPorts {
     /// Per line, A then B.
     pub lines: [LinePorts; 2],
     /// The arbiter's request port.
-    pub zone_request: ZonePort,
+    pub zone_request: ZoneLink,
     /// The arbiter's release port.
-    pub zone_release: ZonePort,
+    pub zone_release: ZoneLink,
     /// The coordinator's reservation port.
     pub zone_reserve: ReservePort,
     /// The coordinator's port for freeing a reservation.
@@ -83,7 +184,8 @@ fn secs(seconds: u64) -> Duration {
 }
 
 impl LinePorts {
-    fn declare(line: Line, clock: &SharedClock) -> Self {
+    /// Declares `line`'s ports on `clock`.
+    pub fn new(line: Line, clock: &SharedClock) -> Self {
         let n = LineNames::of(line);
         let twin = LineNames::of(line.other());
         Self {
@@ -130,35 +232,53 @@ impl LinePorts {
     }
 }
 
+impl LinePorts {
+    /// Makes this line's ports known to `cell`, for the wiring check.
+    pub fn declare_to(&self, cell: &Cell) -> Result<(), WireError> {
+        cell.declare_filtered(&self.frequency)?;
+        cell.declare(&self.let_1_go)?;
+        cell.declare(&self.ask_child1)?;
+        cell.declare(&self.ask_child2)?;
+        cell.declare(&self.pallet_in_place)?;
+        cell.declare(&self.card_in_place)?;
+        cell.declare(&self.ready_to_chip)?;
+        cell.declare(&self.share_feeder)
+    }
+}
+
 impl CellPorts {
-    /// Declares every port on `clock`, and makes each known to `cell` for the wiring check;
-    /// the arbiter's or the coordinator's ports only under its policy.
-    pub fn declare(cell: &Cell, policy: FeederPolicy) -> Result<Self, WireError> {
-        let clock = cell.clock();
-        let ports = Self {
+    /// Declares every port on `clock`, none of them yet known to a cell.
+    pub fn new(clock: &SharedClock) -> Self {
+        Self {
             lines: [
-                LinePorts::declare(Line::A, clock),
-                LinePorts::declare(Line::B, clock),
+                LinePorts::new(Line::A, clock),
+                LinePorts::new(Line::B, clock),
             ],
-            zone_request: ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
-            zone_release: ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
+            zone_request: ZoneLink::Here(
+                ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
+            ),
+            zone_release: ZoneLink::Here(
+                ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
+            ),
             zone_reserve: ReservePort::declare(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)),
             zone_free: ZonePort::declare(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
-        };
+        }
+    }
+
+    /// Declares every port on `cell`'s clock, and makes each known to `cell` for the wiring
+    /// check; the arbiter's or the coordinator's ports only under its policy.
+    pub fn declare(cell: &Cell, policy: FeederPolicy) -> Result<Self, WireError> {
+        let ports = Self::new(cell.clock());
         for line in &ports.lines {
-            cell.declare_filtered(&line.frequency)?;
-            cell.declare(&line.let_1_go)?;
-            cell.declare(&line.ask_child1)?;
-            cell.declare(&line.ask_child2)?;
-            cell.declare(&line.pallet_in_place)?;
-            cell.declare(&line.card_in_place)?;
-            cell.declare(&line.ready_to_chip)?;
-            cell.declare(&line.share_feeder)?;
+            line.declare_to(cell)?;
         }
         match policy {
             FeederPolicy::Arbiter => {
-                cell.declare(&ports.zone_request)?;
-                cell.declare(&ports.zone_release)?;
+                for link in [&ports.zone_request, &ports.zone_release] {
+                    if let Some(port) = link.here() {
+                        cell.declare(port)?;
+                    }
+                }
             }
             FeederPolicy::Coordinator => {
                 cell.declare(&ports.zone_reserve)?;

@@ -135,6 +135,8 @@ pub struct Report {
     pub simulated: f64,
     /// Wall seconds.
     pub wall: f64,
+    /// Across processes: how many times as fast as the wall clock the cell ran.
+    pub processes: Option<f64>,
 }
 
 impl Report {
@@ -287,6 +289,7 @@ impl Report {
             invariants,
             simulated: record.simulated.as_secs_f64(),
             wall: record.wall.as_secs_f64(),
+            processes: record.config.processes.then_some(record.config.speed),
         }
     }
 
@@ -398,6 +401,13 @@ impl fmt::Display for Report {
             writeln!(f, "faults injected: none")?;
         } else {
             writeln!(f, "faults injected: {}", self.faults.join(", "))?;
+        }
+        if let Some(speed) = self.processes {
+            writeln!(
+                f,
+                "processes: world (simulation, WORLD, FEEDER_MONITOR), line A, line B \
+                 over iceoryx2, on the wall clock x {speed}"
+            )?;
         }
         writeln!(f)?;
         writeln!(f, "  {:<34}{:>12}{:>12}", "", "line A", "line B")?;

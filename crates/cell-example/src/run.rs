@@ -7,7 +7,7 @@ use std::time::Duration;
 use imrs_record::{RecordError, Recorder, Timeline};
 use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::{CellError, CellErrors, Log, ModuleTree, time::drive};
+use imrs_sim::imrs_core::{CellError, CellErrors, Log, ModuleDecl, ModuleTree, time::drive};
 use imrs_sim::{
     Fault, FaultKind, FeederId, Line, PalletId, RobotId, RobotTimes, Role, Sim, SimConfig,
     SimEvent, Station,
@@ -17,10 +17,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::chip::{
     FeederPolicy, SharedWaits, ZoneWaits, chip_it, feeder_coordinator, feeder_monitor,
 };
+use crate::devices::Devices;
 use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes, gate};
 use crate::load::{load_card, load_it, screw_in_card};
 use crate::ports::CellPorts;
+use crate::processes::{self, DEFAULT_SPEED, LineProcess};
 use crate::tally::Tally;
 
 /// How a run is made.
@@ -47,6 +49,13 @@ pub struct CellConfig {
     pub record: Option<PathBuf>,
     /// Draw a timeline of a window of the run.
     pub timeline: Option<TimelineConfig>,
+    /// Run across processes: the world in this one, each line in its own (see
+    /// [`processes`](crate::processes)).
+    pub processes: bool,
+    /// Across processes, how many times as fast as the wall clock the cell runs.
+    pub speed: f64,
+    /// Set in a line's process, which the world started.
+    pub line_process: Option<LineProcess>,
 }
 
 /// Where to draw a timeline, and of which window of the run.
@@ -73,6 +82,9 @@ impl Default for CellConfig {
             kept_events: Log::<Event>::DEFAULT_CAPACITY,
             record: None,
             timeline: None,
+            processes: false,
+            speed: DEFAULT_SPEED,
+            line_process: None,
         }
     }
 }
@@ -126,6 +138,13 @@ pub enum RunError {
         /// What went wrong.
         error: String,
     },
+    /// A run across processes could not be made: which process, and why.
+    Processes {
+        /// The process: the world, line A or line B.
+        process: String,
+        /// What went wrong.
+        why: String,
+    },
     /// A fault is set for after the run's end, so it would never fire.
     FaultAfterEnd {
         /// The fault, as `--fault` writes it.
@@ -148,6 +167,7 @@ impl std::fmt::Display for RunError {
             Self::Output { path, error } => {
                 write!(f, "{}: cannot be written: {error}", path.display())
             }
+            Self::Processes { process, why } => write!(f, "across processes, {process}: {why}"),
             Self::FaultAfterEnd { fault, hours } => write!(
                 f,
                 "--fault {fault}: set for after the run's end ({hours} h), so it would never fire; \
@@ -190,6 +210,9 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
             fault: late.to_string(),
             hours: config.hours,
         });
+    }
+    if config.processes {
+        return processes::run_world(config);
     }
     let wall = std::time::Instant::now();
     let mut record = if config.realtime {
@@ -249,19 +272,21 @@ async fn simulate(
     let cycle_times: [SharedCycleTimes; 2] = Default::default();
     let waits: SharedWaits = Arc::default();
     inject(config, &sim, &deaths);
+    let devices = Devices::Local(sim.clone());
 
     // The load-time check, over every module the cell will run (children included).
     let mut declarations = Vec::new();
+    let line_modules = |line: Line| LineModules {
+        line,
+        feeder: config.feeder,
+        ports: ports.clone(),
+        devices: devices.clone(),
+        death: Arc::clone(&deaths[line.index()]),
+        history: Arc::clone(&cycle_times[line.index()]),
+        waits: Arc::clone(&waits),
+    };
     for line in Line::ALL {
-        let lines = &ports.lines[line.index()];
-        let (death, history) = (&deaths[line.index()], &cycle_times[line.index()]);
-        declarations
-            .push(gate(line, lines, &sim, Arc::clone(death), Arc::clone(history)).declaration());
-        declarations.push(load_it(line, lines, &sim).declaration());
-        declarations.push(load_card(line, lines, &sim).declaration());
-        declarations.push(screw_in_card(line, lines, &sim).declaration());
-        declarations
-            .push(chip_it(line, config.feeder, &ports, &sim, Arc::clone(&waits)).declaration());
+        declarations.extend(line_modules(line).declarations());
     }
     match config.feeder {
         FeederPolicy::Arbiter => declarations.push(feeder_monitor(&ports).declaration()),
@@ -271,7 +296,6 @@ async fn simulate(
     cell.check(&declarations)?;
 
     sim.spawn();
-    let policy = RestartPolicy::restart(3, Duration::from_secs(5));
     match config.feeder {
         FeederPolicy::Arbiter => {
             cell.start(feeder_monitor(&ports))?;
@@ -282,29 +306,7 @@ async fn simulate(
         FeederPolicy::Appendix => {}
     }
     for line in Line::ALL {
-        let (lines, sim) = (ports.lines[line.index()].clone(), sim.clone());
-        let death = Arc::clone(&deaths[line.index()]);
-        let history = Arc::clone(&cycle_times[line.index()]);
-        let (gate_lines, gate_sim) = (lines.clone(), sim.clone());
-        cell.supervise(policy, move || {
-            gate(
-                line,
-                &gate_lines,
-                &gate_sim,
-                Arc::clone(&death),
-                Arc::clone(&history),
-            )
-        })?;
-        cell.start(load_it(line, &lines, &sim))?;
-        let (all_ports, chip_sim, chip_waits, feeder) = (
-            ports.clone(),
-            sim.clone(),
-            Arc::clone(&waits),
-            config.feeder,
-        );
-        cell.supervise(policy, move || {
-            chip_it(line, feeder, &all_ports, &chip_sim, Arc::clone(&chip_waits))
-        })?;
+        line_modules(line).start(&cell)?;
     }
 
     let total = Duration::from_secs_f64(config.hours * 3600.0);
@@ -355,7 +357,59 @@ async fn simulate(
     })
 }
 
-fn inject(config: &CellConfig, sim: &Sim, deaths: &[ReleaseDeath; 2]) {
+/// The modules of one line, and what they share with the run: everything needed to
+/// declare them for the wiring check and to start them, in one process or in a line's own.
+pub(crate) struct LineModules {
+    pub(crate) line: Line,
+    pub(crate) feeder: FeederPolicy,
+    pub(crate) ports: CellPorts,
+    pub(crate) devices: Devices,
+    pub(crate) death: ReleaseDeath,
+    pub(crate) history: SharedCycleTimes,
+    pub(crate) waits: SharedWaits,
+}
+
+impl LineModules {
+    /// GATE, LOAD_IT (with its children LOAD_CARD and SCREW_IN_CARD) and CHIP_IT, declared.
+    pub(crate) fn declarations(&self) -> Vec<ModuleDecl> {
+        let (line, lines) = (self.line, &self.ports.lines[self.line.index()]);
+        let history = Arc::clone(&self.history);
+        let waits = Arc::clone(&self.waits);
+        vec![
+            gate(line, lines, &self.devices, Arc::clone(&self.death), history).declaration(),
+            load_it(line, lines, &self.devices).declaration(),
+            load_card(line, lines, &self.devices).declaration(),
+            screw_in_card(line, lines, &self.devices).declaration(),
+            chip_it(line, self.feeder, &self.ports, &self.devices, waits).declaration(),
+        ]
+    }
+
+    /// Starts the line's modules in `cell`: GATE and CHIP_IT supervised, restarted as a
+    /// cell engineer would want; LOAD_IT starts its own children.
+    pub(crate) fn start(self, cell: &Cell) -> Result<(), CellError> {
+        let policy = RestartPolicy::restart(3, Duration::from_secs(5));
+        let (line, lines) = (self.line, self.ports.lines[self.line.index()].clone());
+        let (gate_lines, gate_devices) = (lines.clone(), self.devices.clone());
+        let (death, history) = (self.death, self.history);
+        cell.supervise(policy, move || {
+            gate(
+                line,
+                &gate_lines,
+                &gate_devices,
+                Arc::clone(&death),
+                Arc::clone(&history),
+            )
+        })?;
+        cell.start(load_it(line, &lines, &self.devices))?;
+        let (ports, devices, waits, feeder) = (self.ports, self.devices, self.waits, self.feeder);
+        cell.supervise(policy, move || {
+            chip_it(line, feeder, &ports, &devices, Arc::clone(&waits))
+        })?;
+        Ok(())
+    }
+}
+
+pub(crate) fn inject(config: &CellConfig, sim: &Sim, deaths: &[ReleaseDeath; 2]) {
     for fault in &config.faults {
         let at = Instant::from_start(fault.at);
         let kind = match fault.kind {

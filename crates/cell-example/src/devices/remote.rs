@@ -1,0 +1,172 @@
+//! A line's devices reached through ports to the world's process.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::sync::Arc;
+
+use imrs_ipc::{Imported, IpcError, Remote, import};
+use imrs_sim::imrs_core::imrs_ports::{End, usage};
+use imrs_sim::{DeviceError, Line, RobotId, Role, Station};
+use tokio::sync::Mutex;
+
+use super::server::WORLD;
+use super::wire::{Answer, DeviceAnswer, DeviceCall, Op};
+use crate::names::LineNames;
+
+/// A device of the cell, as the world serves it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Device {
+    /// A robot.
+    Robot(RobotId),
+    /// A line's gate.
+    Gate(Line),
+    /// A station's freeze relay.
+    Relay(Line, Station),
+}
+
+impl Device {
+    /// Every device of `line`.
+    pub fn of_line(line: Line) -> [Device; 6] {
+        [
+            Device::Gate(line),
+            Device::Robot(RobotId::new(line, Role::LoadCard)),
+            Device::Robot(RobotId::new(line, Role::ScrewInCard)),
+            Device::Robot(RobotId::new(line, Role::ChipIt)),
+            Device::Relay(line, Station::Load),
+            Device::Relay(line, Station::Chip),
+        ]
+    }
+
+    /// The name of the world's port that serves it.
+    pub fn port(self) -> String {
+        let line = |line: Line| match line {
+            Line::A => "A",
+            Line::B => "B",
+        };
+        match self {
+            Device::Robot(robot) => {
+                let role = match robot.role {
+                    Role::LoadCard => "LOAD",
+                    Role::ScrewInCard => "SCREW",
+                    Role::ChipIt => "CHIP",
+                };
+                format!("{role}_ROBOT_{}", line(robot.line))
+            }
+            Device::Gate(at) => format!("GATE_DEVICE_{}", line(at)),
+            Device::Relay(at, Station::Load) => format!("LOAD_RELAY_{}", line(at)),
+            Device::Relay(at, Station::Chip) => format!("CHIP_RELAY_{}", line(at)),
+        }
+    }
+
+    /// The module that drives it: the only user of its port.
+    pub fn user(self) -> String {
+        match self {
+            Device::Gate(line) => LineNames::of(line).gate,
+            Device::Robot(robot) => {
+                let names = LineNames::of(robot.line);
+                match robot.role {
+                    Role::LoadCard => names.load_card,
+                    Role::ScrewInCard => names.screw_in_card,
+                    Role::ChipIt => names.chip_it,
+                }
+            }
+            Device::Relay(line, Station::Load) => LineNames::of(line).load_card,
+            Device::Relay(line, Station::Chip) => LineNames::of(line).chip_it,
+        }
+    }
+}
+
+type DeviceEnd = End<DeviceCall, DeviceAnswer, usage::Send>;
+
+/// The end a device's proxies send on; `None` for a device this process did not import.
+#[derive(Clone)]
+pub struct Link(Option<Arc<Mutex<DeviceEnd>>>);
+
+impl fmt::Debug for Link {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(if self.0.is_some() {
+            "Link(imported)"
+        } else {
+            "Link(none)"
+        })
+    }
+}
+
+impl Link {
+    /// Calls the device and waits for its answer; `None` if the world's process could not
+    /// be reached or answered with a record that does not decode.
+    pub async fn call(&self, op: Op) -> Option<Answer> {
+        let end = self.0.as_ref()?;
+        // One call at a time per device, as a device does one thing at a time; a call
+        // dropped halfway (its module killed) frees the end with it.
+        let mut end = end.lock().await;
+        let answer = end.send(DeviceCall::new(op)).await.ok()?;
+        answer.answer()
+    }
+
+    /// A robot's call: its value, or its error. A world that cannot be reached is a
+    /// faulted robot to the module, which alarms and retries as for any fault.
+    pub async fn robot(&self, robot: RobotId, op: Op) -> Result<u32, DeviceError> {
+        match self.call(op).await {
+            Some(Answer::Done) => Ok(0),
+            Some(Answer::Value(value)) => Ok(value),
+            Some(Answer::Failed(error)) => Err(error),
+            Some(Answer::Malformed) | None => Err(DeviceError::RobotFault { robot }),
+        }
+    }
+
+    /// A relay's call: the pallet it names, or its error. A world that cannot be reached
+    /// holds no pallet for the module.
+    pub async fn relay(&self, line: Line, station: Station, op: Op) -> Result<u32, DeviceError> {
+        match self.call(op).await {
+            Some(Answer::Value(pallet)) => Ok(pallet),
+            Some(Answer::Failed(error)) => Err(error),
+            Some(Answer::Done | Answer::Malformed) | None => {
+                Err(DeviceError::NoPallet { line, station })
+            }
+        }
+    }
+}
+
+/// The devices of one line, imported from the world's process.
+pub struct RemoteDevices {
+    links: BTreeMap<Device, Link>,
+    /// The bridges: the ports work while these are held.
+    _imported: Vec<Imported<DeviceCall, DeviceAnswer>>,
+}
+
+impl fmt::Debug for RemoteDevices {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("RemoteDevices")
+            .field("devices", &self.links.keys().collect::<Vec<_>>())
+            .finish()
+    }
+}
+
+impl RemoteDevices {
+    /// Imports every device of `line` from the world's process of `remote`'s cell, each for
+    /// the module that drives it. Call it within the tokio runtime the line runs on.
+    pub fn import(remote: &Remote, line: Line) -> Result<Self, IpcError> {
+        let mut links = BTreeMap::new();
+        let mut imported = Vec::new();
+        for device in Device::of_line(line) {
+            let user = device.user();
+            let port = import::<DeviceCall, DeviceAnswer>(remote, &device.port(), WORLD, &user)?;
+            let end = port
+                .port()
+                .user_named(user.as_str())
+                .map_err(IpcError::Local)?;
+            links.insert(device, Link(Some(Arc::new(Mutex::new(end)))));
+            imported.push(port);
+        }
+        Ok(Self {
+            links,
+            _imported: imported,
+        })
+    }
+
+    /// The link to `device`: one that fails every call if this process did not import it.
+    pub fn link(&self, device: Device) -> Link {
+        self.links.get(&device).cloned().unwrap_or(Link(None))
+    }
+}

@@ -1,0 +1,621 @@
+//! The chip cell split over processes (`chip_cell --processes`): the world — the simulation,
+//! WORLD serving the devices, and FEEDER_MONITOR — in the process started by the command, and
+//! each line's modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD, CHIP_IT) in a process of its
+//! own, which the world starts. The lines reach their robots, gate and relays through the
+//! world's device ports, and the feeder zone's arbiter through its ports, all carried by
+//! iceoryx2 (`imrs-ipc`); the modules' code is that of the single-process cell.
+//!
+//! Time: every process runs on the wall clock sped up by `--speed`, from one epoch the world
+//! chooses and hands to the lines when it starts them, so the processes agree on one time
+//! with no message between them. Virtual time does not cross processes: it moves only when
+//! the whole cell is idle, which no single process can see. A run across processes is
+//! therefore not reproducible to the step, as a single-process run is; its figures are
+//! those of the same cell, measured by the same simulation.
+//!
+//! At the end each line writes its modules' figures (timeouts, alarms, restarts, deadlocks,
+//! waits for the zone, GATE's cycle times) as one JSON line on its standard output; the
+//! world folds them into its own and reports as a single process does. A line whose world
+//! dies sees its standard input close and exits.
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use imrs_ipc::{Exported, IpcError, Remote, export, import};
+use imrs_sim::imrs_core::CellErrors;
+use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock};
+use imrs_sim::imrs_core::prelude::*;
+use imrs_sim::{Line, Sim, SimConfig};
+use serde_json::{Value, json};
+use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+
+use crate::alarms::AlarmKind;
+use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_monitor};
+use crate::devices::{DevicePorts, Devices, RemoteDevices, world};
+use crate::faults::CellFaultKind;
+use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
+use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+use crate::ports::{CellPorts, ModuleName, ZoneLink};
+use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject};
+use crate::tally::Tally;
+
+/// How much faster than the wall clock a run across processes goes, unless `--speed` says.
+pub const DEFAULT_SPEED: f64 = 60.0;
+
+/// How long the world gives the lines' processes to start before the epoch.
+const STARTUP: Duration = Duration::from_secs(2);
+
+/// How long the world waits, in wall time, for a line to say it is ready, and for its
+/// figures once the run has ended.
+const PATIENCE: Duration = Duration::from_secs(30);
+
+/// What makes a process one line's part of a cell run across processes: the line, the
+/// cell's name on this host, and the moment its time starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineProcess {
+    /// The line whose modules it runs.
+    pub line: Line,
+    /// The cell's name, from which every port's service name is derived.
+    pub remote: String,
+    /// When the cell's time is zero, on the system clock.
+    pub epoch: SystemTime,
+}
+
+fn refused(process: &str, why: impl std::fmt::Display) -> RunError {
+    RunError::Processes {
+        process: process.into(),
+        why: why.to_string(),
+    }
+}
+
+/// What `--processes` cannot do yet, refused before anything starts.
+pub(crate) fn check_config(config: &CellConfig) -> Result<(), RunError> {
+    let unsupported = if config.feeder != FeederPolicy::Arbiter {
+        Some(
+            "--feeder: only the arbiter's ports cross processes (the Appendix's SHARE_FEEDER is queried by its owner, and the coordinator's sweeps are computed where the simulation runs)",
+        )
+    } else if config.record.is_some() || config.timeline.is_some() {
+        Some("--record and --timeline: a recording sees one process's modules")
+    } else if config.show_tree {
+        Some("--tree: each process has a module tree of its own")
+    } else if config.realtime {
+        Some("--realtime: a run across processes is on the wall clock already (see --speed)")
+    } else {
+        None
+    };
+    match unsupported {
+        Some(why) => Err(refused("world", format!("not with --processes: {why}"))),
+        None => Ok(()),
+    }
+}
+
+fn runtime(process: &str) -> Result<tokio::runtime::Runtime, RunError> {
+    tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .map_err(|error| refused(process, format!("no tokio runtime: {error}")))
+}
+
+fn clock(process: &str, epoch: SystemTime, speed: f64) -> Result<SharedClock, RunError> {
+    match RealClock::from_epoch(epoch, speed) {
+        Some(clock) => Ok(Arc::new(clock)),
+        None => Err(refused(
+            process,
+            format!(
+                "--speed {speed}: expected 1 to {}, with an epoch within a year",
+                RealClock::MAX_SPEED
+            ),
+        )),
+    }
+}
+
+fn ipc(process: &str) -> impl Fn(IpcError) -> RunError + '_ {
+    move |error| refused(process, error)
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Runs the cell across three processes — this one the world's — and folds the lines'
+/// figures into one record.
+pub fn run_world(config: &CellConfig) -> Result<RunRecord, RunError> {
+    check_config(config)?;
+    let wall = std::time::Instant::now();
+    let mut record = runtime("world")?.block_on(world_process(config))?;
+    record.wall = wall.elapsed();
+    Ok(record)
+}
+
+async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
+    let epoch = SystemTime::now() + STARTUP;
+    let clock = clock("world", epoch, config.speed)?;
+    let nanos = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap_or_default()
+        .subsec_nanos();
+    // Unique on this host: two runs never meet.
+    let remote =
+        Remote::new(&format!("chip_cell-{}-{nanos}", std::process::id())).map_err(ipc("world"))?;
+    let cell = Cell::new(clock.clone());
+    let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
+    cell.events().set_capacity(config.kept_events);
+    sim.log().set_capacity(config.kept_events);
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let folded = Arc::clone(&tally);
+    sim.log().subscribe(move |event| lock(&folded).sim(event));
+    let folded = Arc::clone(&tally);
+    cell.events()
+        .subscribe(move |event| lock(&folded).cell(event));
+    // A line's RELEASE dies in the line's process; the simulation's faults happen here.
+    inject(config, &sim, &Default::default());
+
+    let ports = CellPorts::new(&clock);
+    let zone: Vec<_> = [&ports.zone_request, &ports.zone_release]
+        .into_iter()
+        .filter_map(ZoneLink::here)
+        .collect();
+    let devices = DevicePorts::declare(&clock);
+    for port in &zone {
+        cell.declare(*port).map_err(CellErrors::from)?;
+    }
+    for port in devices.iter() {
+        cell.declare(port).map_err(CellErrors::from)?;
+    }
+    cell.check(&[
+        world(&devices, &sim).declaration(),
+        feeder_monitor(&ports).declaration(),
+    ])?;
+    // Exported before a line starts: a line imports them at once.
+    let mut exported: Vec<Exported> = Vec::new();
+    for port in zone {
+        exported.push(export(&remote, port).map_err(ipc("world"))?);
+    }
+    for port in devices.iter() {
+        exported.push(export(&remote, port).map_err(ipc("world"))?);
+    }
+    sim.spawn();
+    cell.start(world(&devices, &sim))?;
+    cell.start(feeder_monitor(&ports))?;
+
+    let (said, mut hear) = unbounded_channel();
+    let mut lines = Lines(Vec::new());
+    for line in Line::ALL {
+        lines
+            .0
+            .push(start_line(config, line, &remote, epoch, said.clone())?);
+    }
+    drop(said);
+    for _ in Line::ALL {
+        match hear_from(&mut hear).await? {
+            (_, Said::Ready) => {}
+            (line, other) => return Err(other.refusal(line, "ready")),
+        }
+    }
+
+    let total = Duration::from_secs_f64(config.hours * 3600.0);
+    let mut waits = [ZoneWaits::default(); 2];
+    let mut cycle_times: [CycleTimeHistory; 2] = Default::default();
+    let mut heard = [false; 2];
+    // Until the end, a line that fails or dies fails the run at once; then each line's
+    // figures are due.
+    let end = clock.sleep_until(Instant::from_start(total));
+    tokio::pin!(end);
+    let mut ended = false;
+    while heard.contains(&false) {
+        let said = if ended {
+            hear_from(&mut hear).await?
+        } else {
+            tokio::select! {
+                () = &mut end => {
+                    ended = true;
+                    continue;
+                }
+                said = hear.recv() => said.ok_or_else(|| refused("world", "the lines' processes are gone"))?,
+            }
+        };
+        match said {
+            (line, Said::Figures(figures)) if !heard[line.index()] => {
+                let i = line.index();
+                absorb(
+                    &mut lock(&tally),
+                    &mut waits[i],
+                    &mut cycle_times[i],
+                    &figures,
+                )
+                .ok_or_else(|| refused(process_name(line), "its figures do not read"))?;
+                heard[i] = true;
+            }
+            (line, other) => return Err(other.refusal(line, "its figures")),
+        }
+    }
+    lines.wait();
+    drop(exported);
+    Ok(RunRecord {
+        config: config.clone(),
+        tally: lock(&tally).clone(),
+        sim_events: sim.log().snapshot(),
+        cell_events: cell.events().snapshot(),
+        pallets_left: sim.pallets(),
+        waits,
+        tree: cell.tree(),
+        feeders: sim.feeders(),
+        robot_times: sim.robot_times(),
+        closest_in_zone: sim.closest_in_zone(),
+        cycle_times,
+        simulated: total,
+        wall: Duration::ZERO,
+    })
+}
+
+fn process_name(line: Line) -> &'static str {
+    match line {
+        Line::A => "line A",
+        Line::B => "line B",
+    }
+}
+
+/// What a line's process said on its standard output.
+#[derive(Debug)]
+enum Said {
+    /// Its ports are imported and its modules started.
+    Ready,
+    /// Its figures, at the end of the run.
+    Figures(Value),
+    /// It could not run, and why.
+    Failed(String),
+    /// Its output closed: it ended, with this status if known.
+    Ended(Option<ExitStatus>),
+    /// A line the world does not understand.
+    Garbled(String),
+}
+
+impl Said {
+    fn refusal(self, line: Line, expected: &str) -> RunError {
+        let why = match self {
+            Said::Failed(why) => why,
+            Said::Ended(status) => format!(
+                "ended ({}) before it sent {expected}",
+                status.map_or("status unknown".into(), |status| status.to_string())
+            ),
+            Said::Garbled(text) => format!("said {text:?} where {expected} was due"),
+            Said::Ready | Said::Figures(_) => format!("answered out of turn, before {expected}"),
+        };
+        refused(process_name(line), why)
+    }
+}
+
+async fn hear_from(hear: &mut UnboundedReceiver<(Line, Said)>) -> Result<(Line, Said), RunError> {
+    match tokio::time::timeout(PATIENCE, hear.recv()).await {
+        Ok(Some(said)) => Ok(said),
+        Ok(None) => Err(refused("world", "the lines' processes are gone")),
+        Err(_) => Err(refused(
+            "world",
+            format!("no line's process said anything for {PATIENCE:?}"),
+        )),
+    }
+}
+
+/// The lines' processes: killed if the world gives up on them.
+struct Lines(Vec<Child>);
+
+impl Lines {
+    fn wait(&mut self) {
+        for child in &mut self.0 {
+            let _ = child.wait();
+        }
+    }
+}
+
+impl Drop for Lines {
+    fn drop(&mut self) {
+        for child in &mut self.0 {
+            if let Ok(None) = child.try_wait() {
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+        }
+    }
+}
+
+/// Starts `line`'s process — this same program, told which line it is — and a thread that
+/// hands on what it says.
+fn start_line(
+    config: &CellConfig,
+    line: Line,
+    remote: &Remote,
+    epoch: SystemTime,
+    said: UnboundedSender<(Line, Said)>,
+) -> Result<Child, RunError> {
+    let name = process_name(line);
+    let program = std::env::current_exe()
+        .map_err(|error| refused(name, format!("this program cannot be found: {error}")))?;
+    let epoch_ns = epoch
+        .duration_since(UNIX_EPOCH)
+        .map_err(|_| refused(name, "the epoch lies before 1970"))?
+        .as_nanos();
+    let mut command = Command::new(program);
+    command
+        .args(["--processes", "--line-process", &format!("{line:?}")])
+        .args(["--remote", remote.cell(), "--epoch", &epoch_ns.to_string()])
+        .args(["--speed", &config.speed.to_string()])
+        .args(["--hours", &config.hours.to_string()])
+        .args(["--seed", &config.seed.to_string()]);
+    for fault in &config.faults {
+        command.arg(format!("--fault={fault}"));
+    }
+    let mut child = command
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .map_err(|error| refused(name, format!("cannot be started: {error}")))?;
+    let Some(out) = child.stdout.take() else {
+        return Err(refused(name, "has no standard output"));
+    };
+    std::thread::spawn(move || {
+        for text in BufReader::new(out).lines() {
+            let Ok(text) = text else { break };
+            let heard = match text.split_once(' ') {
+                _ if text == "ready" => Said::Ready,
+                Some(("figures", json)) => match serde_json::from_str(json) {
+                    Ok(figures) => Said::Figures(figures),
+                    Err(_) => Said::Garbled(text),
+                },
+                Some(("failed", why)) => Said::Failed(why.into()),
+                _ => Said::Garbled(text),
+            };
+            if said.send((line, heard)).is_err() {
+                return;
+            }
+        }
+        let _ = said.send((line, Said::Ended(None)));
+    });
+    Ok(child)
+}
+
+/// Runs one line's modules in this process, as the world started it; says `ready`, then its
+/// figures at the end, or `failed` and why.
+pub fn run_line(config: &CellConfig, process: &LineProcess) -> Result<(), RunError> {
+    let name = process_name(process.line);
+    let runtime = runtime(name)?;
+    let outcome = runtime.block_on(line_process(config, process));
+    let mut out = std::io::stdout().lock();
+    let written = match &outcome {
+        Ok(figures) => writeln!(out, "figures {figures}"),
+        Err(error) => writeln!(out, "failed {}", error.to_string().replace('\n', "; ")),
+    };
+    let _ = written.and_then(|()| out.flush());
+    // The modules still run: stop them without waiting on their next step.
+    runtime.shutdown_timeout(Duration::from_millis(100));
+    outcome.map(drop)
+}
+
+async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Value, RunError> {
+    let (line, name) = (process.line, process_name(process.line));
+    let clock = clock(name, process.epoch, config.speed)?;
+    let remote = Remote::new(&process.remote).map_err(ipc(name))?;
+    let cell = Cell::new(clock.clone());
+    // The report counts the time lost to deadlocks from how long each wait lasted.
+    cell.observe(true);
+    cell.events().set_capacity(config.kept_events);
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let folded = Arc::clone(&tally);
+    cell.events()
+        .subscribe(move |event| lock(&folded).cell(event));
+
+    let names = LineNames::of(line);
+    let mut ports = CellPorts::new(&clock);
+    for (link, port) in [
+        (&mut ports.zone_request, ZONE_REQUEST),
+        (&mut ports.zone_release, ZONE_RELEASE),
+    ] {
+        let imported = import::<ModuleName, ()>(&remote, port, FEEDER_MONITOR, &names.chip_it)
+            .map_err(ipc(name))?;
+        cell.declare_imported(imported.port())
+            .map_err(CellErrors::from)?;
+        *link = ZoneLink::Imported(Arc::new(imported));
+    }
+    ports.lines[line.index()]
+        .declare_to(&cell)
+        .map_err(CellErrors::from)?;
+    // CHIP_IT keeps the Appendix's shape and answers its twin's SHARE_FEEDER, owned in the
+    // other line's process; under the arbiter nobody queries it.
+    cell.declare_imported(&ports.lines[line.other().index()].share_feeder)
+        .map_err(CellErrors::from)?;
+    let devices = RemoteDevices::import(&remote, line).map_err(ipc(name))?;
+
+    let death: ReleaseDeath = Arc::default();
+    for fault in &config.faults {
+        if fault.kind == CellFaultKind::ReleaseDies(line) {
+            *lock(&death) = Some(Instant::from_start(fault.at));
+        }
+    }
+    let history: SharedCycleTimes = Arc::default();
+    let waits: SharedWaits = Arc::default();
+    let modules = LineModules {
+        line,
+        feeder: config.feeder,
+        ports,
+        devices: Devices::Remote(Arc::new(devices)),
+        death,
+        history: Arc::clone(&history),
+        waits: Arc::clone(&waits),
+    };
+    cell.check(&modules.declarations())?;
+    modules.start(&cell)?;
+    println!("ready");
+    let _ = std::io::stdout().flush();
+    // The world holds our standard input: when it closes, the world is gone.
+    std::thread::spawn(|| {
+        let _ = std::io::copy(&mut std::io::stdin().lock(), &mut std::io::sink());
+        std::process::exit(3);
+    });
+
+    let total = Duration::from_secs_f64(config.hours * 3600.0);
+    clock.sleep_until(Instant::from_start(total)).await;
+    let waits = lock(&waits)[line.index()];
+    let history = lock(&history).clone();
+    let figures = figures(&lock(&tally), &waits, &history);
+    Ok(figures)
+}
+
+/// A line's figures: what its modules' events counted, its chip robot's waits, and its
+/// GATE's cycle times.
+fn figures(tally: &Tally, waits: &ZoneWaits, history: &CycleTimeHistory) -> Value {
+    let alarm_kinds: Vec<Value> = tally
+        .alarm_kinds
+        .iter()
+        .map(|(kind, count)| json!([kind.map(AlarmKind::label), count]))
+        .collect();
+    json!({
+        "timeouts": tally.timeouts,
+        "restarts": tally.restarts,
+        "alarms": tally.alarms,
+        "alarm_kinds": alarm_kinds,
+        "deadlocks": tally.deadlocks,
+        "last_deadlock": tally.last_deadlock,
+        "deadlock_lost": tally.deadlock_lost,
+        "waits": [waits.asks, waits.refused, waits.waited],
+        "cycle_time": {
+            "first": history.first,
+            "now": history.now,
+            "range": history.range.map(|(low, high)| [low, high]),
+            "changes": history.changes,
+            "recent": history.recent.iter().map(|(at, value)| [*at, *value]).collect::<Vec<_>>(),
+        },
+    })
+}
+
+/// Folds a line's figures into the world's; `None` if they do not read.
+fn absorb(
+    tally: &mut Tally,
+    waits: &mut ZoneWaits,
+    history: &mut CycleTimeHistory,
+    figures: &Value,
+) -> Option<()> {
+    let count = |value: &Value| value.as_u64().and_then(|n| u32::try_from(n).ok());
+    let float = |value: &Value| {
+        if value.is_null() {
+            Some(None)
+        } else {
+            value.as_f64().map(Some)
+        }
+    };
+    for (port, n) in figures["timeouts"].as_object()? {
+        *tally.timeouts.entry(port.clone()).or_insert(0) += count(n)?;
+    }
+    tally.restarts += count(&figures["restarts"])?;
+    tally.alarms += count(&figures["alarms"])?;
+    for pair in figures["alarm_kinds"].as_array()? {
+        let kind = match &pair[0] {
+            Value::Null => None,
+            label => {
+                let label = label.as_str()?;
+                Some(
+                    AlarmKind::ALL
+                        .into_iter()
+                        .find(|kind| kind.label() == label)?,
+                )
+            }
+        };
+        *tally.alarm_kinds.entry(kind).or_insert(0) += count(&pair[1])?;
+    }
+    tally.deadlocks += count(&figures["deadlocks"])?;
+    if let Some(last) = float(&figures["last_deadlock"])? {
+        tally.last_deadlock = Some(tally.last_deadlock.map_or(last, |other| other.max(last)));
+    }
+    tally.deadlock_lost += figures["deadlock_lost"].as_f64()?;
+    let asked = &figures["waits"];
+    *waits = ZoneWaits {
+        asks: count(&asked[0])?,
+        refused: count(&asked[1])?,
+        waited: asked[2].as_f64()?,
+    };
+    let cycle = &figures["cycle_time"];
+    let pair = |value: &Value| Some((value[0].as_f64()?, value[1].as_f64()?));
+    *history = CycleTimeHistory {
+        first: float(&cycle["first"])?,
+        now: float(&cycle["now"])?,
+        range: match &cycle["range"] {
+            Value::Null => None,
+            range => Some(pair(range)?),
+        },
+        changes: count(&cycle["changes"])?,
+        recent: cycle["recent"]
+            .as_array()?
+            .iter()
+            .map(pair)
+            .collect::<Option<_>>()?,
+    };
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lines_figures_cross_as_json_and_fold_into_the_worlds() {
+        let mut line = Tally::default();
+        line.timeouts.insert("LET_1_GO".into(), 2);
+        line.restarts = 1;
+        line.alarms = 3;
+        line.alarm_kinds.insert(Some(AlarmKind::EmptyFeeder), 2);
+        line.alarm_kinds.insert(None, 1);
+        line.deadlocks = 1;
+        line.last_deadlock = Some(120.5);
+        line.deadlock_lost = 4.25;
+        let waits = ZoneWaits {
+            asks: 10,
+            refused: 1,
+            waited: 12.5,
+        };
+        let history = CycleTimeHistory {
+            first: Some(10.0),
+            now: Some(9.0),
+            range: Some((8.0, 10.0)),
+            changes: 2,
+            recent: vec![(100.0, 9.5), (200.0, 9.0)],
+        };
+        // Sent over a pipe as text, and read back.
+        let text = figures(&line, &waits, &history).to_string();
+        let read: Value = serde_json::from_str(&text).unwrap();
+        let mut world = Tally::default();
+        world.timeouts.insert("LET_1_GO".into(), 1);
+        world.alarms = 1;
+        let (mut got_waits, mut got_history) = Default::default();
+        absorb(&mut world, &mut got_waits, &mut got_history, &read).unwrap();
+        assert_eq!(world.timeouts["LET_1_GO"], 3);
+        assert_eq!(world.restarts, 1);
+        assert_eq!(world.alarms, 4);
+        assert_eq!(world.alarm_kinds[&Some(AlarmKind::EmptyFeeder)], 2);
+        assert_eq!(world.alarm_kinds[&None], 1);
+        assert_eq!((world.deadlocks, world.last_deadlock), (1, Some(120.5)));
+        assert_eq!(world.deadlock_lost, 4.25);
+        assert_eq!(got_waits, waits);
+        assert_eq!(got_history, history);
+    }
+
+    #[test]
+    fn figures_that_do_not_read_are_refused() {
+        let (mut waits, mut history) = Default::default();
+        let good = figures(&Tally::default(), &ZoneWaits::default(), &history);
+        for broken in ["restarts", "waits", "cycle_time", "alarm_kinds"] {
+            let mut figures = good.clone();
+            figures[broken] = json!("garbage");
+            let absorbed = absorb(&mut Tally::default(), &mut waits, &mut history, &figures);
+            assert_eq!(absorbed, None, "{broken}");
+        }
+        let mut unknown_kind = good;
+        unknown_kind["alarm_kinds"] = json!([["no such kind", 1]]);
+        let absorbed = absorb(
+            &mut Tally::default(),
+            &mut waits,
+            &mut history,
+            &unknown_kind,
+        );
+        assert_eq!(absorbed, None);
+    }
+}

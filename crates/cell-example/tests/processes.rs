@@ -1,0 +1,240 @@
+//! The chip cell across three processes (`chip_cell --processes`), run as an operator runs
+//! it: the world's process reports as a single process does, a line's process that dies
+//! fails the run by name without hanging it, and a world that dies takes its lines with it.
+//!
+//! These run on the wall clock, sped up: time does not cross processes virtually.
+
+use std::path::PathBuf;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// The example binary, built beside this test by `cargo test`.
+fn chip_cell() -> PathBuf {
+    let test = std::env::current_exe().unwrap();
+    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
+    profile_dir.join("examples").join("chip_cell")
+}
+
+/// The processes `pid` started, as Linux lists them.
+fn children_of(pid: u32) -> Vec<u32> {
+    let list = std::fs::read_to_string(format!("/proc/{pid}/task/{pid}/children"));
+    list.unwrap_or_default()
+        .split_whitespace()
+        .filter_map(|child| child.parse().ok())
+        .collect()
+}
+
+fn alive(pid: u32) -> bool {
+    // A zombie has ended: only its parent has not read its status yet.
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+        !stat
+            .rsplit(')')
+            .next()
+            .unwrap_or("")
+            .trim_start()
+            .starts_with('Z')
+    })
+}
+
+fn kill_9(pid: u32) {
+    let killed = Command::new("kill").args(["-9", &pid.to_string()]).status();
+    assert!(killed.is_ok_and(|status| status.success()), "kill -9 {pid}");
+}
+
+/// Waits (polling, bounded) until `condition` holds; whether it did.
+fn within(limit: Duration, mut condition: impl FnMut() -> bool) -> bool {
+    let start = Instant::now();
+    while start.elapsed() < limit {
+        if condition() {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    condition()
+}
+
+/// The world, started: killed if the test fails before it ends.
+struct World(Child);
+
+impl World {
+    fn start(args: &[&str]) -> Self {
+        let child = Command::new(chip_cell())
+            .arg("--processes")
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the example is built with the tests");
+        Self(child)
+    }
+
+    fn pid(&self) -> u32 {
+        self.0.id()
+    }
+
+    /// Its two lines' processes, once both are running.
+    fn lines(&self) -> Vec<u32> {
+        let mut lines = Vec::new();
+        let started = within(Duration::from_secs(30), || {
+            lines = children_of(self.pid());
+            lines.len() == 2
+        });
+        assert!(
+            started,
+            "the world did not start two line processes: {lines:?}"
+        );
+        lines
+    }
+
+    fn finish(mut self, limit: Duration) -> Output {
+        let ended = within(limit, || self.0.try_wait().is_ok_and(|s| s.is_some()));
+        assert!(ended, "the world did not end within {limit:?}");
+        let child = std::mem::replace(
+            &mut self.0,
+            Command::new("true").spawn().expect("true runs"),
+        );
+        child.wait_with_output().unwrap()
+    }
+}
+
+impl Drop for World {
+    fn drop(&mut self) {
+        let lines = children_of(self.pid());
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+        for line in lines {
+            let _ = Command::new("kill")
+                .args(["-9", &line.to_string()])
+                .status();
+        }
+    }
+}
+
+/// A row of the report: its two columns, line A and line B.
+fn row<'a>(report: &'a str, what: &str) -> (&'a str, &'a str) {
+    let line = report
+        .lines()
+        .find(|line| line.trim_start().starts_with(what))
+        .unwrap_or_else(|| panic!("no row {what:?} in:\n{report}"));
+    let mut columns = line.split_whitespace().rev();
+    let b = columns.next().unwrap();
+    let a = columns.next().unwrap();
+    (a, b)
+}
+
+#[test]
+fn the_cell_across_three_processes_reports_as_a_single_process_does() {
+    // Six simulated minutes at sixty times the wall clock.
+    let world = World::start(&["--hours", "0.1", "--speed", "60"]);
+    let lines = world.lines();
+    assert!(lines.iter().all(|line| *line != world.pid()));
+    let output = world.finish(Duration::from_secs(120));
+    let (report, errors) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    assert!(
+        report.contains("processes: world (simulation, WORLD, FEEDER_MONITOR), line A, line B"),
+        "{report}"
+    );
+    // The simulation ran in the world; the lines' modules drove it from their processes.
+    for what in [
+        "pallets released",
+        "pallets completed",
+        "feeder zone entries (rapier)",
+    ] {
+        let (a, b) = row(&report, what);
+        let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+        assert!(a > 0 && b > 0, "{what}: {a} and {b}\n{report}");
+    }
+    // The chip robots' waits for the zone were counted in the lines' processes and came
+    // back with their figures.
+    let (a, b) = row(&report, "zone requests / refused");
+    for asked in [a, b] {
+        let requests: u32 = asked.split('/').next().unwrap().parse().unwrap();
+        assert!(requests > 0, "{asked}\n{report}");
+    }
+    assert!(report.contains("[ok] no two robots in the feeder zone together (rapier)"));
+    assert!(report.contains("[ok] no two arms touching (rapier)"));
+    assert!(!report.contains("[FAILED]"), "{report}");
+    // The lines ended with the world.
+    for line in lines {
+        assert!(
+            within(Duration::from_secs(5), || !alive(line)),
+            "line {line} lives on"
+        );
+    }
+}
+
+#[test]
+fn a_line_killed_mid_run_fails_the_run_by_name_at_once() {
+    // An hour at ten times the wall clock: six minutes, unless the death is seen.
+    let world = World::start(&["--hours", "1", "--speed", "10"]);
+    let lines = world.lines();
+    // Let the run get going, then kill one line.
+    std::thread::sleep(Duration::from_secs(3));
+    kill_9(lines[0]);
+    let killed_at = Instant::now();
+    let output = world.finish(Duration::from_secs(30));
+    let errors = String::from_utf8_lossy(&output.stderr);
+    assert!(killed_at.elapsed() < Duration::from_secs(30));
+    assert_ne!(output.status.code(), Some(0), "{errors}");
+    assert!(
+        errors.contains("across processes, line A: ended")
+            || errors.contains("across processes, line B: ended"),
+        "{errors}"
+    );
+    // The other line went with the world.
+    assert!(
+        within(Duration::from_secs(5), || !alive(lines[1])),
+        "the other line lives on"
+    );
+}
+
+#[test]
+fn a_world_killed_mid_run_takes_its_lines_with_it() {
+    let world = World::start(&["--hours", "1", "--speed", "10"]);
+    let lines = world.lines();
+    std::thread::sleep(Duration::from_secs(3));
+    kill_9(world.pid());
+    for line in lines {
+        assert!(
+            within(Duration::from_secs(10), || !alive(line)),
+            "line {line} outlived its world"
+        );
+    }
+}
+
+#[test]
+fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
+    for (flags, named) in [
+        (&["--feeder", "appendix"][..], "--feeder"),
+        (&["--record", "x.mcap"][..], "--record"),
+        (&["--tree"][..], "--tree"),
+        (&["--realtime"][..], "--realtime"),
+    ] {
+        let output = Command::new(chip_cell())
+            .arg("--processes")
+            .args(flags)
+            .output()
+            .unwrap();
+        let errors = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{flags:?}: {errors}");
+        assert!(errors.contains("not with --processes"), "{errors}");
+        assert!(errors.contains(named), "{errors}");
+    }
+    // A speed-up without processes, or one that means nothing, is a mistake of the flags.
+    for flags in [
+        &["--speed", "10"][..],
+        &["--processes", "--speed", "0.5"][..],
+    ] {
+        let output = Command::new(chip_cell()).args(flags).output().unwrap();
+        let errors = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{flags:?}: {errors}");
+        assert!(
+            errors.contains("--speed") || errors.contains("--processes"),
+            "{errors}"
+        );
+    }
+}
