@@ -64,7 +64,12 @@ fn a_bad_value_is_refused_naming_its_flag_and_what_was_expected() {
             &["--timeline-span", "soon"][..],
             "invalid value 'soon' for '--timeline-span <SECONDS>'",
         ),
-        (&["--speed", "2"][..], "unexpected argument '--speed'"),
+        (&["--speedup", "2"][..], "unexpected argument '--speedup'"),
+        // A speed-up only means something across processes.
+        (
+            &["--speed", "2"][..],
+            "the following required arguments were not provided:\n  --processes",
+        ),
     ] {
         let refused = parse(args(flags)).unwrap_err();
         assert_eq!(refused.status, 2, "{flags:?}");
@@ -91,8 +96,15 @@ fn help_lists_every_flag_with_its_meaning_and_default() {
         "--timeline-from <SECONDS>",
         "--timeline-span <SECONDS>",
         "--no-progress",
+        "--processes",
+        "--speed <X>",
+        "[default: 60]",
     ] {
         assert!(help.message.contains(flag), "{flag:?} in\n{help}");
+    }
+    // The flags the world sets on the lines' processes are its business, not the user's.
+    for hidden in ["--line-process", "--remote", "--epoch"] {
+        assert!(!help.message.contains(hidden), "{hidden:?} in\n{help}");
     }
 }
 
