@@ -16,8 +16,6 @@ use crate::{IpcError, Remote, Wire};
 /// Ports usable from any thread: the bridges hand requests to tokio tasks.
 pub(crate) type Svc = ipc_threadsafe::Service;
 
-/// How many user processes a port admits (iceoryx2's clients, beside the owner's server).
-pub(crate) const MAX_USERS: usize = 16;
 /// How many requests one user process may have pending at once.
 pub(crate) const MAX_PENDING: usize = 16;
 /// How often a waiting bridge thread looks up from its wait: to see whether it should stop
@@ -27,7 +25,20 @@ pub(crate) const TICK: Duration = Duration::from_millis(50);
 pub(crate) type Service<Req, Rep> =
     request_response::PortFactory<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 
-/// The iceoryx2 side of one port, opened (or created) by either process.
+/// Which side of a port opens its services.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Side {
+    /// The owner's process, which creates the services (or opens them again after a
+    /// restart), sized for the port's number of users.
+    Owner {
+        /// How many users the port admits.
+        users: usize,
+    },
+    /// A user's process, which opens the services the owner created.
+    User,
+}
+
+/// The iceoryx2 side of one port, created by its owner's process and opened by its users'.
 pub(crate) struct Channel<Req: Wire, Rep: Wire> {
     pub(crate) port: Name,
     /// Keeps the services open while the port crosses.
@@ -45,8 +56,10 @@ fn transport(port: &Name, what: &str, error: impl std::fmt::Debug) -> IpcError {
 }
 
 impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
-    /// Opens port `port` of `remote`, creating its services if this process is first.
-    pub(crate) fn open(remote: &Remote, port: &Name) -> Result<Self, IpcError> {
+    /// Opens port `port` of `remote` from `side`: the owner creates its services, sized
+    /// from the port's restrictions rather than iceoryx2's defaults; a user opens them, and
+    /// is told there is no owner if they are not there.
+    pub(crate) fn open(remote: &Remote, port: &Name, side: Side) -> Result<Self, IpcError> {
         // Defaults need no configuration file; iceoryx2 says so at every start unless told
         // to keep its warnings for what matters (`IOX2_LOG_LEVEL` still overrides).
         static QUIET: std::sync::Once = std::sync::Once::new();
@@ -56,37 +69,51 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<Svc>()
             .map_err(|error| transport(port, "creating the node", error))?;
-        let service = node
+        let refusal = |error: &dyn std::fmt::Debug| {
+            let detail = format!("{error:?}");
+            if detail.contains("DoesNotExist") {
+                IpcError::NoOwner { port: port.clone() }
+            } else if detail.contains("Incompatible") || detail.contains("TypeDefinition") {
+                IpcError::TypeMismatch {
+                    port: port.clone(),
+                    detail,
+                }
+            } else {
+                transport(port, "opening its service", detail)
+            }
+        };
+        let messages = node
             .service_builder(&remote.service(port.as_str(), "messages")?)
             .request_response::<Req, Rep>()
             .request_user_header::<RequestMeta>()
-            .response_user_header::<ReplyMeta>()
-            .max_servers(1)
-            .max_clients(MAX_USERS)
-            .max_nodes(MAX_USERS + 1)
-            .max_active_requests_per_client(MAX_PENDING)
-            .max_loaned_requests(MAX_PENDING)
-            .max_response_buffer_size(2)
-            .open_or_create()
-            .map_err(|error| {
-                let detail = format!("{error:?}");
-                if detail.contains("Incompatible") || detail.contains("TypeDefinition") {
-                    IpcError::TypeMismatch {
-                        port: port.clone(),
-                        detail,
-                    }
-                } else {
-                    transport(port, "opening its service", detail)
-                }
-            })?;
-        let event = |part: &str| {
-            node.service_builder(&remote.service(port.as_str(), part)?)
-                .event()
-                .max_notifiers(MAX_USERS + 2)
-                .max_listeners(MAX_USERS + 2)
-                .max_nodes(MAX_USERS + 1)
+            .response_user_header::<ReplyMeta>();
+        let service = match side {
+            // One client more than the port has users: a process beyond them connects,
+            // and is refused by name with the port's own error rather than by iceoryx2.
+            Side::Owner { users } => messages
+                .max_servers(1)
+                .max_clients(users + 1)
+                .max_nodes(users + 2)
+                .max_active_requests_per_client(MAX_PENDING)
+                .max_loaned_requests(MAX_PENDING)
+                .max_response_buffer_size(2)
                 .open_or_create()
-                .map_err(|error| transport(port, "opening its events", error))
+                .map_err(|error| refusal(&error))?,
+            Side::User => messages.open().map_err(|error| refusal(&error))?,
+        };
+        let event = |part: &str| {
+            let events = node
+                .service_builder(&remote.service(port.as_str(), part)?)
+                .event();
+            match side {
+                Side::Owner { users } => events
+                    .max_notifiers(users + 3)
+                    .max_listeners(users + 3)
+                    .max_nodes(users + 2)
+                    .open_or_create()
+                    .map_err(|error| transport(port, "opening its events", error)),
+                Side::User => events.open().map_err(|error| refusal(&error)),
+            }
         };
         let (requested, replied) = (event("requested")?, event("replied")?);
         Ok(Self {

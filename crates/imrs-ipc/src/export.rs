@@ -12,7 +12,7 @@ use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
 
-use crate::bridge::{Channel, Svc, TICK};
+use crate::bridge::{Channel, Side, Svc, TICK};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND,
     TOO_MANY_USERS,
@@ -85,7 +85,7 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), move |module: &str| {
+    bridge(remote, Name::from(&port), N, move |module: &str| {
         Ok(port.user_named(module)?)
     })
 }
@@ -98,7 +98,7 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), move |module: &str| {
+    bridge(remote, Name::from(&port), N, move |module: &str| {
         Ok(port.user_named(module)?)
     })
 }
@@ -106,6 +106,7 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 pub(crate) fn bridge<Req, Rep, E, A>(
     remote: &Remote,
     name: Name,
+    users: usize,
     mut attach: A,
 ) -> Result<Exported, IpcError>
 where
@@ -118,7 +119,7 @@ where
         port: name.clone(),
         detail: "export it from within the tokio runtime its cell runs on".into(),
     })?;
-    let channel = Channel::<Req, Rep>::open(remote, &name)?;
+    let channel = Channel::<Req, Rep>::open(remote, &name, Side::Owner { users })?;
     let server =
         channel
             .service

@@ -17,7 +17,7 @@ use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
 };
 
-use crate::bridge::{Channel, Svc, TICK, sweep_dead};
+use crate::bridge::{Channel, Side, Svc, TICK, sweep_dead};
 use crate::wire::{
     CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TOO_MANY_USERS,
 };
@@ -248,7 +248,7 @@ pub(crate) fn connect<Req: Wire, Rep: Wire>(
     name: &Name,
     module: &str,
 ) -> Result<Connection<Req, Rep>, IpcError> {
-    let channel = Channel::<Req, Rep>::open(remote, name)?;
+    let channel = Channel::<Req, Rep>::open(remote, name, Side::User)?;
     let client =
         channel
             .service

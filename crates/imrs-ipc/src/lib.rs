@@ -44,8 +44,13 @@
 //! the owner that exports the port again is served.
 //!
 //! Service names are derived from the cell's name and the port's, so two cells on one
-//! host never meet; no iceoryx2 configuration file is needed. Across processes the ports
-//! run on real time: each process has its own clock.
+//! host never meet; no iceoryx2 configuration file is needed. The owner's process creates a
+//! port's services sized from its restrictions — as many user processes as the port has
+//! users, not iceoryx2's default of eight — and a user's process only opens them, so an
+//! import of a port nobody exports fails at once with [`IpcError::NoOwner`]. Across
+//! processes the ports run on the wall clock: each process has its own clock, and processes
+//! that must agree on one time build it from one epoch
+//! ([`RealClock::from_epoch`](imrs_core::imrs_ports::RealClock::from_epoch)).
 //!
 //! A message is copied once into shared memory and moved by value through the bridges'
 //! tasks: there is no loan yet to build it in place. Large messages (tens of KiB) therefore

@@ -57,7 +57,7 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     })?;
     let (port, owner, cell) = (port.clone(), port.owner_module().clone(), remote.clone());
     let served = name.clone();
-    bridge::<Req, Rep, _, _>(remote, name, move |module: &str| {
+    bridge::<Req, Rep, _, _>(remote, name, N, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
         let end = port.user_named(module)?;
         let _entered = runtime.enter();
@@ -83,9 +83,11 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
     // First the service the owner's process will relay to, so that it is there when the
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
+    // Its one user is the owner's relay.
     let server = bridge(
         remote,
         to_module(&name, module),
+        1,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {
                 return Err(Refusal::Wire(WireError::NotOnUserList {

@@ -587,3 +587,67 @@ async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() 
     let reply = within(5, asker.send(Number { value: 7 })).await.unwrap();
     assert_eq!(reply.value, 14);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceoryx2s_default() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    let cell = cell("many");
+    // Three times iceoryx2's default of 8 clients to a service.
+    const USERS: usize = 24;
+    let port: Port<Number, Number, usage::Receive, AnyUser, USERS> =
+        Port::declare(PortSpec::new("MANY", "OWNER"));
+    let remote = Remote::new(&cell).unwrap();
+    let _exported = imrs_ipc::export(&remote, &port).unwrap();
+    let users: Vec<_> = (0..USERS)
+        .map(|n| {
+            let module = format!("USER_{n}");
+            import::<Number, Number>(&remote, "MANY", "OWNER", &module)
+                .unwrap_or_else(|error| panic!("{module}: {error}"))
+        })
+        .collect();
+    // One more is refused by the port, naming it, as in one process.
+    let error = import::<Number, Number>(&remote, "MANY", "OWNER", "ONE_TOO_MANY")
+        .err()
+        .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::Refused(WireError::TooManyUsers {
+            port: "MANY".into(),
+            module: "ONE_TOO_MANY".into(),
+            capacity: USERS,
+        })
+    );
+    // And every admitted user is served.
+    let mut owner = port.owner().unwrap();
+    let serve = tokio::spawn(async move {
+        for _ in 0..USERS {
+            let (n, reply) = owner.receive().await.unwrap();
+            reply.reply(Number { value: n.value * 2 });
+        }
+    });
+    for (n, imported) in users.iter().enumerate() {
+        let mut end = imported.port().user_named(format!("USER_{n}")).unwrap();
+        let value = n as u64;
+        let doubled = within(10, end.send(Number { value })).await.unwrap();
+        assert_eq!(doubled.value, 2 * value);
+    }
+    within(10, serve).await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn importing_a_port_that_nobody_exports_says_so_at_once() {
+    let remote = Remote::new(&cell("nobody")).unwrap();
+    let started = std::time::Instant::now();
+    let error = import::<Number, Number>(&remote, "NOBODYS", "OWNER", "USER")
+        .err()
+        .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::NoOwner {
+            port: "NOBODYS".into()
+        }
+    );
+    // Not after the connect timeout: the port's services are not there at all.
+    assert!(started.elapsed() < Duration::from_secs(2));
+}
