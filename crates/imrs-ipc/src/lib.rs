@@ -30,7 +30,9 @@
 //! users query them, with [`export_response`] and [`import_response`] — a remote query
 //! waits for the owner's response handler, which runs when the owner's order says. `SENDALL`
 //! ports cross with [`export_send_all`] and [`import_send_all`]: the owner's broadcast
-//! reaches modules in other processes, and their replies come back.
+//! reaches modules in other processes, and their replies come back. `CALLALL` ports cross
+//! with [`export_call_all`] and [`import_call_all`]: the owner's query reaches the response
+//! handlers of modules in other processes, each run when its module's order says.
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
@@ -67,7 +69,7 @@ mod wire;
 pub use error::IpcError;
 pub use export::{Exported, export, export_response};
 pub use import::{Imported, import, import_response};
-pub use send_all::{export_send_all, import_send_all};
+pub use send_all::{export_call_all, export_send_all, import_call_all, import_send_all};
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;

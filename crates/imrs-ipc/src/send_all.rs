@@ -1,12 +1,15 @@
-//! `SENDALL` ports across processes: the owner's broadcast reaches user modules in other
-//! processes. Here the owner starts each rendezvous, so the bridges swap roles: a user
-//! module's process serves a service of its own, `PORT/to/MODULE`, and the owner's process
-//! relays to it whatever that module's end of the real port receives.
+//! `SENDALL` and `CALLALL` ports across processes: the owner's broadcast reaches user
+//! modules in other processes. Here the owner starts each rendezvous, so the bridges swap
+//! roles: a user module's process serves a service of its own, `PORT/to/MODULE`, and the
+//! owner's process relays to it whatever that module's end of the real port receives — a
+//! message to reply to, or a query its response handler would answer.
 
 use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireError, usage};
 
+use imrs_core::imrs_ports::usage::{Plain, Usage};
+
 use crate::export::{Forward, Refusal, bridge};
-use crate::import::{Relay, connect, relay};
+use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
 /// The service a remote user module is served on.
@@ -27,18 +30,32 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for Relayed {
     }
 }
 
+/// The owner counts a remote module attached from its connection; here the module attaches
+/// to the local port a moment later. A broadcast that comes in between waits for it, as it
+/// would have reached it in one process. (A short wait, checked each millisecond: only
+/// between the connection and the module's attaching.)
+async fn until_attached<Req: Wire, Rep: Wire, U: Usage>(end: &End<Req, Rep, U>) {
+    while end.peers().is_empty() {
+        tokio::time::sleep(std::time::Duration::from_millis(1)).await;
+    }
+}
+
 /// On a user's side, the local port's owner end: each broadcast from the other process is
 /// sent to the one local user, whose reply goes back.
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::SendAll> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
-        // The owner counts the module attached from its connection; here it attaches to the
-        // local port a moment later. A broadcast that comes in between waits for it, as it
-        // would have reached it in one process. (A short wait, checked each millisecond:
-        // only between the connection and the module's attaching.)
-        while self.peers().is_empty() {
-            tokio::time::sleep(std::time::Duration::from_millis(1)).await;
-        }
+        until_attached(self).await;
         let broadcast = self.send_all(request).await.ok()?;
+        Some(broadcast.first)
+    }
+}
+
+/// On a user's side, the local port's owner end: each query from the other process goes
+/// to the one local user's response handler, which answers when that module's order says.
+impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::CallAll> {
+    async fn forward(&mut self, request: Req) -> Option<Rep> {
+        until_attached(self).await;
+        let broadcast = self.call_all(request).await.ok()?;
         Some(broadcast.first)
     }
 }
@@ -50,6 +67,42 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
+    export_relayed(remote, port, |port, module| port.user_named(module))
+}
+
+/// Exports `port`, a `CALLALL` port, to the other processes of `remote`'s cell: its owner's
+/// queries reach their modules too, each answered by that module's response handler when
+/// its order says, as for a user in this process. Call it within the tokio runtime the cell
+/// runs on.
+pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Req, Rep, usage::CallAll, L, N>,
+) -> Result<Exported, IpcError> {
+    // The handler never runs: the relay takes each query and answers it with the other
+    // process's reply.
+    export_relayed(remote, port, |port, module| {
+        port.responder_named(module, |_: &(), _: Req| Rep::default())
+    })
+}
+
+/// How a remote module's end of the real port is attached.
+type UserEnd<Req, Rep, U, L, T, const N: usize> =
+    fn(&Port<Req, Rep, U, L, N>, &str) -> Result<T, WireError>;
+
+/// Exports a port whose owner starts each rendezvous: each remote module attached gets
+/// `user_end` of the real port, whose every message or query is relayed to its process.
+fn export_relayed<Req, Rep, U, L, T, const N: usize>(
+    remote: &Remote,
+    port: &Port<Req, Rep, U, L, N>,
+    user_end: UserEnd<Req, Rep, U, L, T, N>,
+) -> Result<Exported, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    U: Usage,
+    L: UserList,
+    T: Take<Req, Rep>,
+{
     let name = Name::from(port);
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
@@ -59,7 +112,7 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     let served = name.clone();
     bridge::<Req, Rep, _, _>(remote, name, N, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
-        let end = port.user_named(module)?;
+        let end = user_end(&port, module)?;
         let _entered = runtime.enter();
         relay(&cell, &to_module(&served, module), owner.as_str(), end)
             .map(|relay| Relayed { _relay: relay })
@@ -77,8 +130,37 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::SendAll>, IpcError> {
+    import_relayed(remote, port, owner, module)
+}
+
+/// Imports a `CALLALL` port of another process for module `module` of this one: a port of
+/// the same name and types, on which `module` attaches its response handler as in one
+/// process; the owner's queries wait for it, and it runs when `module`'s order says.
+/// Connects at once, refused as [`crate::import`] is. Call it within the tokio runtime the
+/// cell runs on.
+pub fn import_call_all<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, usage::CallAll>, IpcError> {
+    import_relayed(remote, port, owner, module)
+}
+
+fn import_relayed<Req, Rep, U>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, U>, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    U: Usage + Plain,
+    End<Req, Rep, U>: Forward<Req, Rep>,
+{
     let name = Name::from(port);
-    let local: Port<Req, Rep, usage::SendAll, AnyUser, 1> =
+    let local: Port<Req, Rep, U, AnyUser, 1> =
         Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
     // First the service the owner's process will relay to, so that it is there when the
     // owner answers the connection by relaying.

@@ -651,3 +651,69 @@ async fn importing_a_port_that_nobody_exports_says_so_at_once() {
     // Not after the connect timeout: the port's services are not there at all.
     assert!(started.elapsed() < Duration::from_secs(2));
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_this_one() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    let cell = cell("call-all");
+    let port: Port<Number, Number, usage::CallAll, AnyUser, 3> =
+        Port::declare(PortSpec::new("POLL", "CALLER").user_list(["REMOTE_1", "REMOTE_2", "LOCAL"]));
+    let _exported = imrs_ipc::export_call_all(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut caller = port.owner().unwrap();
+    // A response handler in this process, beside two in others (which answer with 4 n).
+    let mut local = port
+        .responder_named("LOCAL", |_: &(), n: Number| Number { value: 3 * n.value })
+        .unwrap();
+    let answerers: Vec<Peer> = ["REMOTE_1", "REMOTE_2"]
+        .iter()
+        .map(|module| peer(&["answerer", &cell, "POLL", module, "10"]))
+        .collect();
+    within(10, async {
+        while caller.peers().len() < 3 {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    // The local handler answers only when served, so each query is answered first by a
+    // remote one, then by the other, then by the local one.
+    for value in 1..=10 {
+        let mut poll = within(5, caller.call_all(Number { value })).await.unwrap();
+        let mut answers = vec![(poll.from.clone(), poll.first.value)];
+        let (from, second) = within(5, poll.next_reply()).await.unwrap();
+        answers.push((from, second.value));
+        within(5, local.serve(&())).await.unwrap();
+        let (from, third) = within(5, poll.next_reply()).await.unwrap();
+        answers.push((from, third.value));
+        assert!(
+            within(5, poll.next_reply()).await.is_none(),
+            "three answers"
+        );
+        answers.sort();
+        assert_eq!(
+            answers,
+            [
+                ("LOCAL".into(), 3 * value),
+                ("REMOTE_1".into(), 4 * value),
+                ("REMOTE_2".into(), 4 * value)
+            ]
+        );
+    }
+    for answerer in answerers {
+        let text = within(30, async {
+            let mut peer = answerer;
+            loop {
+                if let Some(status) = peer.0.try_wait().unwrap() {
+                    let mut text = String::new();
+                    std::io::Read::read_to_string(&mut peer.0.stdout.take().unwrap(), &mut text)
+                        .unwrap();
+                    assert!(status.success(), "{text}");
+                    break text;
+                }
+                tokio::time::sleep(Duration::from_millis(20)).await;
+            }
+        })
+        .await;
+        assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
+    }
+}

@@ -7,6 +7,9 @@
 //!   response handler answers each number with its triple. Prints `ready` once exported.
 //! - `ipc_peer listener CELL PORT MODULE N`: imports the `SENDALL` port PORT (owner
 //!   BROADCASTER) for MODULE, answers N broadcasts with their doubles, printing each.
+//! - `ipc_peer answerer CELL PORT MODULE N`: imports the `CALLALL` port PORT (owner CALLER)
+//!   for MODULE, whose response handler answers N queries with their quadruples, printing
+//!   each.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -14,7 +17,9 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
-use imrs_ipc::{Remote, ZeroCopySend, export, export_response, import, import_send_all};
+use imrs_ipc::{
+    Remote, ZeroCopySend, export, export_response, import, import_call_all, import_send_all,
+};
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
@@ -36,9 +41,10 @@ fn main() -> ExitCode {
             ["owner", cell, port] => owner(cell, port).await,
             ["responder", cell, port] => responder(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
+            ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
-                "usage: ipc_peer owner|responder CELL PORT | user|listener CELL PORT MODULE N"
+                "usage: ipc_peer owner|responder CELL PORT | user|listener|answerer CELL PORT MODULE N"
                     .into(),
             ),
         }
@@ -96,6 +102,21 @@ async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
         reply.reply(Number {
             value: 2 * number.value,
         });
+    }
+    Ok(())
+}
+
+async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
+    let imported = import_call_all::<Number, Number>(&Remote::new(cell)?, port, "CALLER", module)?;
+    let mut answering =
+        imported
+            .port()
+            .responder_named(module, |factor: &u64, number: Number| Number {
+                value: factor * number.value,
+            })?;
+    for _ in 0..n.parse::<u64>()? {
+        answering.serve(&4).await?;
+        println!("answered");
     }
     Ok(())
 }
