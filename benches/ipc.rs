@@ -4,8 +4,13 @@
 //! the same two processes, the same run. Each case: p50, p99 and p99.9 over its round
 //! trips, and the ratios the targets are stated in.
 //!
+//! Then the TIGHT cases, against a second peer started only for them (its spinning threads
+//! would otherwise take processor time from the parked cases): an IMRS port declared TIGHT,
+//! whose bridges spin instead of waiting on events, beside a raw iceoryx2 round trip whose
+//! client and server both spin.
+//!
 //! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
-//! that the benchmark cannot rot. The peer is this same binary, started again with
+//! that the benchmark cannot rot. The peers are this same binary, started again with
 //! `IMRS_IPC_BENCH_PEER` set.
 
 use std::io::{BufRead, BufReader};
@@ -13,7 +18,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
 use imrs_ipc::{Remote, Wire, export, import};
 
 type Svc = ipc_threadsafe::Service;
@@ -39,6 +44,7 @@ impl Default for Large {
 }
 
 const PEER: &str = "IMRS_IPC_BENCH_PEER";
+const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
 
 fn main() {
     if let Ok(cell) = std::env::var(PEER) {
@@ -51,20 +57,10 @@ fn main() {
         200
     };
     let cell = format!("bench-{}", std::process::id());
-    let mut child = Command::new(std::env::current_exe().expect("this binary"))
-        .env(PEER, &cell)
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("the peer starts");
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().expect("piped"))
-        .read_line(&mut line)
-        .expect("the peer speaks");
-    assert_eq!(line.trim(), "ready", "the peer failed: {line}");
-
+    let mut child = start_peer(&cell, false);
     let runtime = runtime();
-    let raw_small = raw_round_trips::<Small>(&cell, "small", rounds);
-    let raw_large = raw_round_trips::<Large>(&cell, "large", rounds);
+    let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
+    let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
     let (imrs_small, imrs_large) = runtime.block_on(async {
         (
             imrs_round_trips::<Small>(&cell, "SMALL", rounds).await,
@@ -74,12 +70,21 @@ fn main() {
     let _ = child.kill();
     let _ = child.wait();
 
+    let tight_cell = format!("{cell}-tight");
+    let mut child = start_peer(&tight_cell, true);
+    let raw_spin = raw_round_trips::<Small>(&tight_cell, "small", rounds, Wait::Spin);
+    let imrs_tight = runtime.block_on(imrs_round_trips::<Small>(&tight_cell, "SMALL", rounds));
+    let _ = child.kill();
+    let _ = child.wait();
+
     println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
     for (name, times) in [
         ("raw iceoryx2, events, 8 B", &raw_small),
         ("IMRS port over iceoryx2, 8 B", &imrs_small),
         ("raw iceoryx2, events, 64 KiB", &raw_large),
         ("IMRS port over iceoryx2, 64 KiB", &imrs_large),
+        ("raw iceoryx2, both spinning, 8 B", &raw_spin),
+        ("IMRS TIGHT port, 8 B", &imrs_tight),
     ] {
         let [p50, p99, p999] = percentiles(times);
         println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
@@ -97,6 +102,35 @@ fn main() {
         "  IMRS 64 KiB vs IMRS 8 B (target: within 1.5)                       {}",
         show(ratio(&imrs_large, &imrs_small).collect())
     );
+    println!(
+        "  IMRS TIGHT 8 B vs raw spinning 8 B (target: within 1.2)            {}",
+        show(ratio(&imrs_tight, &raw_spin).collect())
+    );
+}
+
+/// Starts a peer for `cell`, TIGHT or parked, and waits until it serves.
+fn start_peer(cell: &str, tight: bool) -> std::process::Child {
+    let mut command = Command::new(std::env::current_exe().expect("this binary"));
+    command.env(PEER, cell).stdout(Stdio::piped());
+    if tight {
+        command.env(TIGHT, "1");
+    }
+    let mut child = command.spawn().expect("the peer starts");
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().expect("piped"))
+        .read_line(&mut line)
+        .expect("the peer speaks");
+    assert_eq!(line.trim(), "ready", "the peer failed: {line}");
+    child
+}
+
+/// How a raw round trip's two ends wait.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Wait {
+    /// On iceoryx2 events, each side notifying the other.
+    Events,
+    /// Looking again at once, yielding the processor between looks: nobody notifies.
+    Spin,
 }
 
 /// Each process's runtime: two workers, with stacks large enough for 64 KiB messages, which
@@ -118,29 +152,50 @@ fn percentiles(times: &[Duration]) -> [Duration; 3] {
     [at(0.5), at(0.99), at(0.999)]
 }
 
-/// The peer: owns both IMRS ports (echoing), and serves both raw services.
+/// The peer: owns both IMRS ports (echoing), and serves both raw services; or, TIGHT, one
+/// TIGHT IMRS port and one spinning raw service.
 fn peer(cell: &str) {
-    for part in ["small", "large"] {
-        let cell = cell.to_owned();
+    let tight = std::env::var(TIGHT).is_ok();
+    let parts: &[&str] = if tight {
+        &["small"]
+    } else {
+        &["small", "large"]
+    };
+    let wait = if tight { Wait::Spin } else { Wait::Events };
+    for part in parts {
+        let (cell, part) = (cell.to_owned(), *part);
         std::thread::spawn(move || match part {
-            "small" => raw_server::<Small>(&cell, part),
-            _ => raw_server::<Large>(&cell, part),
+            "small" => raw_server::<Small>(&cell, part, wait),
+            _ => raw_server::<Large>(&cell, part, wait),
         });
     }
+    let process_type = if tight {
+        ProcessType::Tight
+    } else {
+        ProcessType::Indep
+    };
     let runtime = runtime();
     runtime.block_on(async {
         let remote = Remote::new(cell).expect("a cell name");
-        let small = echo::<Small>(&remote, "SMALL");
-        let large = echo::<Large>(&remote, "LARGE");
+        let small = echo::<Small>(&remote, "SMALL", process_type);
+        let large = (!tight).then(|| echo::<Large>(&remote, "LARGE", process_type));
         // Give the raw servers a moment to open their services.
         tokio::time::sleep(Duration::from_millis(200)).await;
         println!("ready");
-        let _ = tokio::join!(small, large);
+        let _ = small.await;
+        if let Some(large) = large {
+            let _ = large.await;
+        }
     });
 }
 
-fn echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
-    let port: Port<T, T, usage::Receive, AnyUser, 1> = Port::declare(PortSpec::new(name, "ECHO"));
+fn echo<T: Wire>(
+    remote: &Remote,
+    name: &str,
+    process_type: ProcessType,
+) -> tokio::task::JoinHandle<()> {
+    let port: Port<T, T, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new(name, "ECHO").process_type(process_type));
     let exported = export(remote, &port).expect("exported");
     let mut owner = port.owner().expect("the owner's end");
     tokio::spawn(async move {
@@ -202,37 +257,52 @@ fn raw_services<T: Wire>(
     (node, service, requested, replied)
 }
 
-/// A raw iceoryx2 server: waits on its request event, answers a copy, notifies.
-fn raw_server<T: Wire>(cell: &str, part: &str) {
+/// A raw iceoryx2 server: waits on its request event (or spins), answers a copy, notifies
+/// (unless the client spins too).
+fn raw_server<T: Wire>(cell: &str, part: &str, wait: Wait) {
     let (_node, service, requested, replied) = raw_services::<T>(cell, part);
     let server = service.server_builder().create().expect("a server");
     let listener = requested.listener_builder().create().expect("a listener");
     let notifier = replied.notifier_builder().create().expect("a notifier");
     loop {
-        if listener.blocking_wait(|_| {}).is_err() {
-            return;
+        match wait {
+            Wait::Events => {
+                if listener.blocking_wait(|_| {}).is_err() {
+                    return;
+                }
+            }
+            Wait::Spin => std::thread::yield_now(),
         }
         while let Ok(Some(request)) = server.receive() {
             let payload = *request.payload();
             let _ = request.send_copy(payload);
-            let _ = notifier.notify();
+            if wait == Wait::Events {
+                let _ = notifier.notify();
+            }
         }
     }
 }
 
-fn raw_round_trips<T: Wire>(cell: &str, part: &str, rounds: usize) -> Vec<Duration> {
+fn raw_round_trips<T: Wire>(cell: &str, part: &str, rounds: usize, wait: Wait) -> Vec<Duration> {
     let (_node, service, requested, replied) = raw_services::<T>(cell, part);
     let client = service.client_builder().create().expect("a client");
     let listener = replied.listener_builder().create().expect("a listener");
     let notifier = requested.notifier_builder().create().expect("a notifier");
     let round_trip = || {
         let pending = client.send_copy(T::default()).expect("sent");
-        let _ = notifier.notify();
+        if wait == Wait::Events {
+            let _ = notifier.notify();
+        }
         loop {
             if let Ok(Some(response)) = pending.receive() {
                 return std::hint::black_box(*response.payload());
             }
-            let _ = listener.timed_wait(|_| {}, Duration::from_millis(50));
+            match wait {
+                Wait::Events => {
+                    let _ = listener.timed_wait(|_| {}, Duration::from_millis(50));
+                }
+                Wait::Spin => std::thread::yield_now(),
+            }
         }
     };
     for _ in 0..rounds / 10 {

@@ -12,10 +12,10 @@ use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
 
-use crate::bridge::{Channel, Side, Svc, TICK};
+use crate::bridge::{Channel, Side, Svc, Wait};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND,
-    TOO_MANY_USERS,
+    TIGHT, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -85,7 +85,8 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), N, move |module: &str| {
+    let wait = Wait::of(port.process_type());
+    bridge(remote, Name::from(&port), N, wait, move |module: &str| {
         Ok(port.user_named(module)?)
     })
 }
@@ -98,7 +99,8 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), N, move |module: &str| {
+    let wait = Wait::of(port.process_type());
+    bridge(remote, Name::from(&port), N, wait, move |module: &str| {
         Ok(port.user_named(module)?)
     })
 }
@@ -107,6 +109,7 @@ pub(crate) fn bridge<Req, Rep, E, A>(
     remote: &Remote,
     name: Name,
     users: usize,
+    wait: Wait,
     mut attach: A,
 ) -> Result<Exported, IpcError>
 where
@@ -140,14 +143,15 @@ where
             let _channel = channel;
             let mut users: Users<E> = HashMap::new();
             while !halt.load(Ordering::Acquire) {
-                // Blocks until a request event or the tick: no polling of the data.
-                if listener.timed_wait(|_| {}, TICK).is_err() {
+                // Parked, blocks until a request event or the tick: no polling of the data.
+                // Spinning (TIGHT), looks again at once.
+                if !wait.once(&listener) {
                     break;
                 }
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take(active, &mut attach, &mut users, &runtime, &notifier);
+                    take(active, &mut attach, &mut users, &runtime, &notifier, wait);
                 }
             }
         })
@@ -172,11 +176,12 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     users: &mut Users<E>,
     runtime: &tokio::runtime::Handle,
     notifier: &Arc<Mutex<Notifier<Svc>>>,
+    wait: Wait,
 ) {
     let meta = *active.user_header();
     // A header a peer wrote garbage into is refused; the bridge goes on serving.
     let Some(module) = meta.module().map(str::to_owned) else {
-        respond(active, MALFORMED, 0, Rep::default(), notifier);
+        respond(active, MALFORMED, 0, Rep::default(), Some(notifier));
         return;
     };
     // A module this copy of the owner has not seen yet — the owner was restarted since the
@@ -184,26 +189,32 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     let end = match user(attach, users, &module) {
         Ok(end) => end,
         Err((status, detail)) => {
-            respond(active, status, detail, Rep::default(), notifier);
+            respond(active, status, detail, Rep::default(), Some(notifier));
             return;
         }
     };
     match meta.kind {
-        CONNECT => respond(active, OK, 0, Rep::default(), notifier),
+        // The connection learns how the port waits: a TIGHT port's user spins too.
+        CONNECT => {
+            let flags = if wait.notifies() { 0 } else { TIGHT };
+            respond(active, OK, flags, Rep::default(), Some(notifier));
+        }
         SEND => {
             let request = *active.payload();
-            let notifier = Arc::clone(notifier);
+            // A spinning user looks for its reply without being woken.
+            let notifier = wait.notifies().then(|| Arc::clone(notifier));
             // Each request waits on tokio, so that several remote modules' requests are
             // pending at once and the owner's order decides which it takes.
             runtime.spawn(async move {
                 let reply = end.lock().await.forward(request).await;
+                let notifier = notifier.as_deref();
                 match reply {
-                    Some(reply) => respond(active, OK, 0, reply, &notifier),
-                    None => respond(active, NO_REPLY, 0, Rep::default(), &notifier),
+                    Some(reply) => respond(active, OK, 0, reply, notifier),
+                    None => respond(active, NO_REPLY, 0, Rep::default(), notifier),
                 }
             });
         }
-        _ => respond(active, MALFORMED, 0, Rep::default(), notifier),
+        _ => respond(active, MALFORMED, 0, Rep::default(), Some(notifier)),
     }
 }
 
@@ -231,21 +242,23 @@ fn user<E>(
     }
 }
 
-/// Replies through shared memory, then wakes the users' bridges.
+/// Replies through shared memory, then wakes the users' bridges (unless they spin).
 fn respond<Req: Wire, Rep: Wire>(
     active: Active<Req, Rep>,
     status: u32,
     detail: u32,
     reply: Rep,
-    notifier: &Mutex<Notifier<Svc>>,
+    notifier: Option<&Mutex<Notifier<Svc>>>,
 ) {
     if let Ok(mut response) = active.loan_uninit() {
         *response.user_header_mut() = ReplyMeta { status, detail };
         // A user that died meanwhile cannot be answered; nothing else is lost.
         let _ = response.write_payload(reply).send();
     }
-    let _ = notifier
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .notify();
+    if let Some(notifier) = notifier {
+        let _ = notifier
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .notify();
+    }
 }

@@ -17,9 +17,9 @@ use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
 };
 
-use crate::bridge::{Channel, Side, Svc, TICK, sweep_dead};
+use crate::bridge::{Channel, Side, Svc, TICK, Wait, sweep_dead};
 use crate::wire::{
-    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TOO_MANY_USERS,
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -27,6 +27,9 @@ type Pending<Req, Rep> = PendingResponse<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 type Asker<Req, Rep> = Client<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 /// A request sent, and the local sender's right to its reply (taken when answered).
 type Waiting<Req, Rep> = (Pending<Req, Rep>, Option<ReplyHandle<Rep>>);
+
+/// How often a waiter with requests waiting looks for dead peers.
+const SWEEP_PERIOD: Duration = Duration::from_millis(500);
 
 /// How long the owner may take to accept the connection.
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
@@ -182,6 +185,7 @@ where
         client,
         listener,
         wake_owner,
+        wait,
     } = connect(remote, &name, module)?;
     let wake_self = channel.notifier(&channel.replied)?;
 
@@ -194,7 +198,7 @@ where
         .spawn(move || {
             // The channel lives as long as the waiter: its node keeps the services open.
             let _channel = channel;
-            wait_for_replies(&listener, &pending_rx, &halt);
+            wait_for_replies(&listener, &pending_rx, &halt, wait);
         })
         .map_err(|error| IpcError::Transport {
             port: name.clone(),
@@ -218,6 +222,10 @@ where
             if pending_tx.send((pending, reply)).is_err() {
                 break;
             }
+            // A TIGHT port's owner and waiter look without being woken.
+            if !wait.notifies() {
+                continue;
+            }
             let wake = wake.lock().unwrap_or_else(PoisonError::into_inner);
             let _ = wake.0.notify();
             // The reply may have come before the waiter had the pending request: wake it
@@ -239,6 +247,8 @@ pub(crate) struct Connection<Req: Wire, Rep: Wire> {
     pub(crate) client: Asker<Req, Rep>,
     pub(crate) listener: Listener<Svc>,
     pub(crate) wake_owner: Notifier<Svc>,
+    /// How the port waits, as its owner said at connection.
+    pub(crate) wait: Wait,
 }
 
 /// Opens port `name` of `remote` as a client and connects as module `module`: the owner
@@ -260,23 +270,25 @@ pub(crate) fn connect<Req: Wire, Rep: Wire>(
             })?;
     let listener = channel.listener(&channel.replied)?;
     let wake_owner = channel.notifier(&channel.requested)?;
-    handshake(&client, &listener, &wake_owner, name, module)?;
+    let wait = handshake(&client, &listener, &wake_owner, name, module)?;
     Ok(Connection {
         channel,
         client,
         listener,
         wake_owner,
+        wait,
     })
 }
 
-/// The handshake: the owner attaches `module` to its port, or refuses it by name.
+/// The handshake: the owner attaches `module` to its port, and says how the port waits; or
+/// refuses it by name.
 fn handshake<Req: Wire, Rep: Wire>(
     client: &Asker<Req, Rep>,
     listener: &Listener<Svc>,
     wake_owner: &Notifier<Svc>,
     port: &Name,
     module: &str,
-) -> Result<(), IpcError> {
+) -> Result<Wait, IpcError> {
     let transport = |detail: String| IpcError::Transport {
         port: port.clone(),
         detail,
@@ -296,7 +308,8 @@ fn handshake<Req: Wire, Rep: Wire>(
             let meta = *response.user_header();
             let (port, module) = (port.clone(), Name::from(module));
             return match meta.status {
-                OK => Ok(()),
+                OK if meta.detail & TIGHT != 0 => Ok(Wait::Spinning),
+                OK => Ok(Wait::Parked),
                 NOT_ON_USER_LIST => {
                     Err(IpcError::Refused(WireError::NotOnUserList { port, module }))
                 }
@@ -316,17 +329,25 @@ fn handshake<Req: Wire, Rep: Wire>(
 }
 
 /// The waiter: hands each reply to its local sender; drops the handles of requests whose
-/// owner is gone, so that their senders fail at once.
+/// owner is gone, so that their senders fail at once. On a TIGHT port it looks again at
+/// once while a request waits, and rests on the queue of new requests while none does.
 fn wait_for_replies<Req: Wire, Rep: Wire>(
     listener: &Listener<Svc>,
     incoming: &mpsc::Receiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
     stop: &AtomicBool,
+    wait: Wait,
 ) {
     let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
-    let mut ticks = 0_u32;
+    let mut swept = Instant::now();
     while !stop.load(Ordering::Acquire) {
-        // Blocks until a reply event or the tick.
-        if listener.timed_wait(|_| {}, TICK).is_err() {
+        if waiting.is_empty() && !wait.notifies() {
+            match incoming.recv_timeout(TICK) {
+                Ok((pending, reply)) => waiting.push((pending, Some(reply))),
+                Err(mpsc::RecvTimeoutError::Timeout) => continue,
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+        // Parked, blocks until a reply event or the tick.
+        } else if !wait.once(listener) {
             break;
         }
         waiting.extend(
@@ -334,10 +355,10 @@ fn wait_for_replies<Req: Wire, Rep: Wire>(
                 .try_iter()
                 .map(|(pending, reply)| (pending, Some(reply))),
         );
-        ticks += 1;
         // Every half second while something waits: see whether a peer died.
-        if !waiting.is_empty() && ticks.is_multiple_of(10) {
+        if !waiting.is_empty() && swept.elapsed() >= SWEEP_PERIOD {
             sweep_dead();
+            swept = Instant::now();
         }
         waiting.retain_mut(|(pending, reply)| {
             // Whether the owner still holds the request, read before looking for its

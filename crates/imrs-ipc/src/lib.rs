@@ -34,6 +34,12 @@
 //! with [`export_call_all`] and [`import_call_all`]: the owner's query reaches the response
 //! handlers of modules in other processes, each run when its module's order says.
 //!
+//! A port declared TIGHT ([`ProcessType::Tight`](imrs_core::imrs_ports::ProcessType))
+//! crosses with both sides' bridge threads spinning — looking again at once, yielding the
+//! processor between looks — instead of waiting on iceoryx2 events, and nobody notifies. Its
+//! users learn it when they connect. The owner's bridge spins for as long as the port is
+//! exported; a user's only while a request waits.
+//!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
 //! port connects — and a mismatch is refused, naming the port.

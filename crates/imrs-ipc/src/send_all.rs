@@ -8,6 +8,7 @@ use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireEr
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
+use crate::bridge::Wait;
 use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
@@ -110,7 +111,8 @@ where
     })?;
     let (port, owner, cell) = (port.clone(), port.owner_module().clone(), remote.clone());
     let served = name.clone();
-    bridge::<Req, Rep, _, _>(remote, name, N, move |module: &str| {
+    // The owner starts each rendezvous here; its relays are parked.
+    bridge::<Req, Rep, _, _>(remote, name, N, Wait::Parked, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
         let end = user_end(&port, module)?;
         let _entered = runtime.enter();
@@ -170,6 +172,7 @@ where
         remote,
         to_module(&name, module),
         1,
+        Wait::Parked,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {
                 return Err(Refusal::Wire(WireError::NotOnUserList {

@@ -56,7 +56,12 @@ fn peer(args: &[&str]) -> Peer {
 
 /// Starts an owner of `port` in `cell` and waits until it has exported it.
 fn owner(cell: &str, port: &str) -> Peer {
-    let mut owner = peer(&["owner", cell, port]);
+    started_owner("owner", cell, port)
+}
+
+/// Starts an owner of the role `role` (`owner`, `tight-owner`), ready once exported.
+fn started_owner(role: &str, cell: &str, port: &str) -> Peer {
+    let mut owner = peer(&[role, cell, port]);
     let stdout = owner.0.stdout.take().expect("piped");
     let mut line = String::new();
     BufReader::new(stdout)
@@ -716,4 +721,29 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
         .await;
         assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
     }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tight_port_crosses_with_both_sides_spinning_and_a_dead_owner_still_fails_the_sender() {
+    let cell = cell("tight");
+    let mut first = started_owner("tight-owner", &cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    // Nobody notifies on a TIGHT port: every reply is found by looking.
+    for value in 1..=200 {
+        let reply = within(5, asker.send(Number { value })).await.unwrap();
+        assert_eq!(reply.value, 2 * value);
+    }
+    // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile. The spinning
+    // waiter sees it gone as a parked one does.
+    let sending = tokio::spawn(async move { asker.send(Number { value: 4000 }).await });
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    let result = within(3, sending).await.unwrap();
+    assert!(
+        matches!(result, Err(SendError::NoReply { ref port }) if port == "DOUBLE"),
+        "{result:?}"
+    );
 }

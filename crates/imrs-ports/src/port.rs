@@ -191,6 +191,11 @@ where
         &self.core.meta.owner
     }
 
+    /// The process type the port was declared with: how its waits are made.
+    pub fn process_type(&self) -> ProcessType {
+        self.core.meta.process_type
+    }
+
     /// The name of this port's handler or exception `what`: `PORT.what`, as an order names
     /// it (`ask_child1.handler("STATUS")` is `"ASK_CHILD1.STATUS"`, `.handler("TIMEOUT")`
     /// its timeout). Built from the port, so it cannot name another one by a typo.

@@ -3,6 +3,8 @@
 //! - `ipc_peer owner CELL PORT`: exports PORT (users ASKER and ASKER_2, two at most), and
 //!   answers each number with its double, after waiting the number's milliseconds if it is
 //!   over 1000 (so that a test can catch it mid-rendezvous). Prints `ready` once exported.
+//! - `ipc_peer tight-owner CELL PORT`: the same, with PORT declared TIGHT: both sides' bridges
+//!   spin instead of waiting on events.
 //! - `ipc_peer responder CELL PORT`: exports the `RESPONSE` port PORT (user ASKER), whose
 //!   response handler answers each number with its triple. Prints `ready` once exported.
 //! - `ipc_peer listener CELL PORT MODULE N`: imports the `SENDALL` port PORT (owner
@@ -16,7 +18,7 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
 use imrs_ipc::{
     Remote, ZeroCopySend, export, export_response, import, import_call_all, import_send_all,
 };
@@ -38,13 +40,14 @@ fn main() -> ExitCode {
         .expect("a tokio runtime starts");
     let result = runtime.block_on(async {
         match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
-            ["owner", cell, port] => owner(cell, port).await,
+            ["owner", cell, port] => owner(cell, port, ProcessType::Indep).await,
+            ["tight-owner", cell, port] => owner(cell, port, ProcessType::Tight).await,
             ["responder", cell, port] => responder(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
-                "usage: ipc_peer owner|responder CELL PORT | user|listener|answerer CELL PORT MODULE N"
+                "usage: ipc_peer owner|tight-owner|responder CELL PORT | user|listener|answerer CELL PORT MODULE N"
                     .into(),
             ),
         }
@@ -60,9 +63,12 @@ fn main() -> ExitCode {
 
 type Error = Box<dyn std::error::Error>;
 
-async fn owner(cell: &str, port: &str) -> Result<(), Error> {
-    let port: Port<Number, Number, usage::Receive, AnyUser, 2> =
-        Port::declare(PortSpec::new(port, "DOUBLER").user_list(["ASKER", "ASKER_2"]));
+async fn owner(cell: &str, port: &str, process_type: ProcessType) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::declare(
+        PortSpec::new(port, "DOUBLER")
+            .user_list(["ASKER", "ASKER_2"])
+            .process_type(process_type),
+    );
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut owner = port.owner()?;
