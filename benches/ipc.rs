@@ -19,18 +19,18 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
-use imrs_ipc::{Remote, Wire, export, import};
+use imrs_ipc::{FromBytes, Remote, Wire, export, import};
 
 type Svc = ipc_threadsafe::Service;
 
-#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_benches::Small")]
 struct Small {
     value: u64,
 }
 
-#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_benches::Large")]
 struct Large {

@@ -5,7 +5,7 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_ipc::{Imported, ZeroCopySend};
+use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
 use imrs_sim::imrs_core::Cell;
 use imrs_sim::imrs_core::imrs_ports::{
     AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage,
@@ -42,7 +42,7 @@ pub type ZonePort = Port<ModuleName, (), usage::Receive, AnyUser, 2>;
 const MODULE_NAME: usize = 32;
 
 /// A module's name as a message that can cross processes: fixed-size and self-contained.
-#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
+#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("cell_example::ModuleName")]
 pub struct ModuleName {

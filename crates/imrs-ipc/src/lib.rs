@@ -79,3 +79,4 @@ pub use send_all::{export_call_all, export_send_all, import_call_all, import_sen
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;
+pub use zerocopy::FromBytes;

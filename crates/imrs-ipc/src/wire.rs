@@ -3,22 +3,27 @@
 use std::fmt::Debug;
 
 use iceoryx2::prelude::*;
+use zerocopy::FromBytes;
 
 use crate::IpcError;
 
 /// A message that can cross processes: `#[repr(C)]`, self-contained (no `Vec`, `String` or
 /// reference), and `ZeroCopySend`, so that it can lie in shared memory and be read in place
-/// by another process. `Default` gives the bridge a value for its own handshake.
+/// by another process; and `FromBytes` — every bit pattern is one of its values (no `bool`,
+/// `char` or enum) — so that whatever a peer writes into a sample is read as a value, never
+/// as undefined behaviour: a message that makes no sense is the receiver's to refuse.
+/// `Default` gives the bridge a value for its own handshake.
 #[diagnostic::on_unimplemented(
     message = "`{Self}` cannot cross processes",
     label = "not a message an IPC port can carry",
-    note = "an IPC port's messages lie in shared memory: make the type #[repr(C)], \
-            self-contained (no Vec, String, Box or reference), Copy and Default, and \
-            #[derive(ZeroCopySend)]"
+    note = "an IPC port's messages lie in shared memory, written by another process: make \
+            the type #[repr(C)], self-contained (no Vec, String, Box or reference), of \
+            fields valid for any bits (no bool, char or enum), Copy and Default, and \
+            #[derive(ZeroCopySend, FromBytes)]"
 )]
-pub trait Wire: ZeroCopySend + Copy + Default + Debug + Send + Sync + 'static {}
+pub trait Wire: ZeroCopySend + FromBytes + Copy + Default + Debug + Send + Sync + 'static {}
 
-impl<T: ZeroCopySend + Copy + Default + Debug + Send + Sync + 'static> Wire for T {}
+impl<T: ZeroCopySend + FromBytes + Copy + Default + Debug + Send + Sync + 'static> Wire for T {}
 
 /// What a request is for.
 pub(crate) const CONNECT: u32 = 1;
@@ -28,7 +33,7 @@ pub(crate) const SEND: u32 = 2;
 pub(crate) const MODULE_NAME: usize = 64;
 
 /// Beside each request: what it is for, and the module it comes from.
-#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc::RequestMeta")]
 pub(crate) struct RequestMeta {
@@ -69,7 +74,7 @@ impl RequestMeta {
 }
 
 /// Beside each reply: how the request went.
-#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc::ReplyMeta")]
 pub(crate) struct ReplyMeta {

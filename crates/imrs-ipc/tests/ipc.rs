@@ -8,10 +8,10 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_core::imrs_ports::{SendError, WireError};
-use imrs_ipc::{IpcError, Remote, ZeroCopySend, import};
+use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import};
 
 /// The peer's message: the same by name, size and alignment.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc_tests::Number")]
 struct Number {
@@ -19,7 +19,7 @@ struct Number {
 }
 
 /// A message the peer does not know.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc_tests::Wide")]
 struct Wide {
@@ -236,7 +236,7 @@ fn a_cell_name_that_cannot_name_a_service_is_refused_by_name() {
 }
 
 /// The request header as the bridge lays it out, for a peer that writes garbage into it.
-#[derive(Debug, Clone, Copy, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc::RequestMeta")]
 struct ForgedMeta {
@@ -255,7 +255,7 @@ impl Default for ForgedMeta {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc::ReplyMeta")]
 struct ReplyMeta {

@@ -3,7 +3,7 @@
 //! encoded and decoded here, so that a record a peer garbled decodes to `None`, never to a
 //! wrong command.
 
-use imrs_ipc::ZeroCopySend;
+use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_sim::{DeviceError, FeederId, Line, PalletId, Release, RobotId, Role, Station, Target};
 
 /// What a line's module asks of a device.
@@ -32,7 +32,7 @@ pub enum Op {
 }
 
 /// An [`Op`] in shared memory.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("cell_example::DeviceCall")]
 pub struct DeviceCall {
@@ -121,7 +121,7 @@ impl DeviceCall {
 
 /// How a device call went, in shared memory: a value (a chip number, a pallet), nothing, or
 /// the device's error.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("cell_example::DeviceAnswer")]
 pub struct DeviceAnswer {

@@ -20,11 +20,12 @@ use std::time::Duration;
 
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
 use imrs_ipc::{
-    Remote, ZeroCopySend, export, export_response, import, import_call_all, import_send_all,
+    FromBytes, Remote, ZeroCopySend, export, export_response, import, import_call_all,
+    import_send_all,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
 #[repr(C)]
 #[type_name("imrs_ipc_tests::Number")]
 struct Number {
