@@ -32,7 +32,8 @@
 //! ports cross with [`export_send_all`] and [`import_send_all`]: the owner's broadcast
 //! reaches modules in other processes, and their replies come back. `CALLALL` ports cross
 //! with [`export_call_all`] and [`import_call_all`]: the owner's query reaches the response
-//! handlers of modules in other processes, each run when its module's order says.
+//! handlers of modules in other processes, each run when its module's order says; and
+//! `QUERY` ports, whose owner queries its users, with [`export_query`] and [`import_query`].
 //!
 //! A port declared TIGHT ([`ProcessType::Tight`](imrs_core::imrs_ports::ProcessType))
 //! crosses with both sides' bridge threads spinning — looking again at once, yielding the
@@ -75,7 +76,9 @@ mod wire;
 pub use error::IpcError;
 pub use export::{Exported, export, export_response};
 pub use import::{Imported, import, import_response};
-pub use send_all::{export_call_all, export_send_all, import_call_all, import_send_all};
+pub use send_all::{
+    export_call_all, export_query, export_send_all, import_call_all, import_query, import_send_all,
+};
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;

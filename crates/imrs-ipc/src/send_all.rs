@@ -1,5 +1,5 @@
-//! `SENDALL` and `CALLALL` ports across processes: the owner's broadcast reaches user
-//! modules in other processes. Here the owner starts each rendezvous, so the bridges swap
+//! `SENDALL`, `CALLALL` and `QUERY` ports across processes: the owner's broadcast or query
+//! reaches user modules in other processes. Here the owner starts each rendezvous, so the bridges swap
 //! roles: a user module's process serves a service of its own, `PORT/to/MODULE`, and the
 //! owner's process relays to it whatever that module's end of the real port receives — a
 //! message to reply to, or a query its response handler would answer.
@@ -9,7 +9,7 @@ use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireEr
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
 use crate::bridge::Wait;
-use crate::export::{Forward, Refusal, bridge};
+use crate::export::{Forward, Refusal, bridge, until_attached};
 use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
@@ -28,16 +28,6 @@ struct Relayed {
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for Relayed {
     async fn forward(&mut self, _: Req) -> Option<Rep> {
         None
-    }
-}
-
-/// The owner counts a remote module attached from its connection; here the module attaches
-/// to the local port a moment later. A broadcast that comes in between waits for it, as it
-/// would have reached it in one process. (A short wait, checked each millisecond: only
-/// between the connection and the module's attaching.)
-async fn until_attached<Req: Wire, Rep: Wire, U: Usage>(end: &End<Req, Rep, U>) {
-    while end.peers().is_empty() {
-        tokio::time::sleep(std::time::Duration::from_millis(1)).await;
     }
 }
 
@@ -89,6 +79,21 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// How a remote module's end of the real port is attached.
 type UserEnd<Req, Rep, U, L, T, const N: usize> =
     fn(&Port<Req, Rep, U, L, N>, &str) -> Result<T, WireError>;
+
+/// Exports `port`, a `QUERY` port (the owner queries its users), to the other processes of
+/// `remote`'s cell: the owner's query to a module there waits for that module's response
+/// handler, which runs when the module's order says. Call it within the tokio runtime the
+/// cell runs on.
+pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Req, Rep, usage::Query, L, N>,
+) -> Result<Exported, IpcError> {
+    // The handler never runs: the relay takes each query and answers it with the other
+    // process's reply.
+    export_relayed(remote, port, |port, module| {
+        port.responder_named(module, |_: &(), _: Req| Rep::default())
+    })
+}
 
 /// Exports a port whose owner starts each rendezvous: each remote module attached gets
 /// `user_end` of the real port, whose every message or query is relayed to its process.
@@ -146,6 +151,19 @@ pub fn import_call_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::CallAll>, IpcError> {
+    import_relayed(remote, port, owner, module)
+}
+
+/// Imports a `QUERY` port of another process for module `module` of this one, which
+/// answers the owner's queries with its response handler as in one process, when its order
+/// says. Connects at once, refused as [`crate::import`] is. Call it within the tokio
+/// runtime the cell runs on.
+pub fn import_query<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, usage::Query>, IpcError> {
     import_relayed(remote, port, owner, module)
 }
 

@@ -747,3 +747,45 @@ async fn a_tight_port_crosses_with_both_sides_spinning_and_a_dead_owner_still_fa
         "{result:?}"
     );
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fails_it() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, QueryError, usage};
+
+    let cell = cell("query");
+    // ASK_STATUS(N): USAGE=QUERY, USERLIST=(CHILD): the parent asks its child.
+    let port: Port<Number, Number, usage::Query, AnyUser, 1> =
+        Port::declare(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
+    let _exported = imrs_ipc::export_query(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut parent = port.owner().unwrap();
+    let mut child = peer(&["child", &cell, "ASK_STATUS", "CHILD", "10"]);
+    within(10, async {
+        while parent.peers().is_empty() {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    for value in 1..=10 {
+        let status = within(5, parent.query(Number { value })).await.unwrap();
+        assert_eq!(status.value, 5 * value);
+    }
+    // The child answered ten and ended: the next query fails, typed, and nothing hangs.
+    let ended = within(10, async {
+        loop {
+            if let Some(status) = child.0.try_wait().unwrap() {
+                break status;
+            }
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    assert!(ended.success());
+    let late = within(10, parent.query(Number { value: 11 })).await;
+    assert!(
+        matches!(
+            late,
+            Err(QueryError::NoResponse { .. } | QueryError::PeerGone { .. })
+        ),
+        "{late:?}"
+    );
+}

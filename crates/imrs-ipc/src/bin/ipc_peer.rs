@@ -12,6 +12,9 @@
 //! - `ipc_peer answerer CELL PORT MODULE N`: imports the `CALLALL` port PORT (owner CALLER)
 //!   for MODULE, whose response handler answers N queries with their quadruples, printing
 //!   each.
+//! - `ipc_peer child CELL PORT MODULE N`: imports the `QUERY` port PORT (owner PARENT) for
+//!   MODULE, whose response handler answers N queries with five times their number, printing
+//!   each; then exits.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -21,7 +24,7 @@ use std::time::Duration;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_response, import, import_call_all,
-    import_send_all,
+    import_query, import_send_all,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -46,9 +49,10 @@ fn main() -> ExitCode {
             ["responder", cell, port] => responder(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
+            ["child", cell, port, module, n] => child(cell, port, module, n).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
-                "usage: ipc_peer owner|tight-owner|responder CELL PORT | user|listener|answerer CELL PORT MODULE N"
+                "usage: ipc_peer owner|tight-owner|responder CELL PORT | user|listener|answerer|child CELL PORT MODULE N"
                     .into(),
             ),
         }
@@ -123,6 +127,21 @@ async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
             })?;
     for _ in 0..n.parse::<u64>()? {
         answering.serve(&4).await?;
+        println!("answered");
+    }
+    Ok(())
+}
+
+async fn child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
+    let imported = import_query::<Number, Number>(&Remote::new(cell)?, port, "PARENT", module)?;
+    let mut answering =
+        imported
+            .port()
+            .responder_named(module, |factor: &u64, number: Number| Number {
+                value: factor * number.value,
+            })?;
+    for _ in 0..n.parse::<u64>()? {
+        answering.serve(&5).await?;
         println!("answered");
     }
     Ok(())
