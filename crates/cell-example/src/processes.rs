@@ -1,9 +1,10 @@
 //! The chip cell split over processes (`chip_cell --processes`): the world — the simulation,
-//! WORLD serving the devices, and FEEDER_MONITOR — in the process started by the command, and
-//! each line's modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD, CHIP_IT) in a process of its
-//! own, which the world starts. The lines reach their robots, gate and relays through the
-//! world's device ports, and the feeder zone's arbiter through its ports, all carried by
-//! iceoryx2 (`imrs-ipc`); the modules' code is that of the single-process cell.
+//! WORLD serving the devices, and FEEDER_MONITOR under the arbiter's policy — in the process
+//! started by the command, and each line's modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD,
+//! CHIP_IT) in a process of its own, which the world starts. The lines reach their robots,
+//! gate and relays through the world's device ports, and the feeder zone through the
+//! arbiter's ports or, under the Appendix's policy, through each other's SHARE_FEEDER, all
+//! carried by iceoryx2 (`imrs-ipc`); the modules' code is that of the single-process cell.
 //!
 //! Time: every process runs on the wall clock sped up by `--speed`, from one epoch the world
 //! chooses and hands to the lines when it starts them, so the processes agree on one time
@@ -22,9 +23,9 @@ use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_ipc::{Exported, IpcError, Remote, export, import};
+use imrs_ipc::{Exported, Imported, IpcError, Remote, export, export_query, import, import_query};
 use imrs_sim::imrs_core::CellErrors;
-use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock};
+use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, Sim, SimConfig};
 use serde_json::{Value, json};
@@ -71,10 +72,8 @@ fn refused(process: &str, why: impl std::fmt::Display) -> RunError {
 
 /// What `--processes` cannot do yet, refused before anything starts.
 pub(crate) fn check_config(config: &CellConfig) -> Result<(), RunError> {
-    let unsupported = if config.feeder != FeederPolicy::Arbiter {
-        Some(
-            "--feeder: only the arbiter's ports cross processes (the Appendix's SHARE_FEEDER is queried by its owner, and the coordinator's sweeps are computed where the simulation runs)",
-        )
+    let unsupported = if config.feeder == FeederPolicy::Coordinator {
+        Some("--feeder coordinator: its sweeps are computed where the simulation runs")
     } else if config.record.is_some() || config.timeline.is_some() {
         Some("--record and --timeline: a recording sees one process's modules")
     } else if config.show_tree {
@@ -152,8 +151,11 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     inject(config, &sim, &Default::default());
 
     let ports = CellPorts::new(&clock);
+    // The arbiter runs here; under the Appendix's policy the lines ask each other.
+    let arbiter = config.feeder == FeederPolicy::Arbiter;
     let zone: Vec<_> = [&ports.zone_request, &ports.zone_release]
         .into_iter()
+        .filter(|_| arbiter)
         .filter_map(ZoneLink::here)
         .collect();
     let devices = DevicePorts::declare(&clock);
@@ -163,10 +165,11 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     for port in devices.iter() {
         cell.declare(port).map_err(CellErrors::from)?;
     }
-    cell.check(&[
-        world(&devices, &sim).declaration(),
-        feeder_monitor(&ports).declaration(),
-    ])?;
+    let mut declarations = vec![world(&devices, &sim).declaration()];
+    if arbiter {
+        declarations.push(feeder_monitor(&ports).declaration());
+    }
+    cell.check(&declarations)?;
     // Exported before a line starts: a line imports them at once.
     let mut exported: Vec<Exported> = Vec::new();
     for port in zone {
@@ -177,7 +180,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     }
     sim.spawn();
     cell.start(world(&devices, &sim))?;
-    cell.start(feeder_monitor(&ports))?;
+    if arbiter {
+        cell.start(feeder_monitor(&ports))?;
+    }
 
     let (said, mut hear) = unbounded_channel();
     let mut lines = Lines(Vec::new());
@@ -341,7 +346,8 @@ fn start_line(
         .args(["--remote", remote.cell(), "--epoch", &epoch_ns.to_string()])
         .args(["--speed", &config.speed.to_string()])
         .args(["--hours", &config.hours.to_string()])
-        .args(["--seed", &config.seed.to_string()]);
+        .args(["--seed", &config.seed.to_string()])
+        .args(["--feeder", feeder_flag(config.feeder)]);
     for fault in &config.faults {
         command.arg(format!("--fault={fault}"));
     }
@@ -375,6 +381,15 @@ fn start_line(
     Ok(child)
 }
 
+/// The `--feeder` value of `policy`.
+fn feeder_flag(policy: FeederPolicy) -> &'static str {
+    match policy {
+        FeederPolicy::Appendix => "appendix",
+        FeederPolicy::Arbiter => "arbiter",
+        FeederPolicy::Coordinator => "coordinator",
+    }
+}
+
 /// Runs one line's modules in this process, as the world started it; says `ready`, then its
 /// figures at the end, or `failed` and why.
 pub fn run_line(config: &CellConfig, process: &LineProcess) -> Result<(), RunError> {
@@ -405,23 +420,37 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     cell.events()
         .subscribe(move |event| lock(&folded).cell(event));
 
-    let names = LineNames::of(line);
+    let (names, twin) = (LineNames::of(line), LineNames::of(line.other()));
     let mut ports = CellPorts::new(&clock);
-    for (link, port) in [
-        (&mut ports.zone_request, ZONE_REQUEST),
-        (&mut ports.zone_release, ZONE_RELEASE),
-    ] {
-        let imported = import::<ModuleName, ()>(&remote, port, FEEDER_MONITOR, &names.chip_it)
-            .map_err(ipc(name))?;
-        cell.declare_imported(imported.port())
-            .map_err(CellErrors::from)?;
-        *link = ZoneLink::Imported(Arc::new(imported));
+    if config.feeder == FeederPolicy::Arbiter {
+        for (link, port) in [
+            (&mut ports.zone_request, ZONE_REQUEST),
+            (&mut ports.zone_release, ZONE_RELEASE),
+        ] {
+            let imported = import::<ModuleName, ()>(&remote, port, FEEDER_MONITOR, &names.chip_it)
+                .map_err(ipc(name))?;
+            cell.declare_imported(imported.port())
+                .map_err(CellErrors::from)?;
+            *link = ZoneLink::Imported(Arc::new(imported));
+        }
     }
     ports.lines[line.index()]
         .declare_to(&cell)
         .map_err(CellErrors::from)?;
-    // CHIP_IT keeps the Appendix's shape and answers its twin's SHARE_FEEDER, owned in the
-    // other line's process; under the arbiter nobody queries it.
+    // CHIP_IT queries its twin through its own SHARE_FEEDER, and answers its twin's, owned in
+    // the other line's process. Under the Appendix's policy both cross: each line exports
+    // its own, then imports its twin's once the twin has exported it. Under the arbiter
+    // nobody queries them, and the twin's stays a port of this process.
+    let mut shared: Option<(Exported, Imported<(), i32, usage::Query>)> = None;
+    if config.feeder == FeederPolicy::Appendix {
+        let own =
+            export_query(&remote, &ports.lines[line.index()].share_feeder).map_err(ipc(name))?;
+        let imported = import_twin(&remote, &twin.share_feeder, &twin.chip_it, &names.chip_it)
+            .await
+            .map_err(ipc(name))?;
+        ports.lines[line.other().index()].share_feeder = imported.port().clone();
+        shared = Some((own, imported));
+    }
     cell.declare_imported(&ports.lines[line.other().index()].share_feeder)
         .map_err(CellErrors::from)?;
     let devices = RemoteDevices::import(&remote, line).map_err(ipc(name))?;
@@ -455,10 +484,31 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
 
     let total = Duration::from_secs_f64(config.hours * 3600.0);
     clock.sleep_until(Instant::from_start(total)).await;
+    drop(shared);
     let waits = lock(&waits)[line.index()];
     let history = lock(&history).clone();
     let figures = figures(&lock(&tally), &waits, &history);
     Ok(figures)
+}
+
+/// Imports the twin's SHARE_FEEDER for `module`, waiting (up to the world's patience) until
+/// the twin's process has exported it: the two lines start at once, and each exports its own
+/// before it imports the other's.
+async fn import_twin(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<(), i32, usage::Query>, IpcError> {
+    let deadline = std::time::Instant::now() + PATIENCE;
+    loop {
+        match import_query::<(), i32>(remote, port, owner, module) {
+            Err(IpcError::NoOwner { .. }) if std::time::Instant::now() < deadline => {
+                tokio::time::sleep(Duration::from_millis(20)).await;
+            }
+            other => return other,
+        }
+    }
 }
 
 /// A line's figures: what its modules' events counted, its chip robot's waits, and its

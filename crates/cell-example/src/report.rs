@@ -403,10 +403,15 @@ impl fmt::Display for Report {
             writeln!(f, "faults injected: {}", self.faults.join(", "))?;
         }
         if let Some(speed) = self.processes {
+            let arbiter = if self.policy == FeederPolicy::Arbiter {
+                ", FEEDER_MONITOR"
+            } else {
+                ""
+            };
             writeln!(
                 f,
-                "processes: world (simulation, WORLD, FEEDER_MONITOR), line A, line B \
-                 over iceoryx2, on the wall clock x {speed}"
+                "processes: world (simulation, WORLD{arbiter}), line A, line B over iceoryx2, \
+                 on the wall clock x {speed}"
             )?;
         }
         writeln!(f)?;

@@ -168,6 +168,35 @@ fn the_cell_across_three_processes_reports_as_a_single_process_does() {
 }
 
 #[test]
+fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process() {
+    let world = World::start(&["--feeder", "appendix", "--hours", "0.1", "--speed", "60"]);
+    let output = world.finish(Duration::from_secs(120));
+    let (report, errors) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    // No arbiter in the world: the lines ask each other.
+    assert!(
+        report.contains("processes: world (simulation, WORLD), line A, line B"),
+        "{report}"
+    );
+    // A chip robot enters the zone only once its twin, in the other process, answered
+    // CLEAR from its response handler: cards done on both lines are answers that crossed.
+    let (a, b) = row(&report, "pallets completed");
+    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
+    let (a, b) = row(&report, "zone requests / refused");
+    for asked in [a, b] {
+        let (requests, refused) = asked.split_once('/').unwrap();
+        let (requests, refused): (u32, u32) = (requests.parse().unwrap(), refused.parse().unwrap());
+        assert!(requests > refused, "{asked}\n{report}");
+    }
+    assert!(report.contains("[ok] no two robots in the feeder zone together (rapier)"));
+    assert!(!report.contains("[FAILED]"), "{report}");
+}
+
+#[test]
 fn a_line_killed_mid_run_fails_the_run_by_name_at_once() {
     // An hour at ten times the wall clock: six minutes, unless the death is seen.
     let world = World::start(&["--hours", "1", "--speed", "10"]);
@@ -209,7 +238,7 @@ fn a_world_killed_mid_run_takes_its_lines_with_it() {
 #[test]
 fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
     for (flags, named) in [
-        (&["--feeder", "appendix"][..], "--feeder"),
+        (&["--feeder", "coordinator"][..], "--feeder coordinator"),
         (&["--record", "x.mcap"][..], "--record"),
         (&["--tree"][..], "--tree"),
         (&["--realtime"][..], "--realtime"),
