@@ -2,6 +2,7 @@
 //! service, and the two event services that wake whoever waits (requests for the owner,
 //! replies for the users) — so that nobody polls.
 
+use std::os::fd::{AsRawFd, RawFd};
 use std::time::Duration;
 
 use iceoryx2::port::listener::Listener;
@@ -9,6 +10,8 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
 use imrs_core::imrs_ports::{Name, ProcessType};
+use tokio::io::Interest;
+use tokio::io::unix::AsyncFd;
 
 use crate::wire::{ReplyMeta, RequestMeta};
 use crate::{IpcError, Remote, Wire};
@@ -59,6 +62,65 @@ impl Wait {
     /// Whether the other side must be woken by an event.
     pub(crate) fn notifies(self) -> bool {
         self == Wait::Parked
+    }
+}
+
+/// A listener whose wake-ups a tokio task awaits: its socket is registered with tokio's
+/// reactor, so that the other process's notify wakes the task directly, with no thread of
+/// ours between.
+pub(crate) struct Readiness {
+    // Declared first, so dropped first: deregistered before the listener closes its socket.
+    socket: AsyncFd<Socket>,
+    listener: Listener<Svc>,
+}
+
+/// A listener's socket, as tokio's reactor names it.
+struct Socket(RawFd);
+
+impl AsRawFd for Socket {
+    fn as_raw_fd(&self) -> RawFd {
+        self.0
+    }
+}
+
+impl Readiness {
+    /// Watches `listener`'s notifications. Call it within a tokio runtime whose I/O driver
+    /// is enabled (`enable_io` or `enable_all`); refused, naming the port, otherwise.
+    pub(crate) fn new(listener: Listener<Svc>, port: &Name) -> Result<Self, IpcError> {
+        // SAFETY: `native_handle` only reads the number of the listener's own socket.
+        let raw = unsafe { listener.file_descriptor().native_handle() };
+        // tokio panics where the runtime has no I/O driver: a mistake of the caller's set-up,
+        // told as an error rather than a crash.
+        let registered = std::panic::catch_unwind(|| {
+            // SAFETY: the descriptor is the listener's socket, open for as long as the
+            // listener lives, and `Socket` always returns that same number. `Readiness` owns
+            // the listener and drops the registration first (field order), so the
+            // registration never outlives the socket.
+            unsafe { AsyncFd::register_with_interest(Socket(raw), Interest::READABLE) }
+        });
+        let socket = match registered {
+            Ok(Ok(socket)) => socket,
+            Ok(Err(error)) => return Err(transport(port, "watching its events", error)),
+            Err(_) => {
+                return Err(transport(
+                    port,
+                    "watching its events",
+                    "the tokio runtime has no I/O driver: build it with enable_io or enable_all",
+                ));
+            }
+        };
+        Ok(Self { socket, listener })
+    }
+
+    /// Waits until the other side has notified since the last call, and takes its
+    /// notifications. `Err` if the reactor is gone.
+    pub(crate) async fn notified(&self) -> std::io::Result<()> {
+        let mut ready = self.socket.readable().await?;
+        // Cleared before the notifications are taken: one that comes after is a new edge,
+        // which wakes the next call.
+        ready.clear_ready();
+        let _ = self.listener.try_wait(|_| {});
+        Ok(())
     }
 }
 

@@ -17,7 +17,7 @@ use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
 };
 
-use crate::bridge::{Channel, Side, Svc, TICK, Wait, sweep_dead};
+use crate::bridge::{Channel, Readiness, Side, Svc, TICK, Wait, sweep_dead};
 use crate::wire::{
     CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
 };
@@ -45,8 +45,31 @@ pub struct Imported<Req: Wire, Rep: Wire, U: Usage = usage::Receive> {
 /// while this is held.
 pub(crate) struct Relay {
     stop: Arc<AtomicBool>,
-    waiter: Option<JoinHandle<()>>,
+    waiter: Waiter,
     forwarder: tokio::task::JoinHandle<()>,
+}
+
+/// Who hands the replies back: a tokio task woken by the owner's notify, or, on a TIGHT
+/// port, a thread of ours that spins.
+enum Waiter {
+    Task(tokio::task::JoinHandle<()>),
+    Thread(Option<JoinHandle<()>>),
+}
+
+/// Where the forwarder hands each request sent, with its sender's right to the reply.
+enum ToWaiter<Req: Wire, Rep: Wire> {
+    Task(tokio::sync::mpsc::UnboundedSender<(Pending<Req, Rep>, ReplyHandle<Rep>)>),
+    Thread(mpsc::Sender<(Pending<Req, Rep>, ReplyHandle<Rep>)>),
+}
+
+impl<Req: Wire, Rep: Wire> ToWaiter<Req, Rep> {
+    /// `false` once the waiter is gone.
+    fn send(&self, sent: (Pending<Req, Rep>, ReplyHandle<Rep>)) -> bool {
+        match self {
+            ToWaiter::Task(waiter) => waiter.send(sent).is_ok(),
+            ToWaiter::Thread(waiter) => waiter.send(sent).is_ok(),
+        }
+    }
 }
 
 impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
@@ -67,8 +90,13 @@ impl Drop for Relay {
     fn drop(&mut self) {
         self.forwarder.abort();
         self.stop.store(true, Ordering::Release);
-        if let Some(waiter) = self.waiter.take() {
-            let _ = waiter.join();
+        match &mut self.waiter {
+            Waiter::Task(waiter) => waiter.abort(),
+            Waiter::Thread(waiter) => {
+                if let Some(waiter) = waiter.take() {
+                    let _ = waiter.join();
+                }
+            }
         }
     }
 }
@@ -187,26 +215,38 @@ where
         wake_owner,
         wait,
     } = connect(remote, &name, module)?;
-    let wake_self = channel.notifier(&channel.replied)?;
-
-    let (pending_tx, pending_rx) = mpsc::channel::<(Pending<Req, Rep>, ReplyHandle<Rep>)>();
     let stop = Arc::new(AtomicBool::new(false));
-
-    let halt = Arc::clone(&stop);
-    let waiter = std::thread::Builder::new()
-        .name(format!("imrs-ipc {name} replies"))
-        .spawn(move || {
-            // The channel lives as long as the waiter: its node keeps the services open.
-            let _channel = channel;
-            wait_for_replies(&listener, &pending_rx, &halt, wait);
-        })
-        .map_err(|error| IpcError::Transport {
-            port: name.clone(),
-            detail: format!("starting its bridge thread: {error}"),
-        })?;
+    let (to_waiter, waiter) = match wait {
+        // Parked: a task, woken by the owner's notify through tokio's reactor.
+        Wait::Parked => {
+            let readiness = Readiness::new(listener, &name)?;
+            let (to_waiter, incoming) = tokio::sync::mpsc::unbounded_channel();
+            let waiter = runtime.spawn(async move {
+                // The channel lives as long as the waiter: its node keeps the services open.
+                let _channel = channel;
+                hand_back_replies(&readiness, incoming).await;
+            });
+            (ToWaiter::Task(to_waiter), Waiter::Task(waiter))
+        }
+        Wait::Spinning => {
+            let (to_waiter, incoming) = mpsc::channel();
+            let halt = Arc::clone(&stop);
+            let waiter = std::thread::Builder::new()
+                .name(format!("imrs-ipc {name} replies"))
+                .spawn(move || {
+                    let _channel = channel;
+                    spin_for_replies(&incoming, &halt);
+                })
+                .map_err(|error| IpcError::Transport {
+                    port: name.clone(),
+                    detail: format!("starting its bridge thread: {error}"),
+                })?;
+            (ToWaiter::Thread(to_waiter), Waiter::Thread(Some(waiter)))
+        }
+    };
 
     let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
-    let wake = Arc::new(Mutex::new((wake_owner, wake_self)));
+    let wake_owner = Arc::new(Mutex::new(wake_owner));
     let forwarder = runtime.spawn(async move {
         while let Some((request, reply)) = taken.next().await {
             let sent = {
@@ -219,23 +259,21 @@ where
             // Not sent (no room, no owner): the reply handle is dropped, and the local
             // sender gets `SendError::NoReply` at once.
             let Some(pending) = sent else { continue };
-            if pending_tx.send((pending, reply)).is_err() {
+            if !to_waiter.send((pending, reply)) {
                 break;
             }
-            // A TIGHT port's owner and waiter look without being woken.
-            if !wait.notifies() {
-                continue;
+            // A TIGHT port's owner looks without being woken.
+            if wait.notifies() {
+                let _ = wake_owner
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .notify();
             }
-            let wake = wake.lock().unwrap_or_else(PoisonError::into_inner);
-            let _ = wake.0.notify();
-            // The reply may have come before the waiter had the pending request: wake it
-            // to look.
-            let _ = wake.1.notify();
         }
     });
     Ok(Relay {
         stop,
-        waiter: Some(waiter),
+        waiter,
         forwarder,
     })
 }
@@ -328,57 +366,88 @@ fn handshake<Req: Wire, Rep: Wire>(
     Err(IpcError::NoOwner { port: port.clone() })
 }
 
-/// The waiter: hands each reply to its local sender; drops the handles of requests whose
-/// owner is gone, so that their senders fail at once. On a TIGHT port it looks again at
-/// once while a request waits, and rests on the queue of new requests while none does.
-fn wait_for_replies<Req: Wire, Rep: Wire>(
-    listener: &Listener<Svc>,
+/// The waiter of a parked port: woken by the owner's notify, or by a request sent; hands
+/// each reply to its local sender, and drops the handles of requests whose owner is gone,
+/// so that their senders fail at once.
+async fn hand_back_replies<Req: Wire, Rep: Wire>(
+    readiness: &Readiness,
+    mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
+) {
+    let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
+    // Every half second while something waits: see whether a peer died.
+    let mut sweep = tokio::time::interval(SWEEP_PERIOD);
+    loop {
+        tokio::select! {
+            sent = incoming.recv() => match sent {
+                Some((pending, reply)) => waiting.push((pending, Some(reply))),
+                None => return,
+            },
+            notified = readiness.notified() => {
+                if notified.is_err() {
+                    return;
+                }
+            }
+            _ = sweep.tick(), if !waiting.is_empty() => sweep_dead(),
+        }
+        while let Ok((pending, reply)) = incoming.try_recv() {
+            waiting.push((pending, Some(reply)));
+        }
+        look(&mut waiting);
+    }
+}
+
+/// The waiter of a TIGHT port: looks again at once while a request waits, and rests on the
+/// queue of new requests while none does.
+fn spin_for_replies<Req: Wire, Rep: Wire>(
     incoming: &mpsc::Receiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
     stop: &AtomicBool,
-    wait: Wait,
 ) {
     let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
     let mut swept = Instant::now();
     while !stop.load(Ordering::Acquire) {
-        if waiting.is_empty() && !wait.notifies() {
+        if waiting.is_empty() {
             match incoming.recv_timeout(TICK) {
                 Ok((pending, reply)) => waiting.push((pending, Some(reply))),
                 Err(mpsc::RecvTimeoutError::Timeout) => continue,
                 Err(mpsc::RecvTimeoutError::Disconnected) => break,
             }
-        // Parked, blocks until a reply event or the tick.
-        } else if !wait.once(listener) {
-            break;
+        } else {
+            std::thread::yield_now();
         }
         waiting.extend(
             incoming
                 .try_iter()
                 .map(|(pending, reply)| (pending, Some(reply))),
         );
-        // Every half second while something waits: see whether a peer died.
         if !waiting.is_empty() && swept.elapsed() >= SWEEP_PERIOD {
             sweep_dead();
             swept = Instant::now();
         }
-        waiting.retain_mut(|(pending, reply)| {
-            // Whether the owner still holds the request, read before looking for its
-            // reply: an owner replies, then lets the request go, so a reply sent before
-            // it let go is there to be received now.
-            let connected = pending.is_connected();
-            match pending.receive() {
-                Ok(Some(response)) => {
-                    if let Some(reply) = reply.take()
-                        && response.user_header().status == OK
-                    {
-                        reply.reply(*response.payload());
-                    }
-                    false
-                }
-                // The owner is gone (or let the request go unanswered): the reply handle
-                // drops, and the sender fails at once.
-                Ok(None) => connected,
-                Err(_) => false,
-            }
-        });
+        look(&mut waiting);
     }
+}
+
+/// Hands each reply that came to its sender, and lets go of the requests that are done:
+/// answered, or whose owner is gone (their reply handles drop, and their senders fail).
+fn look<Req: Wire, Rep: Wire>(waiting: &mut Vec<Waiting<Req, Rep>>) {
+    waiting.retain_mut(|(pending, reply)| {
+        // Whether the owner still holds the request, read before looking for its reply: an
+        // owner replies, then lets the request go, so a reply sent before it let go is
+        // there to be received now.
+        let connected = pending.is_connected();
+        match pending.receive() {
+            Ok(Some(response)) => {
+                if let Some(reply) = reply.take()
+                    && response.user_header().status == OK
+                {
+                    reply.reply(*response.payload());
+                }
+                false
+            }
+            // The owner is gone (or let the request go unanswered): the reply handle drops,
+            // and the sender fails at once.
+            Ok(None) => connected,
+            Err(_) => false,
+        }
+    });
 }
