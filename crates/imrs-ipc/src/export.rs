@@ -13,7 +13,7 @@ use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
 
-use crate::bridge::{Channel, Side, Svc, Wait};
+use crate::bridge::{Channel, Readiness, Side, Svc, TICK, Wait};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND,
     TIGHT, TOO_MANY_USERS,
@@ -71,7 +71,15 @@ impl From<WireError> for Refusal {
 pub struct Exported {
     port: Name,
     stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    serving: Serving,
+}
+
+/// Who serves the port's requests: a tokio task woken by the users' notify through tokio's
+/// reactor, or a thread of ours — one that spins, on a TIGHT port, or one that may block
+/// to connect a relay back to a user's process.
+enum Serving {
+    Task(tokio::task::JoinHandle<()>),
+    Thread(Option<JoinHandle<()>>),
 }
 
 impl Exported {
@@ -84,8 +92,13 @@ impl Exported {
 impl Drop for Exported {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Release);
-        if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+        match &mut self.serving {
+            Serving::Task(task) => task.abort(),
+            Serving::Thread(thread) => {
+                if let Some(thread) = thread.take() {
+                    let _ = thread.join();
+                }
+            }
         }
     }
 }
@@ -100,9 +113,14 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
     let wait = Wait::of(port.process_type());
-    bridge(remote, Name::from(&port), N, wait, move |module: &str| {
-        Ok(port.user_named(module)?)
-    })
+    bridge(
+        remote,
+        Name::from(&port),
+        N,
+        wait,
+        false,
+        move |module: &str| Ok(port.user_named(module)?),
+    )
 }
 
 /// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
@@ -114,9 +132,14 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
     let wait = Wait::of(port.process_type());
-    bridge(remote, Name::from(&port), N, wait, move |module: &str| {
-        Ok(port.user_named(module)?)
-    })
+    bridge(
+        remote,
+        Name::from(&port),
+        N,
+        wait,
+        false,
+        move |module: &str| Ok(port.user_named(module)?),
+    )
 }
 
 pub(crate) fn bridge<Req, Rep, E, A>(
@@ -124,6 +147,7 @@ pub(crate) fn bridge<Req, Rep, E, A>(
     name: Name,
     users: usize,
     wait: Wait,
+    attach_blocks: bool,
     mut attach: A,
 ) -> Result<Exported, IpcError>
 where
@@ -149,6 +173,37 @@ where
     let listener = channel.listener(&channel.requested)?;
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
+    if wait == Wait::Parked && !attach_blocks {
+        let readiness = Readiness::new(listener, &name)?;
+        let task = runtime.clone().spawn(async move {
+            // The channel lives as long as the task: its node keeps the services open.
+            let _channel = channel;
+            let mut users: Users<E> = HashMap::new();
+            // Woken by a user's notify; and at each tick all the same, so that a request
+            // whose notify was lost (or a peer that never sent one) waits a tick at most.
+            let mut tick = tokio::time::interval(TICK);
+            loop {
+                // An error is a connection iceoryx2 could not make yet: the next wake-up
+                // retries.
+                while let Ok(Some(active)) = server.receive() {
+                    take(active, &mut attach, &mut users, &runtime, &notifier, wait);
+                }
+                tokio::select! {
+                    notified = readiness.notified() => {
+                        if notified.is_err() {
+                            return;
+                        }
+                    }
+                    _ = tick.tick() => {}
+                }
+            }
+        });
+        return Ok(Exported {
+            port: name,
+            stop,
+            serving: Serving::Task(task),
+        });
+    }
     let halt = Arc::clone(&stop);
     let thread = std::thread::Builder::new()
         .name(format!("imrs-ipc {name}"))
@@ -176,7 +231,7 @@ where
     Ok(Exported {
         port: name,
         stop,
-        thread: Some(thread),
+        serving: Serving::Thread(Some(thread)),
     })
 }
 

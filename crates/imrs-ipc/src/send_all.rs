@@ -117,7 +117,9 @@ where
     let (port, owner, cell) = (port.clone(), port.owner_module().clone(), remote.clone());
     let served = name.clone();
     // The owner starts each rendezvous here; its relays are parked.
-    bridge::<Req, Rep, _, _>(remote, name, N, Wait::Parked, move |module: &str| {
+    // Attaching a remote module connects a relay back to its process: a wait of its own,
+    // kept off tokio's workers.
+    bridge::<Req, Rep, _, _>(remote, name, N, Wait::Parked, true, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
         let end = user_end(&port, module)?;
         let _entered = runtime.enter();
@@ -191,6 +193,7 @@ where
         to_module(&name, module),
         1,
         Wait::Parked,
+        false,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {
                 return Err(Refusal::Wire(WireError::NotOnUserList {
