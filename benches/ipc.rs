@@ -4,10 +4,10 @@
 //! the same two processes, the same run. Each case: p50, p99 and p99.9 over its round
 //! trips, and the ratios the targets are stated in.
 //!
-//! Then the TIGHT cases, against a second peer started only for them (its spinning threads
-//! would otherwise take processor time from the parked cases): an IMRS port declared TIGHT,
-//! whose bridges spin instead of waiting on events, beside a raw iceoryx2 round trip whose
-//! client and server both spin.
+//! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
+//! otherwise take processor time from the other cases): an IMRS port declared TIGHT, whose
+//! bridges spin instead of waiting on events, beside a raw iceoryx2 round trip whose client
+//! and server both spin.
 //!
 //! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
 //! that the benchmark cannot rot. The peers are this same binary, started again with
@@ -57,7 +57,7 @@ fn main() {
         200
     };
     let cell = format!("bench-{}", std::process::id());
-    let mut child = start_peer(&cell, false);
+    let mut child = start_peer(&cell, Peer::Parked);
     let runtime = runtime();
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
@@ -71,8 +71,11 @@ fn main() {
     let _ = child.wait();
 
     let tight_cell = format!("{cell}-tight");
-    let mut child = start_peer(&tight_cell, true);
+    let mut child = start_peer(&tight_cell, Peer::RawSpinning);
     let raw_spin = raw_round_trips::<Small>(&tight_cell, "small", rounds, Wait::Spin);
+    let _ = child.kill();
+    let _ = child.wait();
+    let mut child = start_peer(&tight_cell, Peer::Tight);
     let imrs_tight = runtime.block_on(imrs_round_trips::<Small>(&tight_cell, "SMALL", rounds));
     let _ = child.kill();
     let _ = child.wait();
@@ -108,12 +111,29 @@ fn main() {
     );
 }
 
-/// Starts a peer for `cell`, TIGHT or parked, and waits until it serves.
-fn start_peer(cell: &str, tight: bool) -> std::process::Child {
+/// What a peer serves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Peer {
+    /// Both IMRS ports and both raw services, all waiting on events.
+    Parked,
+    /// One raw service, spinning.
+    RawSpinning,
+    /// One IMRS port declared TIGHT.
+    Tight,
+}
+
+/// Starts a peer for `cell` serving `what`, and waits until it serves.
+fn start_peer(cell: &str, what: Peer) -> std::process::Child {
     let mut command = Command::new(std::env::current_exe().expect("this binary"));
     command.env(PEER, cell).stdout(Stdio::piped());
-    if tight {
-        command.env(TIGHT, "1");
+    match what {
+        Peer::Parked => {}
+        Peer::RawSpinning => {
+            command.env(TIGHT, "raw");
+        }
+        Peer::Tight => {
+            command.env(TIGHT, "imrs");
+        }
     }
     let mut child = command.spawn().expect("the peer starts");
     let mut line = String::new();
@@ -152,40 +172,47 @@ fn percentiles(times: &[Duration]) -> [Duration; 3] {
     [at(0.5), at(0.99), at(0.999)]
 }
 
-/// The peer: owns both IMRS ports (echoing), and serves both raw services; or, TIGHT, one
-/// TIGHT IMRS port and one spinning raw service.
+/// The peer: owns both IMRS ports (echoing), and serves both raw services; or serves one
+/// spinning raw service; or owns one TIGHT IMRS port.
 fn peer(cell: &str) {
-    let tight = std::env::var(TIGHT).is_ok();
-    let parts: &[&str] = if tight {
-        &["small"]
-    } else {
-        &["small", "large"]
+    let what = match std::env::var(TIGHT).as_deref() {
+        Ok("raw") => Peer::RawSpinning,
+        Ok(_) => Peer::Tight,
+        Err(_) => Peer::Parked,
     };
-    let wait = if tight { Wait::Spin } else { Wait::Events };
-    for part in parts {
+    let raw: &[&str] = match what {
+        Peer::Parked => &["small", "large"],
+        Peer::RawSpinning => &["small"],
+        Peer::Tight => &[],
+    };
+    let wait = if what == Peer::RawSpinning {
+        Wait::Spin
+    } else {
+        Wait::Events
+    };
+    for part in raw {
         let (cell, part) = (cell.to_owned(), *part);
         std::thread::spawn(move || match part {
             "small" => raw_server::<Small>(&cell, part, wait),
             _ => raw_server::<Large>(&cell, part, wait),
         });
     }
-    let process_type = if tight {
-        ProcessType::Tight
-    } else {
-        ProcessType::Indep
-    };
     let runtime = runtime();
     runtime.block_on(async {
         let remote = Remote::new(cell).expect("a cell name");
-        let small = echo::<Small>(&remote, "SMALL", process_type);
-        let large = (!tight).then(|| echo::<Large>(&remote, "LARGE", process_type));
+        let _echoes = match what {
+            Peer::Parked => vec![
+                echo::<Small>(&remote, "SMALL", ProcessType::Indep),
+                echo::<Large>(&remote, "LARGE", ProcessType::Indep),
+            ],
+            Peer::RawSpinning => Vec::new(),
+            Peer::Tight => vec![echo::<Small>(&remote, "SMALL", ProcessType::Tight)],
+        };
         // Give the raw servers a moment to open their services.
         tokio::time::sleep(Duration::from_millis(200)).await;
         println!("ready");
-        let _ = small.await;
-        if let Some(large) = large {
-            let _ = large.await;
-        }
+        // It serves until it is killed.
+        std::future::pending::<()>().await;
     });
 }
 

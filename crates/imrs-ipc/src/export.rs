@@ -173,8 +173,14 @@ where
     let listener = channel.listener(&channel.requested)?;
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
-    if wait == Wait::Parked && !attach_blocks {
-        let readiness = Readiness::new(listener, &name)?;
+    if !attach_blocks {
+        // Parked, woken by the users' notify; TIGHT, looking again after every other task
+        // of the runtime has had its turn — in the runtime the owner's module runs on, so
+        // that a request reaches it with no hand-over between threads.
+        let readiness = match wait {
+            Wait::Parked => Some(Readiness::new(listener, &name)?),
+            Wait::Spinning => None,
+        };
         let task = runtime.clone().spawn(async move {
             // The channel lives as long as the task: its node keeps the services open.
             let _channel = channel;
@@ -188,6 +194,10 @@ where
                 while let Ok(Some(active)) = server.receive() {
                     take(active, &mut attach, &mut users, &runtime, &notifier, wait);
                 }
+                let Some(readiness) = &readiness else {
+                    tokio::task::yield_now().await;
+                    continue;
+                };
                 tokio::select! {
                     notified = readiness.notified() => {
                         if notified.is_err() {

@@ -2,10 +2,7 @@
 //! name and types whose owner is a bridge: a tokio task takes each local send into shared
 //! memory, and a thread waiting on iceoryx2's reply events hands each reply back.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
 use std::sync::{Arc, Mutex, PoisonError};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use iceoryx2::pending_response::PendingResponse;
@@ -44,32 +41,8 @@ pub struct Imported<Req: Wire, Rep: Wire, U: Usage = usage::Receive> {
 /// The forwarder and the waiter of one port's requests into another process: working
 /// while this is held.
 pub(crate) struct Relay {
-    stop: Arc<AtomicBool>,
-    waiter: Waiter,
+    waiter: tokio::task::JoinHandle<()>,
     forwarder: tokio::task::JoinHandle<()>,
-}
-
-/// Who hands the replies back: a tokio task woken by the owner's notify, or, on a TIGHT
-/// port, a thread of ours that spins.
-enum Waiter {
-    Task(tokio::task::JoinHandle<()>),
-    Thread(Option<JoinHandle<()>>),
-}
-
-/// Where the forwarder hands each request sent, with its sender's right to the reply.
-enum ToWaiter<Req: Wire, Rep: Wire> {
-    Task(tokio::sync::mpsc::UnboundedSender<(Pending<Req, Rep>, ReplyHandle<Rep>)>),
-    Thread(mpsc::Sender<(Pending<Req, Rep>, ReplyHandle<Rep>)>),
-}
-
-impl<Req: Wire, Rep: Wire> ToWaiter<Req, Rep> {
-    /// `false` once the waiter is gone.
-    fn send(&self, sent: (Pending<Req, Rep>, ReplyHandle<Rep>)) -> bool {
-        match self {
-            ToWaiter::Task(waiter) => waiter.send(sent).is_ok(),
-            ToWaiter::Thread(waiter) => waiter.send(sent).is_ok(),
-        }
-    }
 }
 
 impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
@@ -89,15 +62,7 @@ impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
 impl Drop for Relay {
     fn drop(&mut self) {
         self.forwarder.abort();
-        self.stop.store(true, Ordering::Release);
-        match &mut self.waiter {
-            Waiter::Task(waiter) => waiter.abort(),
-            Waiter::Thread(waiter) => {
-                if let Some(waiter) = waiter.take() {
-                    let _ = waiter.join();
-                }
-            }
-        }
+        self.waiter.abort();
     }
 }
 
@@ -215,35 +180,19 @@ where
         wake_owner,
         wait,
     } = connect(remote, &name, module)?;
-    let stop = Arc::new(AtomicBool::new(false));
-    let (to_waiter, waiter) = match wait {
-        // Parked: a task, woken by the owner's notify through tokio's reactor.
-        Wait::Parked => {
-            let readiness = Readiness::new(listener, &name)?;
-            let (to_waiter, incoming) = tokio::sync::mpsc::unbounded_channel();
-            let waiter = runtime.spawn(async move {
-                // The channel lives as long as the waiter: its node keeps the services open.
-                let _channel = channel;
-                hand_back_replies(&readiness, incoming).await;
-            });
-            (ToWaiter::Task(to_waiter), Waiter::Task(waiter))
-        }
-        Wait::Spinning => {
-            let (to_waiter, incoming) = mpsc::channel();
-            let halt = Arc::clone(&stop);
-            let waiter = std::thread::Builder::new()
-                .name(format!("imrs-ipc {name} replies"))
-                .spawn(move || {
-                    let _channel = channel;
-                    spin_for_replies(&incoming, &halt);
-                })
-                .map_err(|error| IpcError::Transport {
-                    port: name.clone(),
-                    detail: format!("starting its bridge thread: {error}"),
-                })?;
-            (ToWaiter::Thread(to_waiter), Waiter::Thread(Some(waiter)))
-        }
+    // A task in the runtime the importing module runs on: parked, woken by the owner's
+    // notify through tokio's reactor; TIGHT, looking again after every other task has had
+    // its turn while a request waits.
+    let readiness = match wait {
+        Wait::Parked => Some(Readiness::new(listener, &name)?),
+        Wait::Spinning => None,
     };
+    let (to_waiter, incoming) = tokio::sync::mpsc::unbounded_channel();
+    let waiter = runtime.spawn(async move {
+        // The channel lives as long as the waiter: its node keeps the services open.
+        let _channel = channel;
+        hand_back_replies(readiness.as_ref(), incoming).await;
+    });
 
     let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
     let wake_owner = Arc::new(Mutex::new(wake_owner));
@@ -259,7 +208,7 @@ where
             // Not sent (no room, no owner): the reply handle is dropped, and the local
             // sender gets `SendError::NoReply` at once.
             let Some(pending) = sent else { continue };
-            if !to_waiter.send((pending, reply)) {
+            if to_waiter.send((pending, reply)).is_err() {
                 break;
             }
             // A TIGHT port's owner looks without being woken.
@@ -271,11 +220,7 @@ where
             }
         }
     });
-    Ok(Relay {
-        stop,
-        waiter,
-        forwarder,
-    })
+    Ok(Relay { waiter, forwarder })
 }
 
 /// A user process's connection to a port's owner: the services, the client, and the
@@ -366,27 +311,30 @@ fn handshake<Req: Wire, Rep: Wire>(
     Err(IpcError::NoOwner { port: port.clone() })
 }
 
-/// The waiter of a parked port: woken by the owner's notify, or by a request sent; hands
+/// The waiter: woken by the owner's notify (parked), or looking again after every other
+/// task's turn while a request waits (TIGHT, `readiness` none), or by a request sent; hands
 /// each reply to its local sender, and drops the handles of requests whose owner is gone,
 /// so that their senders fail at once.
 async fn hand_back_replies<Req: Wire, Rep: Wire>(
-    readiness: &Readiness,
+    readiness: Option<&Readiness>,
     mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
 ) {
     let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
     // Every half second while something waits: see whether a peer died.
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     loop {
+        let spin = readiness.is_none() && !waiting.is_empty();
         tokio::select! {
             sent = incoming.recv() => match sent {
                 Some((pending, reply)) => waiting.push((pending, Some(reply))),
                 None => return,
             },
-            notified = readiness.notified() => {
+            notified = notified(readiness) => {
                 if notified.is_err() {
                     return;
                 }
             }
+            () = tokio::task::yield_now(), if spin => {}
             _ = sweep.tick(), if !waiting.is_empty() => sweep_dead(),
         }
         while let Ok((pending, reply)) = incoming.try_recv() {
@@ -396,34 +344,11 @@ async fn hand_back_replies<Req: Wire, Rep: Wire>(
     }
 }
 
-/// The waiter of a TIGHT port: looks again at once while a request waits, and rests on the
-/// queue of new requests while none does.
-fn spin_for_replies<Req: Wire, Rep: Wire>(
-    incoming: &mpsc::Receiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
-    stop: &AtomicBool,
-) {
-    let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
-    let mut swept = Instant::now();
-    while !stop.load(Ordering::Acquire) {
-        if waiting.is_empty() {
-            match incoming.recv_timeout(TICK) {
-                Ok((pending, reply)) => waiting.push((pending, Some(reply))),
-                Err(mpsc::RecvTimeoutError::Timeout) => continue,
-                Err(mpsc::RecvTimeoutError::Disconnected) => break,
-            }
-        } else {
-            std::thread::yield_now();
-        }
-        waiting.extend(
-            incoming
-                .try_iter()
-                .map(|(pending, reply)| (pending, Some(reply))),
-        );
-        if !waiting.is_empty() && swept.elapsed() >= SWEEP_PERIOD {
-            sweep_dead();
-            swept = Instant::now();
-        }
-        look(&mut waiting);
+/// The owner's notify, where the port has one; never, where it spins.
+async fn notified(readiness: Option<&Readiness>) -> std::io::Result<()> {
+    match readiness {
+        Some(readiness) => readiness.notified().await,
+        None => std::future::pending().await,
     }
 }
 
