@@ -5,9 +5,8 @@
 //! trips, and the ratios the targets are stated in.
 //!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
-//! otherwise take processor time from the other cases): an IMRS port declared TIGHT, whose
-//! bridges spin instead of waiting on events, beside a raw iceoryx2 round trip whose client
-//! and server both spin.
+//! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
+//! a raw iceoryx2 round trip whose client and server both spin.
 //!
 //! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
 //! that the benchmark cannot rot. The peers are this same binary, started again with

@@ -9,7 +9,7 @@ use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
-use imrs_core::imrs_ports::{Name, ProcessType};
+use imrs_core::imrs_ports::Name;
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 
@@ -27,43 +27,6 @@ pub(crate) const TICK: Duration = Duration::from_millis(50);
 
 pub(crate) type Service<Req, Rep> =
     request_response::PortFactory<Svc, Req, RequestMeta, Rep, ReplyMeta>;
-
-/// How a bridge thread waits for what the other process sends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Wait {
-    /// Blocks on the iceoryx2 event the other side notifies, up to the tick.
-    Parked,
-    /// Looks again at once, yielding the processor between looks: a TIGHT port, whose ends
-    /// talk so often that a wake-up costs more than the look. Nobody notifies.
-    Spinning,
-}
-
-impl Wait {
-    /// How a port of process type `process_type` waits.
-    pub(crate) fn of(process_type: ProcessType) -> Self {
-        match process_type {
-            ProcessType::Tight => Wait::Spinning,
-            _ => Wait::Parked,
-        }
-    }
-
-    /// Waits once: until an event or the tick, or not at all when spinning (the caller
-    /// looks at its data each time round). `false` if the listener failed.
-    pub(crate) fn once(self, listener: &Listener<Svc>) -> bool {
-        match self {
-            Wait::Parked => listener.timed_wait(|_| {}, TICK).is_ok(),
-            Wait::Spinning => {
-                std::thread::yield_now();
-                true
-            }
-        }
-    }
-
-    /// Whether the other side must be woken by an event.
-    pub(crate) fn notifies(self) -> bool {
-        self == Wait::Parked
-    }
-}
 
 /// A listener whose wake-ups a tokio task awaits: its socket is registered with tokio's
 /// reactor, so that the other process's notify wakes the task directly, with no thread of

@@ -13,10 +13,10 @@ use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
 
-use crate::bridge::{Channel, Readiness, Side, Svc, TICK, Wait};
+use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND,
-    TIGHT, TOO_MANY_USERS,
+    TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -75,8 +75,8 @@ pub struct Exported {
 }
 
 /// Who serves the port's requests: a tokio task woken by the users' notify through tokio's
-/// reactor, or a thread of ours — one that spins, on a TIGHT port, or one that may block
-/// to connect a relay back to a user's process.
+/// reactor, or, where attaching a user connects a relay back to its process (a wait of its
+/// own), a thread of ours.
 enum Serving {
     Task(tokio::task::JoinHandle<()>),
     Thread(Option<JoinHandle<()>>),
@@ -112,15 +112,9 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    let wait = Wait::of(port.process_type());
-    bridge(
-        remote,
-        Name::from(&port),
-        N,
-        wait,
-        false,
-        move |module: &str| Ok(port.user_named(module)?),
-    )
+    bridge(remote, Name::from(&port), N, false, move |module: &str| {
+        Ok(port.user_named(module)?)
+    })
 }
 
 /// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
@@ -131,22 +125,15 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    let wait = Wait::of(port.process_type());
-    bridge(
-        remote,
-        Name::from(&port),
-        N,
-        wait,
-        false,
-        move |module: &str| Ok(port.user_named(module)?),
-    )
+    bridge(remote, Name::from(&port), N, false, move |module: &str| {
+        Ok(port.user_named(module)?)
+    })
 }
 
 pub(crate) fn bridge<Req, Rep, E, A>(
     remote: &Remote,
     name: Name,
     users: usize,
-    wait: Wait,
     attach_blocks: bool,
     mut attach: A,
 ) -> Result<Exported, IpcError>
@@ -174,13 +161,9 @@ where
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
     if !attach_blocks {
-        // Parked, woken by the users' notify; TIGHT, looking again after every other task
-        // of the runtime has had its turn — in the runtime the owner's module runs on, so
-        // that a request reaches it with no hand-over between threads.
-        let readiness = match wait {
-            Wait::Parked => Some(Readiness::new(listener, &name)?),
-            Wait::Spinning => None,
-        };
+        // A task in the runtime the owner's module runs on, woken by the users' notify, so
+        // that a request reaches the module with no hand-over between threads.
+        let readiness = Readiness::new(listener, &name)?;
         let task = runtime.clone().spawn(async move {
             // The channel lives as long as the task: its node keeps the services open.
             let _channel = channel;
@@ -192,12 +175,8 @@ where
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take(active, &mut attach, &mut users, &runtime, &notifier, wait);
+                    take(active, &mut attach, &mut users, &runtime, &notifier);
                 }
-                let Some(readiness) = &readiness else {
-                    tokio::task::yield_now().await;
-                    continue;
-                };
                 tokio::select! {
                     notified = readiness.notified() => {
                         if notified.is_err() {
@@ -222,15 +201,14 @@ where
             let _channel = channel;
             let mut users: Users<E> = HashMap::new();
             while !halt.load(Ordering::Acquire) {
-                // Parked, blocks until a request event or the tick: no polling of the data.
-                // Spinning (TIGHT), looks again at once.
-                if !wait.once(&listener) {
+                // Blocks until a request event or the tick: no polling of the data.
+                if listener.timed_wait(|_| {}, TICK).is_err() {
                     break;
                 }
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take(active, &mut attach, &mut users, &runtime, &notifier, wait);
+                    take(active, &mut attach, &mut users, &runtime, &notifier);
                 }
             }
         })
@@ -255,12 +233,11 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     users: &mut Users<E>,
     runtime: &tokio::runtime::Handle,
     notifier: &Arc<Mutex<Notifier<Svc>>>,
-    wait: Wait,
 ) {
     let meta = *active.user_header();
     // A header a peer wrote garbage into is refused; the bridge goes on serving.
     let Some(module) = meta.module().map(str::to_owned) else {
-        respond(active, MALFORMED, 0, Rep::default(), Some(notifier));
+        respond(active, MALFORMED, 0, Rep::default(), notifier);
         return;
     };
     // A module this copy of the owner has not seen yet — the owner was restarted since the
@@ -268,32 +245,26 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     let end = match user(attach, users, &module) {
         Ok(end) => end,
         Err((status, detail)) => {
-            respond(active, status, detail, Rep::default(), Some(notifier));
+            respond(active, status, detail, Rep::default(), notifier);
             return;
         }
     };
     match meta.kind {
-        // The connection learns how the port waits: a TIGHT port's user spins too.
-        CONNECT => {
-            let flags = if wait.notifies() { 0 } else { TIGHT };
-            respond(active, OK, flags, Rep::default(), Some(notifier));
-        }
+        CONNECT => respond(active, OK, 0, Rep::default(), notifier),
         SEND => {
             let request = *active.payload();
-            // A spinning user looks for its reply without being woken.
-            let notifier = wait.notifies().then(|| Arc::clone(notifier));
+            let notifier = Arc::clone(notifier);
             // Each request waits on tokio, so that several remote modules' requests are
             // pending at once and the owner's order decides which it takes.
             runtime.spawn(async move {
                 let reply = end.lock().await.forward(request).await;
-                let notifier = notifier.as_deref();
                 match reply {
-                    Some(reply) => respond(active, OK, 0, reply, notifier),
-                    None => respond(active, NO_REPLY, 0, Rep::default(), notifier),
+                    Some(reply) => respond(active, OK, 0, reply, &notifier),
+                    None => respond(active, NO_REPLY, 0, Rep::default(), &notifier),
                 }
             });
         }
-        _ => respond(active, MALFORMED, 0, Rep::default(), Some(notifier)),
+        _ => respond(active, MALFORMED, 0, Rep::default(), notifier),
     }
 }
 
@@ -321,23 +292,21 @@ fn user<E>(
     }
 }
 
-/// Replies through shared memory, then wakes the users' bridges (unless they spin).
+/// Replies through shared memory, then wakes the users' bridges.
 fn respond<Req: Wire, Rep: Wire>(
     active: Active<Req, Rep>,
     status: u32,
     detail: u32,
     reply: Rep,
-    notifier: Option<&Mutex<Notifier<Svc>>>,
+    notifier: &Mutex<Notifier<Svc>>,
 ) {
     if let Ok(mut response) = active.loan_uninit() {
         *response.user_header_mut() = ReplyMeta { status, detail };
         // A user that died meanwhile cannot be answered; nothing else is lost.
         let _ = response.write_payload(reply).send();
     }
-    if let Some(notifier) = notifier {
-        let _ = notifier
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .notify();
-    }
+    let _ = notifier
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .notify();
 }

@@ -14,9 +14,9 @@ use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
 };
 
-use crate::bridge::{Channel, Readiness, Side, Svc, TICK, Wait, sweep_dead};
+use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
 use crate::wire::{
-    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -178,20 +178,15 @@ where
         client,
         listener,
         wake_owner,
-        wait,
     } = connect(remote, &name, module)?;
-    // A task in the runtime the importing module runs on: parked, woken by the owner's
-    // notify through tokio's reactor; TIGHT, looking again after every other task has had
-    // its turn while a request waits.
-    let readiness = match wait {
-        Wait::Parked => Some(Readiness::new(listener, &name)?),
-        Wait::Spinning => None,
-    };
+    // A task in the runtime the importing module runs on, woken by the owner's notify
+    // through tokio's reactor: a reply reaches its sender with no hand-over between threads.
+    let readiness = Readiness::new(listener, &name)?;
     let (to_waiter, incoming) = tokio::sync::mpsc::unbounded_channel();
     let waiter = runtime.spawn(async move {
         // The channel lives as long as the waiter: its node keeps the services open.
         let _channel = channel;
-        hand_back_replies(readiness.as_ref(), incoming).await;
+        hand_back_replies(&readiness, incoming).await;
     });
 
     let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
@@ -211,13 +206,10 @@ where
             if to_waiter.send((pending, reply)).is_err() {
                 break;
             }
-            // A TIGHT port's owner looks without being woken.
-            if wait.notifies() {
-                let _ = wake_owner
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .notify();
-            }
+            let _ = wake_owner
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .notify();
         }
     });
     Ok(Relay { waiter, forwarder })
@@ -230,8 +222,6 @@ pub(crate) struct Connection<Req: Wire, Rep: Wire> {
     pub(crate) client: Asker<Req, Rep>,
     pub(crate) listener: Listener<Svc>,
     pub(crate) wake_owner: Notifier<Svc>,
-    /// How the port waits, as its owner said at connection.
-    pub(crate) wait: Wait,
 }
 
 /// Opens port `name` of `remote` as a client and connects as module `module`: the owner
@@ -253,13 +243,12 @@ pub(crate) fn connect<Req: Wire, Rep: Wire>(
             })?;
     let listener = channel.listener(&channel.replied)?;
     let wake_owner = channel.notifier(&channel.requested)?;
-    let wait = handshake(&client, &listener, &wake_owner, name, module)?;
+    handshake(&client, &listener, &wake_owner, name, module)?;
     Ok(Connection {
         channel,
         client,
         listener,
         wake_owner,
-        wait,
     })
 }
 
@@ -271,7 +260,7 @@ fn handshake<Req: Wire, Rep: Wire>(
     wake_owner: &Notifier<Svc>,
     port: &Name,
     module: &str,
-) -> Result<Wait, IpcError> {
+) -> Result<(), IpcError> {
     let transport = |detail: String| IpcError::Transport {
         port: port.clone(),
         detail,
@@ -291,8 +280,7 @@ fn handshake<Req: Wire, Rep: Wire>(
             let meta = *response.user_header();
             let (port, module) = (port.clone(), Name::from(module));
             return match meta.status {
-                OK if meta.detail & TIGHT != 0 => Ok(Wait::Spinning),
-                OK => Ok(Wait::Parked),
+                OK => Ok(()),
                 NOT_ON_USER_LIST => {
                     Err(IpcError::Refused(WireError::NotOnUserList { port, module }))
                 }
@@ -311,44 +299,33 @@ fn handshake<Req: Wire, Rep: Wire>(
     Err(IpcError::NoOwner { port: port.clone() })
 }
 
-/// The waiter: woken by the owner's notify (parked), or looking again after every other
-/// task's turn while a request waits (TIGHT, `readiness` none), or by a request sent; hands
-/// each reply to its local sender, and drops the handles of requests whose owner is gone,
-/// so that their senders fail at once.
+/// The waiter: woken by the owner's notify, or by a request sent; hands each reply to its
+/// local sender, and drops the handles of requests whose owner is gone, so that their
+/// senders fail at once.
 async fn hand_back_replies<Req: Wire, Rep: Wire>(
-    readiness: Option<&Readiness>,
+    readiness: &Readiness,
     mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
 ) {
     let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
     // Every half second while something waits: see whether a peer died.
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     loop {
-        let spin = readiness.is_none() && !waiting.is_empty();
         tokio::select! {
             sent = incoming.recv() => match sent {
                 Some((pending, reply)) => waiting.push((pending, Some(reply))),
                 None => return,
             },
-            notified = notified(readiness) => {
+            notified = readiness.notified() => {
                 if notified.is_err() {
                     return;
                 }
             }
-            () = tokio::task::yield_now(), if spin => {}
             _ = sweep.tick(), if !waiting.is_empty() => sweep_dead(),
         }
         while let Ok((pending, reply)) = incoming.try_recv() {
             waiting.push((pending, Some(reply)));
         }
         look(&mut waiting);
-    }
-}
-
-/// The owner's notify, where the port has one; never, where it spins.
-async fn notified(readiness: Option<&Readiness>) -> std::io::Result<()> {
-    match readiness {
-        Some(readiness) => readiness.notified().await,
-        None => std::future::pending().await,
     }
 }
 

@@ -35,11 +35,14 @@
 //! handlers of modules in other processes, each run when its module's order says; and
 //! `QUERY` ports, whose owner queries its users, with [`export_query`] and [`import_query`].
 //!
-//! A port declared TIGHT ([`ProcessType::Tight`](imrs_core::imrs_ports::ProcessType))
-//! crosses with both sides' bridge threads spinning — looking again at once, yielding the
-//! processor between looks — instead of waiting on iceoryx2 events, and nobody notifies. Its
-//! users learn it when they connect. The owner's bridge spins for as long as the port is
-//! exported; a user's only while a request waits.
+//! The bridges are tokio tasks in the runtime the cell runs on, woken by iceoryx2's events
+//! through tokio's reactor (the listener's socket, as an `AsyncFd`): a remote request
+//! reaches the owner's module, and its reply the sender, with no hand-over between threads.
+//! They poll no message; an exported port's task also looks at each 50 ms tick, so that a
+//! request whose notify was lost waits a tick at most. Call the functions from within a
+//! runtime whose I/O driver is enabled (`enable_all`). A TIGHT port crosses as any other:
+//! spinning bridges were slower than woken ones on the 2-core machine measured (see the
+//! README), because a spinner takes the processor the other process needs.
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the

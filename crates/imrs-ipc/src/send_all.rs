@@ -8,7 +8,6 @@ use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireEr
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
-use crate::bridge::Wait;
 use crate::export::{Forward, Refusal, bridge, until_attached};
 use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
@@ -119,7 +118,7 @@ where
     // The owner starts each rendezvous here; its relays are parked.
     // Attaching a remote module connects a relay back to its process: a wait of its own,
     // kept off tokio's workers.
-    bridge::<Req, Rep, _, _>(remote, name, N, Wait::Parked, true, move |module: &str| {
+    bridge::<Req, Rep, _, _>(remote, name, N, true, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
         let end = user_end(&port, module)?;
         let _entered = runtime.enter();
@@ -192,7 +191,6 @@ where
         remote,
         to_module(&name, module),
         1,
-        Wait::Parked,
         false,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {

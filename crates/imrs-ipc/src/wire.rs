@@ -91,9 +91,6 @@ pub(crate) const REFUSED: u32 = 3;
 pub(crate) const MALFORMED: u32 = 4;
 pub(crate) const NO_REPLY: u32 = 5;
 
-/// In the detail of an accepted connection: the port is TIGHT, so both sides spin.
-pub(crate) const TIGHT: u32 = 1;
-
 /// Where a cell's ports cross: the cell's name, from which every service name is derived, so
 /// that two cells on one host never meet.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -724,19 +724,17 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_tight_port_crosses_with_both_sides_spinning_and_a_dead_owner_still_fails_the_sender() {
+async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_sender() {
     let cell = cell("tight");
     let mut first = started_owner("tight-owner", &cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
-    // Nobody notifies on a TIGHT port: every reply is found by looking.
     for value in 1..=200 {
         let reply = within(5, asker.send(Number { value })).await.unwrap();
         assert_eq!(reply.value, 2 * value);
     }
-    // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile. The spinning
-    // waiter sees it gone as a parked one does.
+    // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile.
     let sending = tokio::spawn(async move { asker.send(Number { value: 4000 }).await });
     tokio::time::sleep(Duration::from_millis(300)).await;
     first.0.kill().unwrap();

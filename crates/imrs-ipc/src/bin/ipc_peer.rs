@@ -3,8 +3,7 @@
 //! - `ipc_peer owner CELL PORT`: exports PORT (users ASKER and ASKER_2, two at most), and
 //!   answers each number with its double, after waiting the number's milliseconds if it is
 //!   over 1000 (so that a test can catch it mid-rendezvous). Prints `ready` once exported.
-//! - `ipc_peer tight-owner CELL PORT`: the same, with PORT declared TIGHT: both sides' bridges
-//!   spin instead of waiting on events.
+//! - `ipc_peer tight-owner CELL PORT`: the same, with PORT declared TIGHT.
 //! - `ipc_peer responder CELL PORT`: exports the `RESPONSE` port PORT (user ASKER), whose
 //!   response handler answers each number with its triple. Prints `ready` once exported.
 //! - `ipc_peer listener CELL PORT MODULE N`: imports the `SENDALL` port PORT (owner
