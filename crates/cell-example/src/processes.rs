@@ -237,21 +237,16 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     }
     lines.wait();
     drop(exported);
-    Ok(RunRecord {
-        config: config.clone(),
-        tally: lock(&tally).clone(),
-        sim_events: sim.log().snapshot(),
-        cell_events: cell.events().snapshot(),
-        pallets_left: sim.pallets(),
+    let tally = lock(&tally).clone();
+    Ok(RunRecord::measured(
+        config,
+        tally,
+        &sim,
+        &cell,
         waits,
-        tree: cell.tree(),
-        feeders: sim.feeders(),
-        robot_times: sim.robot_times(),
-        closest_in_zone: sim.closest_in_zone(),
         cycle_times,
-        simulated: total,
-        wall: Duration::ZERO,
-    })
+        total,
+    ))
 }
 
 fn process_name(line: Line) -> &'static str {

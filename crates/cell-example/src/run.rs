@@ -335,26 +335,53 @@ async fn simulate(
             .map_err(|error| output(path, error))?;
     }
     let waits = *waits.lock().unwrap_or_else(PoisonError::into_inner);
-    Ok(RunRecord {
-        config: config.clone(),
-        tally: lock(&tally).clone(),
-        sim_events: sim.log().snapshot(),
-        cell_events: cell.events().snapshot(),
-        pallets_left: sim.pallets(),
+    let cycle_times = cycle_times.each_ref().map(|history| {
+        history
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    });
+    let tally = lock(&tally).clone();
+    Ok(RunRecord::measured(
+        config,
+        tally,
+        &sim,
+        &cell,
         waits,
-        tree: cell.tree(),
-        feeders: sim.feeders(),
-        robot_times: sim.robot_times(),
-        closest_in_zone: sim.closest_in_zone(),
-        cycle_times: cycle_times.each_ref().map(|history| {
-            history
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .clone()
-        }),
-        simulated: total,
-        wall: Duration::ZERO,
-    })
+        cycle_times,
+        total,
+    ))
+}
+
+impl RunRecord {
+    /// The record of a run that simulated `simulated` with `sim`, its modules in `cell` (or,
+    /// across processes, the world's), and what was folded from both; its wall time is set
+    /// by the caller.
+    pub(crate) fn measured(
+        config: &CellConfig,
+        tally: Tally,
+        sim: &Sim,
+        cell: &Cell,
+        waits: [ZoneWaits; 2],
+        cycle_times: [CycleTimeHistory; 2],
+        simulated: Duration,
+    ) -> Self {
+        Self {
+            config: config.clone(),
+            tally,
+            sim_events: sim.log().snapshot(),
+            cell_events: cell.events().snapshot(),
+            pallets_left: sim.pallets(),
+            waits,
+            tree: cell.tree(),
+            feeders: sim.feeders(),
+            robot_times: sim.robot_times(),
+            closest_in_zone: sim.closest_in_zone(),
+            cycle_times,
+            simulated,
+            wall: Duration::ZERO,
+        }
+    }
 }
 
 /// The modules of one line, and what they share with the run: everything needed to

@@ -122,6 +122,15 @@ fn row<'a>(report: &'a str, what: &str) -> (&'a str, &'a str) {
     (a, b)
 }
 
+/// The zone requests and refusals of each line, as the report counts them.
+fn zone_requests(report: &str) -> [(u32, u32); 2] {
+    let (a, b) = row(report, "zone requests / refused");
+    [a, b].map(|asked| {
+        let (requests, refused) = asked.split_once('/').unwrap();
+        (requests.parse().unwrap(), refused.parse().unwrap())
+    })
+}
+
 #[test]
 fn the_cell_across_three_processes_reports_as_a_single_process_does() {
     // Six simulated minutes at sixty times the wall clock.
@@ -150,10 +159,8 @@ fn the_cell_across_three_processes_reports_as_a_single_process_does() {
     }
     // The chip robots' waits for the zone were counted in the lines' processes and came
     // back with their figures.
-    let (a, b) = row(&report, "zone requests / refused");
-    for asked in [a, b] {
-        let requests: u32 = asked.split('/').next().unwrap().parse().unwrap();
-        assert!(requests > 0, "{asked}\n{report}");
+    for (requests, _) in zone_requests(&report) {
+        assert!(requests > 0, "{requests}\n{report}");
     }
     assert!(report.contains("[ok] no two robots in the feeder zone together (rapier)"));
     assert!(report.contains("[ok] no two arms touching (rapier)"));
@@ -186,11 +193,8 @@ fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process
     let (a, b) = row(&report, "pallets completed");
     let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
     assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
-    let (a, b) = row(&report, "zone requests / refused");
-    for asked in [a, b] {
-        let (requests, refused) = asked.split_once('/').unwrap();
-        let (requests, refused): (u32, u32) = (requests.parse().unwrap(), refused.parse().unwrap());
-        assert!(requests > refused, "{asked}\n{report}");
+    for (requests, refused) in zone_requests(&report) {
+        assert!(requests > refused, "{requests}/{refused}\n{report}");
     }
     assert!(report.contains("[ok] no two robots in the feeder zone together (rapier)"));
     assert!(!report.contains("[FAILED]"), "{report}");

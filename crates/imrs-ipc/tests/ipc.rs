@@ -96,6 +96,38 @@ async fn answers(mut peer: Peer) -> Vec<u64> {
     text.lines().map(|line| line.parse().unwrap()).collect()
 }
 
+/// Waits (10 s at most) until `n` users are attached to `end`'s port.
+async fn until_users<Req, Rep, U>(end: &imrs_core::imrs_ports::End<Req, Rep, U>, n: usize)
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: imrs_core::imrs_ports::usage::Usage,
+{
+    within(10, async {
+        while end.peers().len() < n {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+}
+
+/// Waits (30 s at most) for a peer process to end successfully; what it printed.
+async fn finished(mut peer: Peer) -> String {
+    within(30, async {
+        loop {
+            if let Some(status) = peer.0.try_wait().unwrap() {
+                let mut text = String::new();
+                std::io::Read::read_to_string(&mut peer.0.stdout.take().unwrap(), &mut text)
+                    .unwrap();
+                assert!(status.success(), "{text}");
+                break text;
+            }
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await
+}
+
 async fn within<T>(seconds: u64, future: impl Future<Output = T>) -> T {
     tokio::time::timeout(Duration::from_secs(seconds), future)
         .await
@@ -528,12 +560,7 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
         .map(|module| peer(&["listener", &cell, "NEWS", module, "20"]))
         .collect();
     // Both listeners' ends are attached when their processes connect.
-    within(10, async {
-        while broadcaster.peers().len() < 2 {
-            tokio::time::sleep(Duration::from_millis(20)).await;
-        }
-    })
-    .await;
+    until_users(&broadcaster, 2).await;
     for value in 1..=20 {
         let mut broadcast = within(5, broadcaster.send_all(Number { value }))
             .await
@@ -674,12 +701,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
         .iter()
         .map(|module| peer(&["answerer", &cell, "POLL", module, "10"]))
         .collect();
-    within(10, async {
-        while caller.peers().len() < 3 {
-            tokio::time::sleep(Duration::from_millis(20)).await;
-        }
-    })
-    .await;
+    until_users(&caller, 3).await;
     // The local handler answers only when served, so each query is answered first by a
     // remote one, then by the other, then by the local one.
     for value in 1..=10 {
@@ -705,20 +727,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
         );
     }
     for answerer in answerers {
-        let text = within(30, async {
-            let mut peer = answerer;
-            loop {
-                if let Some(status) = peer.0.try_wait().unwrap() {
-                    let mut text = String::new();
-                    std::io::Read::read_to_string(&mut peer.0.stdout.take().unwrap(), &mut text)
-                        .unwrap();
-                    assert!(status.success(), "{text}");
-                    break text;
-                }
-                tokio::time::sleep(Duration::from_millis(20)).await;
-            }
-        })
-        .await;
+        let text = finished(answerer).await;
         assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
     }
 }
@@ -756,28 +765,15 @@ async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fai
         Port::declare(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
     let _exported = imrs_ipc::export_query(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
-    let mut child = peer(&["child", &cell, "ASK_STATUS", "CHILD", "10"]);
-    within(10, async {
-        while parent.peers().is_empty() {
-            tokio::time::sleep(Duration::from_millis(20)).await;
-        }
-    })
-    .await;
+    let child = peer(&["child", &cell, "ASK_STATUS", "CHILD", "10"]);
+    until_users(&parent, 1).await;
     for value in 1..=10 {
         let status = within(5, parent.query(Number { value })).await.unwrap();
         assert_eq!(status.value, 5 * value);
     }
     // The child answered ten and ended: the next query fails, typed, and nothing hangs.
-    let ended = within(10, async {
-        loop {
-            if let Some(status) = child.0.try_wait().unwrap() {
-                break status;
-            }
-            tokio::time::sleep(Duration::from_millis(20)).await;
-        }
-    })
-    .await;
-    assert!(ended.success());
+    let text = finished(child).await;
+    assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
     let late = within(10, parent.query(Number { value: 11 })).await;
     assert!(
         matches!(

@@ -20,6 +20,7 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
+use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_response, import, import_call_all,
@@ -118,29 +119,30 @@ async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
 
 async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_call_all::<Number, Number>(&Remote::new(cell)?, port, "CALLER", module)?;
-    let mut answering =
-        imported
-            .port()
-            .responder_named(module, |factor: &u64, number: Number| Number {
-                value: factor * number.value,
-            })?;
-    for _ in 0..n.parse::<u64>()? {
-        answering.serve(&4).await?;
-        println!("answered");
-    }
-    Ok(())
+    answer(imported.port(), module, 4, n).await
 }
 
 async fn child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_query::<Number, Number>(&Remote::new(cell)?, port, "PARENT", module)?;
-    let mut answering =
-        imported
-            .port()
-            .responder_named(module, |factor: &u64, number: Number| Number {
-                value: factor * number.value,
-            })?;
+    answer(imported.port(), module, 5, n).await
+}
+
+/// Answers `n` queries on `port` as `module`, each with `factor` times its number, from a
+/// response handler; prints `answered` after each.
+async fn answer<U>(
+    port: &Port<Number, Number, U, AnyUser, 1>,
+    module: &str,
+    factor: u64,
+    n: &str,
+) -> Result<(), Error>
+where
+    U: Usage<Complement = usage::Response>,
+{
+    let mut answering = port.responder_named(module, |factor: &u64, number: Number| Number {
+        value: factor * number.value,
+    })?;
     for _ in 0..n.parse::<u64>()? {
-        answering.serve(&5).await?;
+        answering.serve(&factor).await?;
         println!("answered");
     }
     Ok(())
