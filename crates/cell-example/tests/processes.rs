@@ -201,6 +201,39 @@ fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process
 }
 
 #[test]
+fn faults_reach_the_process_they_belong_to_and_their_alarms_come_back() {
+    // RELEASE dies in line A's process; line B's chip robot faults in the world's
+    // simulation, and the fault reaches CHIP_IT2 across processes as the device's error.
+    let world = World::start(&[
+        "--hours",
+        "0.05",
+        "--speed",
+        "30",
+        "--fault",
+        "release:A@60s",
+        "--fault",
+        "robot:B@90s",
+    ]);
+    let output = world.finish(Duration::from_secs(120));
+    let (report, errors) = (
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr),
+    );
+    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    assert!(
+        report.contains("faults injected: release:A@60s, robot:B@90s"),
+        "{report}"
+    );
+    let restarts = report
+        .lines()
+        .find_map(|line| line.strip_prefix("restarts: "))
+        .unwrap_or_else(|| panic!("no restarts in\n{report}"));
+    assert!(restarts.starts_with("1 "), "{restarts}");
+    assert!(restarts.contains("robot fault 1"), "{restarts}");
+    assert!(restarts.contains("task failed 1"), "{restarts}");
+}
+
+#[test]
 fn a_line_killed_mid_run_fails_the_run_by_name_at_once() {
     // An hour at ten times the wall clock: six minutes, unless the death is seen.
     let world = World::start(&["--hours", "1", "--speed", "10"]);
