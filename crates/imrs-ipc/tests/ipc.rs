@@ -783,3 +783,27 @@ async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fai
         "{late:?}"
     );
 }
+
+#[test]
+fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+
+    // The bridges wait on tokio's reactor: a runtime built without it cannot carry a port.
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_time()
+        .build()
+        .unwrap();
+    let cell = cell("no-io");
+    runtime.block_on(async {
+        let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+            Port::declare(PortSpec::new("QUIET", "OWNER"));
+        let error = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port)
+            .err()
+            .expect("refused");
+        assert!(
+            matches!(&error, IpcError::Transport { port, .. } if port == "QUIET"),
+            "{error:?}"
+        );
+        assert!(error.to_string().contains("I/O driver"), "{error}");
+    });
+}
