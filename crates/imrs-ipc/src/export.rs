@@ -10,7 +10,6 @@ use std::thread::JoinHandle;
 
 use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
@@ -35,21 +34,12 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
 }
 
 /// A query: a remote user's to the owner of a `RESPONSE` port, or a remote owner's to the
-/// one local user of a `QUERY` port, once that user has attached.
+/// one local user of a `QUERY` port, once that user has attached (the owner counts a remote
+/// module attached from its connection; here the module attaches a moment later).
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
-        until_attached(self).await;
+        self.peer_attached().await;
         self.query(request).await.ok()
-    }
-}
-
-/// The owner counts a remote module attached from its connection; here the module attaches
-/// to the local port a moment later. A broadcast that comes in between waits for it, as it
-/// would have reached it in one process. (A short wait, checked each millisecond: only
-/// between the connection and the module's attaching.)
-pub(crate) async fn until_attached<Req: Wire, Rep: Wire, U: Usage>(end: &End<Req, Rep, U>) {
-    while end.peers().is_empty() {
-        tokio::time::sleep(std::time::Duration::from_millis(1)).await;
     }
 }
 

@@ -8,7 +8,7 @@ use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireEr
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
-use crate::export::{Forward, Refusal, bridge, until_attached};
+use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
@@ -34,7 +34,7 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for Relayed {
 /// sent to the one local user, whose reply goes back.
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::SendAll> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
-        until_attached(self).await;
+        self.peer_attached().await;
         let broadcast = self.send_all(request).await.ok()?;
         Some(broadcast.first)
     }
@@ -44,7 +44,7 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::SendAll> {
 /// to the one local user's response handler, which answers when that module's order says.
 impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::CallAll> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
-        until_attached(self).await;
+        self.peer_attached().await;
         let broadcast = self.call_all(request).await.ok()?;
         Some(broadcast.first)
     }

@@ -1,7 +1,7 @@
 //! One attached end of a port: its place in the core, and what it does on detach.
 
 use std::sync::Arc;
-use std::task::Context;
+use std::task::{Context, Poll};
 use std::time::Duration;
 
 use crate::core::{Core, Gone, SlotId, hold};
@@ -80,6 +80,27 @@ impl<Req, Rep> Attachment<Req, Rep> {
         match self.at {
             SlotId::Owner => self.core.owner_waker.register_by_ref(cx.waker()),
             SlotId::User(index) => self.core.users[index].waker.register_by_ref(cx.waker()),
+        }
+    }
+
+    /// Ready once a module is attached at the other end of the port (at once, for a user's
+    /// end, whose peer is the owner); otherwise the owner's task is woken when a user
+    /// attaches.
+    pub(crate) fn poll_peer(&self, cx: &mut Context<'_>) -> Poll<()> {
+        let any = |this: &Self| {
+            let mut found = false;
+            this.each_peer(|_| found = true);
+            found
+        };
+        if any(self) {
+            return Poll::Ready(());
+        }
+        self.core.user_attached.register_by_ref(cx.waker());
+        // Looked at again once registered: a user that attached in between is not missed.
+        if any(self) {
+            Poll::Ready(())
+        } else {
+            Poll::Pending
         }
     }
 

@@ -106,6 +106,9 @@ pub(crate) struct Core<Req, Rep> {
     pub(crate) owner_waker: Padded<AtomicWaker>,
     owner_attached: AtomicBool,
     owner_holder: Mutex<Holder>,
+    /// Wakes whoever waits for a user to attach (`End::peer_attached`): a waker of its own,
+    /// so that an attaching never wakes the owner's serving, which a processor orders.
+    pub(crate) user_attached: AtomicWaker,
     /// Live `Port` handles: while one exists, a missing end may still attach.
     declarations: AtomicUsize,
     users_attached: AtomicUsize,
@@ -124,6 +127,7 @@ impl<Req, Rep> Core<Req, Rep> {
             owner_waker: Padded(AtomicWaker::new()),
             owner_attached: AtomicBool::new(false),
             owner_holder: Mutex::default(),
+            user_attached: AtomicWaker::new(),
             declarations: AtomicUsize::new(1),
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),

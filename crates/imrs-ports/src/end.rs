@@ -58,6 +58,13 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         self.attachment.peers()
     }
 
+    /// Waits until a module is attached at the other end of the port: for the owner, until
+    /// the first user attaches (a user's end always has its owner). For a transport that
+    /// must not deliver a broadcast before the module it is for has attached.
+    pub async fn peer_attached(&self) {
+        std::future::poll_fn(|cx| self.attachment.poll_peer(cx)).await;
+    }
+
     /// Calls `visit` with each of [`End::peers`], allocating nothing: for the paths that
     /// run at every message, such as a module's deadlock diagnosis.
     pub fn each_peer(&self, visit: impl FnMut(Name)) {

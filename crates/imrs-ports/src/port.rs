@@ -369,6 +369,8 @@ pub(crate) fn attach_user<Req: Send + 'static, Rep: Send + 'static>(
         });
     };
     hold(core, SlotId::User(index), &module, Presence::current());
+    // Whoever waits for a user (`End::peer_attached`) looks again.
+    core.user_attached.wake();
     Ok(Attachment {
         core: Arc::clone(core),
         at: SlotId::User(index),

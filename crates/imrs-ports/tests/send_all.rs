@@ -110,3 +110,40 @@ fn send_all_does_not_wait_for_a_user_that_detached_before_taking_the_message() {
         assert_eq!(later, None);
     });
 }
+
+#[test]
+fn an_owner_waiting_for_its_first_user_is_woken_when_one_attaches_from_another_thread() {
+    use std::future::Future;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::task::{Context, Poll, Wake, Waker};
+
+    /// A waker that remembers it was woken.
+    struct Flag(AtomicBool);
+    impl Wake for Flag {
+        fn wake(self: Arc<Self>) {
+            self.0.store(true, Ordering::SeqCst);
+        }
+    }
+
+    let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+    let supervisor = port.owner().unwrap();
+    let flag = Arc::new(Flag(AtomicBool::new(false)));
+    let waker = Waker::from(Arc::clone(&flag));
+    let mut cx = Context::from_waker(&waker);
+    let mut waiting = std::pin::pin!(supervisor.peer_attached());
+    // Nobody has attached yet: the owner waits.
+    assert_eq!(waiting.as_mut().poll(&mut cx), Poll::Pending);
+    assert!(!flag.0.load(Ordering::SeqCst));
+    // A user attaches from another thread, and stays; the port stays declared here, so
+    // that nothing but the attaching can wake the owner.
+    let declared = port.clone();
+    let attaching = std::thread::spawn(move || declared.user_named("ROBOT1"));
+    let _robot = attaching.join().unwrap().unwrap();
+    assert!(
+        flag.0.load(Ordering::SeqCst),
+        "the attaching wakes the owner"
+    );
+    assert_eq!(waiting.as_mut().poll(&mut cx), Poll::Ready(()));
+    assert_eq!(supervisor.peers(), ["ROBOT1"]);
+}
