@@ -235,7 +235,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             (line, other) => return Err(other.refusal(line, "its figures")),
         }
     }
-    lines.wait();
+    lines.ended().await;
     drop(exported);
     let tally = lock(&tally).clone();
     Ok(RunRecord::measured(
@@ -301,9 +301,18 @@ async fn hear_from(hear: &mut UnboundedReceiver<(Line, Said)>) -> Result<(Line, 
 struct Lines(Vec<Child>);
 
 impl Lines {
-    fn wait(&mut self) {
-        for child in &mut self.0 {
-            let _ = child.wait();
+    /// Gives the lines, which have sent their figures, the world's patience to end on
+    /// their own (so that they let go of their shared memory); any still running then is
+    /// killed when `self` drops. The world never hangs on a line that does not end.
+    async fn ended(&mut self) {
+        let deadline = std::time::Instant::now() + PATIENCE;
+        while std::time::Instant::now() < deadline
+            && self
+                .0
+                .iter_mut()
+                .any(|child| matches!(child.try_wait(), Ok(None)))
+        {
+            tokio::time::sleep(Duration::from_millis(20)).await;
         }
     }
 }

@@ -53,8 +53,13 @@ fn within(limit: Duration, mut condition: impl FnMut() -> bool) -> bool {
     condition()
 }
 
-/// The world, started: killed if the test fails before it ends.
-struct World(Child);
+/// The world, started: killed, with its lines, if the test fails before it ends.
+struct World {
+    child: Option<Child>,
+    pid: u32,
+    /// Its status was read: its pid may now name another process.
+    reaped: bool,
+}
 
 impl World {
     fn start(args: &[&str]) -> Self {
@@ -65,11 +70,15 @@ impl World {
             .stderr(Stdio::piped())
             .spawn()
             .expect("the example is built with the tests");
-        Self(child)
+        Self {
+            pid: child.id(),
+            child: Some(child),
+            reaped: false,
+        }
     }
 
     fn pid(&self) -> u32 {
-        self.0.id()
+        self.pid
     }
 
     /// Its two lines' processes, once both are running.
@@ -86,26 +95,47 @@ impl World {
         lines
     }
 
+    /// Its output once it has ended, read as it comes (so that a full pipe never holds it
+    /// up); the test fails if it has not ended within `limit`.
     fn finish(mut self, limit: Duration) -> Output {
-        let ended = within(limit, || self.0.try_wait().is_ok_and(|s| s.is_some()));
-        assert!(ended, "the world did not end within {limit:?}");
-        let child = std::mem::replace(
-            &mut self.0,
-            Command::new("true").spawn().expect("true runs"),
+        let child = self.child.take().expect("not finished yet");
+        let (output, ended) = std::sync::mpsc::channel();
+        std::thread::spawn(move || output.send(child.wait_with_output()));
+        let output = ended
+            .recv_timeout(limit)
+            .unwrap_or_else(|_| panic!("the world did not end within {limit:?}"));
+        self.reaped = true;
+        output.unwrap()
+    }
+
+    /// Its report, once it has ended within `limit` with status 0.
+    fn report(self, limit: Duration) -> String {
+        let output = self.finish(limit);
+        let (report, errors) = (
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr),
         );
-        child.wait_with_output().unwrap()
+        assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+        report.into_owned()
     }
 }
 
 impl Drop for World {
     fn drop(&mut self) {
-        let lines = children_of(self.pid());
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-        for line in lines {
-            let _ = Command::new("kill")
-                .args(["-9", &line.to_string()])
-                .status();
+        // An ended world ended its lines (it kills any that outlive its patience), and its
+        // pid may now name another process: nothing is left to clean.
+        if self.reaped {
+            return;
+        }
+        // Whatever is left of the run: the lines, and the world if `finish` gave up on it.
+        let mut left = children_of(self.pid);
+        left.push(self.pid);
+        if let Some(child) = &mut self.child {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+        for pid in left {
+            let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
         }
     }
 }
@@ -137,12 +167,7 @@ fn the_cell_across_three_processes_reports_as_a_single_process_does() {
     let world = World::start(&["--hours", "0.1", "--speed", "60"]);
     let lines = world.lines();
     assert!(lines.iter().all(|line| *line != world.pid()));
-    let output = world.finish(Duration::from_secs(120));
-    let (report, errors) = (
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr),
-    );
-    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    let report = world.report(Duration::from_secs(120));
     assert!(
         report.contains("processes: world (simulation, WORLD, FEEDER_MONITOR), line A, line B"),
         "{report}"
@@ -177,12 +202,7 @@ fn the_cell_across_three_processes_reports_as_a_single_process_does() {
 #[test]
 fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process() {
     let world = World::start(&["--feeder", "appendix", "--hours", "0.1", "--speed", "60"]);
-    let output = world.finish(Duration::from_secs(120));
-    let (report, errors) = (
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr),
-    );
-    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    let report = world.report(Duration::from_secs(120));
     // No arbiter in the world: the lines ask each other.
     assert!(
         report.contains("processes: world (simulation, WORLD), line A, line B"),
@@ -214,12 +234,7 @@ fn faults_reach_the_process_they_belong_to_and_their_alarms_come_back() {
         "--fault",
         "robot:B@90s",
     ]);
-    let output = world.finish(Duration::from_secs(120));
-    let (report, errors) = (
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr),
-    );
-    assert_eq!(output.status.code(), Some(0), "{report}\n{errors}");
+    let report = world.report(Duration::from_secs(120));
     assert!(
         report.contains("faults injected: release:A@60s, robot:B@90s"),
         "{report}"
