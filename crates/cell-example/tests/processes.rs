@@ -129,10 +129,13 @@ impl Drop for World {
         }
         // Whatever is left of the run: the lines, and the world if `finish` gave up on it.
         let mut left = children_of(self.pid);
-        left.push(self.pid);
-        if let Some(child) = &mut self.child {
-            let _ = child.kill();
-            let _ = child.wait();
+        match &mut self.child {
+            Some(child) => {
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+            // `finish` gave up on it: its thread holds the child, so it is killed by pid.
+            None => left.push(self.pid),
         }
         for pid in left {
             let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
