@@ -32,6 +32,17 @@ pub enum FeederPolicy {
     Coordinator,
 }
 
+impl FeederPolicy {
+    /// Its name, as `--feeder` takes it and the report prints it.
+    pub fn name(self) -> &'static str {
+        match self {
+            FeederPolicy::Appendix => "appendix",
+            FeederPolicy::Arbiter => "arbiter",
+            FeederPolicy::Coordinator => "coordinator",
+        }
+    }
+}
+
 /// One step of CHIP_IT's work schedule: `GRASP(n), INSERT(X, Y, Z)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChipStep {

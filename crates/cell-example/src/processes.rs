@@ -20,7 +20,7 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_ipc::{Exported, Imported, IpcError, Remote, export, export_query, import, import_query};
@@ -38,7 +38,7 @@ use crate::faults::CellFaultKind;
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
 use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
 use crate::ports::{CellPorts, ModuleName, ZoneLink};
-use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject};
+use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject, lock};
 use crate::tally::Tally;
 
 /// How much faster than the wall clock a run across processes goes, unless `--speed` says.
@@ -111,10 +111,6 @@ fn clock(process: &str, epoch: SystemTime, speed: f64) -> Result<SharedClock, Ru
 
 fn ipc(process: &str) -> impl Fn(IpcError) -> RunError + '_ {
     move |error| refused(process, error)
-}
-
-fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Runs the cell across three processes — this one the world's — and folds the lines'
@@ -351,7 +347,7 @@ fn start_line(
         .args(["--speed", &config.speed.to_string()])
         .args(["--hours", &config.hours.to_string()])
         .args(["--seed", &config.seed.to_string()])
-        .args(["--feeder", feeder_flag(config.feeder)]);
+        .args(["--feeder", config.feeder.name()]);
     for fault in &config.faults {
         command.arg(format!("--fault={fault}"));
     }
@@ -383,15 +379,6 @@ fn start_line(
         let _ = said.send((line, Said::Ended(None)));
     });
     Ok(child)
-}
-
-/// The `--feeder` value of `policy`.
-fn feeder_flag(policy: FeederPolicy) -> &'static str {
-    match policy {
-        FeederPolicy::Appendix => "appendix",
-        FeederPolicy::Arbiter => "arbiter",
-        FeederPolicy::Coordinator => "coordinator",
-    }
 }
 
 /// Runs one line's modules in this process, as the world started it; says `ready`, then its

@@ -316,7 +316,7 @@ impl Report {
             out.push('\n');
         };
         let each = |f: &dyn Fn(&Report) -> String| reports.iter().map(f).collect::<Vec<_>>();
-        row(&mut out, "", each(&|r| policy_name(r.policy).to_string()));
+        row(&mut out, "", each(&|r| r.policy.name().to_string()));
         for (line, name) in [(0, "A"), (1, "B")] {
             row(
                 &mut out,
@@ -380,14 +380,6 @@ fn pallets(pallets: &[PalletId]) -> String {
         .join(", ")
 }
 
-fn policy_name(policy: FeederPolicy) -> &'static str {
-    match policy {
-        FeederPolicy::Appendix => "appendix",
-        FeederPolicy::Arbiter => "arbiter",
-        FeederPolicy::Coordinator => "coordinator",
-    }
-}
-
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
@@ -395,7 +387,7 @@ impl fmt::Display for Report {
             "IMRS chip-insertion cell: seed {}, {:.2} h simulated, feeder policy {}",
             self.seed,
             self.hours,
-            policy_name(self.policy)
+            self.policy.name()
         )?;
         if self.faults.is_empty() {
             writeln!(f, "faults injected: none")?;

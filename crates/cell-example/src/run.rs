@@ -471,7 +471,7 @@ fn progress_bar(wanted: bool, total: Duration) -> ProgressBar {
     bar
 }
 
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     // A fold is one call; a panic in it leaves the tally as the last whole event left it.
     mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }

@@ -225,14 +225,15 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     notifier: &Arc<Mutex<Notifier<Svc>>>,
 ) {
     let meta = *active.user_header();
-    // A header a peer wrote garbage into is refused; the bridge goes on serving.
-    let Some(module) = meta.module().map(str::to_owned) else {
+    // A header a peer wrote garbage into is refused; the bridge goes on serving. Borrowed
+    // from the header's copy: a request allocates no name.
+    let Some(module) = meta.module() else {
         respond(active, MALFORMED, 0, Rep::default(), notifier);
         return;
     };
     // A module this copy of the owner has not seen yet — the owner was restarted since the
     // module connected — is attached now, as at its connection.
-    let end = match user(attach, users, &module) {
+    let end = match user(attach, users, module) {
         Ok(end) => end,
         Err((status, detail)) => {
             respond(active, status, detail, Rep::default(), notifier);
