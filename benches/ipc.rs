@@ -4,6 +4,10 @@
 //! the same two processes, the same run. Each case: p50, p99 and p99.9 over its round
 //! trips, and the ratios the targets are stated in.
 //!
+//! The same round trips on ports of messages built in place (`Shared`): the sender builds
+//! each message in a sample of shared memory loaned from its port, the owner reads it
+//! there, and its reply is copied once into the sample that carries it back.
+//!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
 //! a raw iceoryx2 round trip whose client and server both spin.
@@ -17,8 +21,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
-use imrs_ipc::{FromBytes, Remote, Wire, export, import};
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
+use imrs_ipc::{FromBytes, Remote, Wire, export, export_shared, import, import_shared};
 
 type Svc = ipc_threadsafe::Service;
 
@@ -60,10 +64,12 @@ fn main() {
     let runtime = runtime();
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
-    let (imrs_small, imrs_large) = runtime.block_on(async {
+    let (imrs_small, imrs_large, loaned_small, loaned_large) = runtime.block_on(async {
         (
             imrs_round_trips::<Small>(&cell, "SMALL", rounds).await,
             imrs_round_trips::<Large>(&cell, "LARGE", rounds).await,
+            loaned_round_trips::<Small>(&cell, "SMALL_LOANED", rounds).await,
+            loaned_round_trips::<Large>(&cell, "LARGE_LOANED", rounds).await,
         )
     });
     let _ = child.kill();
@@ -85,6 +91,8 @@ fn main() {
         ("IMRS port over iceoryx2, 8 B", &imrs_small),
         ("raw iceoryx2, events, 64 KiB", &raw_large),
         ("IMRS port over iceoryx2, 64 KiB", &imrs_large),
+        ("IMRS port, loaned, 8 B", &loaned_small),
+        ("IMRS port, loaned, 64 KiB", &loaned_large),
         ("raw iceoryx2, both spinning, 8 B", &raw_spin),
         ("IMRS TIGHT port, 8 B", &imrs_tight),
     ] {
@@ -101,8 +109,20 @@ fn main() {
         show(ratio(&imrs_small, &raw_small).collect())
     );
     println!(
-        "  IMRS 64 KiB vs IMRS 8 B (target: within 1.5)                       {}",
+        "  IMRS 64 KiB vs IMRS 8 B, by value                                  {}",
         show(ratio(&imrs_large, &imrs_small).collect())
+    );
+    println!(
+        "  IMRS 64 KiB loaned vs IMRS 8 B loaned (target: within 1.5)         {}",
+        show(ratio(&loaned_large, &loaned_small).collect())
+    );
+    println!(
+        "  IMRS 64 KiB loaned vs IMRS 8 B by value                            {}",
+        show(ratio(&loaned_large, &imrs_small).collect())
+    );
+    println!(
+        "  IMRS 8 B loaned vs raw 8 B                                         {}",
+        show(ratio(&loaned_small, &raw_small).collect())
     );
     println!(
         "  IMRS TIGHT 8 B vs raw spinning 8 B (target: within 1.2)            {}",
@@ -203,6 +223,8 @@ fn peer(cell: &str) {
             Peer::Parked => vec![
                 echo::<Small>(&remote, "SMALL", ProcessType::Indep),
                 echo::<Large>(&remote, "LARGE", ProcessType::Indep),
+                loaned_echo::<Small>(&remote, "SMALL_LOANED"),
+                loaned_echo::<Large>(&remote, "LARGE_LOANED"),
             ],
             Peer::RawSpinning => Vec::new(),
             Peer::Tight => vec![echo::<Small>(&remote, "SMALL", ProcessType::Tight)],
@@ -230,6 +252,44 @@ fn echo<T: Wire>(
             reply.reply(message);
         }
     })
+}
+
+/// An echo of messages built in place: each read where its sender built it, and answered
+/// with itself, copied once into the reply's sample.
+fn loaned_echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
+    let port: Port<Shared<T>, Shared<T>, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new(name, "ECHO"));
+    let exported = export_shared(remote, &port).expect("exported");
+    let mut owner = port.owner().expect("the owner's end");
+    tokio::spawn(async move {
+        let _exported = exported;
+        while let Ok((message, reply)) = owner.receive().await {
+            reply.reply(message);
+        }
+    })
+}
+
+/// Round trips of messages built in place: each loaned from the port (zeroed, in shared
+/// memory), sent, and its reply read where the owner's process wrote it.
+async fn loaned_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
+    let remote = Remote::new(cell).expect("a cell name");
+    let imported = import_shared::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
+    let mut asker = imported.port().user_named("ASKER").expect("the user's end");
+    let mut round_trip = async || {
+        let message = asker.loan().expect("a loan");
+        let reply = asker.send(message).await.expect("a round trip");
+        std::hint::black_box(&*reply);
+    };
+    for _ in 0..rounds / 10 {
+        round_trip().await;
+    }
+    let mut times = Vec::with_capacity(rounds);
+    for _ in 0..rounds {
+        let start = Instant::now();
+        round_trip().await;
+        times.push(start.elapsed());
+    }
+    times
 }
 
 async fn imrs_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {

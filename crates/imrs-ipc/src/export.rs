@@ -8,18 +8,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
-use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::{End, Name, Port, UserList, WireError, usage};
+use imrs_core::imrs_ports::{End, Name, Port, Shared, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
+use crate::carry::{Active, Carry, Held};
 use crate::wire::{
-    CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND,
-    TOO_MANY_USERS,
+    CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
-
-type Active<Req, Rep> = ActiveRequest<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 
 /// A remote module's end of the real port, through which its requests go in.
 pub(crate) trait Forward<Req, Rep>: Send + 'static {
@@ -27,7 +24,7 @@ pub(crate) trait Forward<Req, Rep>: Send + 'static {
     fn forward(&mut self, request: Req) -> impl Future<Output = Option<Rep>> + Send + '_;
 }
 
-impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
+impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
         self.send(request).await.ok()
     }
@@ -36,7 +33,7 @@ impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
 /// A query: a remote user's to the owner of a `RESPONSE` port, or a remote owner's to the
 /// one local user of a `QUERY` port, once that user has attached (the owner counts a remote
 /// module attached from its connection; here the module attaches a moment later).
-impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
+impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
     async fn forward(&mut self, request: Req) -> Option<Rep> {
         self.peer_attached().await;
         self.query(request).await.ok()
@@ -102,9 +99,27 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), N, false, move |module: &str| {
+    bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
         Ok(port.user_named(module)?)
     })
+}
+
+/// Exports `port`, a port of messages built in place ([`Shared`]), as [`export`] does a
+/// port of values: a remote module's request is read where its sender built it, in shared
+/// memory, with nothing copied on the way; the owner's reply is copied once, into the
+/// sample that carries it back, and read there.
+pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
+) -> Result<Exported, IpcError> {
+    let port = port.clone();
+    bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
+        remote,
+        Name::from(&port),
+        N,
+        false,
+        move |module: &str| Ok(port.user_named(module)?),
+    )
 }
 
 /// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
@@ -115,12 +130,15 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
-    bridge(remote, Name::from(&port), N, false, move |module: &str| {
+    bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
         Ok(port.user_named(module)?)
     })
 }
 
-pub(crate) fn bridge<Req, Rep, E, A>(
+/// Serves port `name`'s requests from other processes: each remote module is attached by
+/// `attach`, and its requests (wire type `Req`, carried in the port as `M`) go in through
+/// its end.
+pub(crate) fn bridge<Req, Rep, M, R, E, A>(
     remote: &Remote,
     name: Name,
     users: usize,
@@ -130,7 +148,9 @@ pub(crate) fn bridge<Req, Rep, E, A>(
 where
     Req: Wire,
     Rep: Wire,
-    E: Forward<Req, Rep>,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    E: Forward<M, R>,
     A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
 {
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
@@ -165,7 +185,7 @@ where
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take(active, &mut attach, &mut users, &runtime, &notifier);
+                    take::<Req, Rep, M, R, E>(active, &mut attach, &mut users, &runtime, &notifier);
                 }
                 tokio::select! {
                     notified = readiness.notified() => {
@@ -198,7 +218,7 @@ where
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take(active, &mut attach, &mut users, &runtime, &notifier);
+                    take::<Req, Rep, M, R, E>(active, &mut attach, &mut users, &runtime, &notifier);
                 }
             }
         })
@@ -217,7 +237,7 @@ where
 type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 
 /// One request from another process.
-fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
+fn take<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, E: Forward<M, R>>(
     active: Active<Req, Rep>,
     attach: &mut impl FnMut(&str) -> Result<E, Refusal>,
     users: &mut Users<E>,
@@ -225,10 +245,11 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     notifier: &Arc<Mutex<Notifier<Svc>>>,
 ) {
     let meta = *active.user_header();
+    let active: Held<Req, Rep> = Arc::new(Mutex::new(active));
     // A header a peer wrote garbage into is refused; the bridge goes on serving. Borrowed
     // from the header's copy: a request allocates no name.
     let Some(module) = meta.module() else {
-        respond(active, MALFORMED, 0, Rep::default(), notifier);
+        respond(&active, MALFORMED, 0, Rep::default(), notifier);
         return;
     };
     // A module this copy of the owner has not seen yet — the owner was restarted since the
@@ -236,26 +257,26 @@ fn take<Req: Wire, Rep: Wire, E: Forward<Req, Rep>>(
     let end = match user(attach, users, module) {
         Ok(end) => end,
         Err((status, detail)) => {
-            respond(active, status, detail, Rep::default(), notifier);
+            respond(&active, status, detail, Rep::default(), notifier);
             return;
         }
     };
     match meta.kind {
-        CONNECT => respond(active, OK, 0, Rep::default(), notifier),
+        CONNECT => respond(&active, OK, 0, Rep::default(), notifier),
         SEND => {
-            let request = *active.payload();
+            let request = M::from_request(&active);
             let notifier = Arc::clone(notifier);
             // Each request waits on tokio, so that several remote modules' requests are
             // pending at once and the owner's order decides which it takes.
             runtime.spawn(async move {
                 let reply = end.lock().await.forward(request).await;
                 match reply {
-                    Some(reply) => respond(active, OK, 0, reply, &notifier),
-                    None => respond(active, NO_REPLY, 0, Rep::default(), &notifier),
+                    Some(reply) => respond(&active, OK, 0, reply, &notifier),
+                    None => respond(&active, NO_REPLY, 0, Rep::default(), &notifier),
                 }
             });
         }
-        _ => respond(active, MALFORMED, 0, Rep::default(), notifier),
+        _ => respond(&active, MALFORMED, 0, Rep::default(), notifier),
     }
 }
 
@@ -283,18 +304,23 @@ fn user<E>(
     }
 }
 
-/// Replies through shared memory, then wakes the users' bridges.
-fn respond<Req: Wire, Rep: Wire>(
-    active: Active<Req, Rep>,
+/// Replies through shared memory, then wakes the users' bridges. The request is let go
+/// when the last holder drops it: here, or, for a request read in place, the module.
+fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(
+    active: &Held<Req, Rep>,
     status: u32,
     detail: u32,
-    reply: Rep,
+    reply: R,
     notifier: &Mutex<Notifier<Svc>>,
 ) {
-    if let Ok(mut response) = active.loan_uninit() {
+    let loaned = active
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .loan_uninit();
+    if let Ok(mut response) = loaned {
         *response.user_header_mut() = ReplyMeta { status, detail };
         // A user that died meanwhile cannot be answered; nothing else is lost.
-        let _ = response.write_payload(reply).send();
+        let _ = reply.into_reply(response).send();
     }
     let _ = notifier
         .lock()

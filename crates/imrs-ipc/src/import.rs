@@ -5,25 +5,24 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use iceoryx2::pending_response::PendingResponse;
-use iceoryx2::port::client::Client;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{
-    AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage,
+    AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, Shared, WireError, usage,
 };
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
-use crate::wire::{
-    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TOO_MANY_USERS,
-};
+use crate::carry::{Asker, Carry, Pending, lend};
+use crate::wire::{CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TOO_MANY_USERS};
 use crate::{IpcError, Remote, Wire};
 
-type Pending<Req, Rep> = PendingResponse<Svc, Req, RequestMeta, Rep, ReplyMeta>;
-type Asker<Req, Rep> = Client<Svc, Req, RequestMeta, Rep, ReplyMeta>;
-/// A request sent, and the local sender's right to its reply (taken when answered).
-type Waiting<Req, Rep> = (Pending<Req, Rep>, Option<ReplyHandle<Rep>>);
+/// A port's client, shared by its forwarder and its lender.
+type SharedAsker<Req, Rep> = Arc<Mutex<Asker<Req, Rep>>>;
+
+/// A request sent, and the local sender's right to its reply (taken when answered), which
+/// the port carries as `R`.
+type Waiting<Req, Rep, R> = (Pending<Req, Rep>, Option<ReplyHandle<R>>);
 
 /// How often a waiter with requests waiting looks for dead peers.
 const SWEEP_PERIOD: Duration = Duration::from_millis(500);
@@ -32,7 +31,7 @@ const SWEEP_PERIOD: Duration = Duration::from_millis(500);
 const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// A port imported from another process, and its bridge: usable while this is held.
-pub struct Imported<Req: Wire, Rep: Wire, U: Usage = usage::Receive> {
+pub struct Imported<Req: Send + 'static, Rep: Send + 'static, U: Usage = usage::Receive> {
     port: Port<Req, Rep, U, AnyUser, 1>,
     /// Whatever keeps the bridge working: dropped, it stops.
     _bridge: Mutex<Box<dyn Send>>,
@@ -45,7 +44,7 @@ pub(crate) struct Relay {
     forwarder: tokio::task::JoinHandle<()>,
 }
 
-impl<Req: Wire, Rep: Wire, U: Usage> Imported<Req, Rep, U> {
+impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
     pub(crate) fn new(port: Port<Req, Rep, U, AnyUser, 1>, bridge: impl Send + 'static) -> Self {
         Self {
             port,
@@ -77,13 +76,35 @@ pub fn import<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep>, IpcError> {
-    bridge(
+    bridge::<Req, Rep, Req, Rep, _, _>(
         remote,
         port,
         module,
         |local: &Port<Req, Rep, usage::Receive, AnyUser, 1>| local.owner(),
         owner,
     )
+}
+
+/// Imports a port of messages built in place ([`Shared`]), exported with
+/// [`export_shared`](crate::export_shared), as [`import`] does a port of values. The
+/// importing module's [`End::loan`] lends it a sample of shared memory: it builds its
+/// message there, and its send hands the sample to the owner's process with nothing copied.
+/// Each reply is read where the owner's process wrote it. A loan is refused, naming the
+/// port, while the module holds as many loans and requests as the port allows at once.
+pub fn import_shared<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Shared<Req>, Shared<Rep>>, IpcError> {
+    let imported = bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
+        remote,
+        port,
+        module,
+        |local: &Port<Shared<Req>, Shared<Rep>, usage::Receive, AnyUser, 1>| local.owner(),
+        owner,
+    )?;
+    Ok(imported)
 }
 
 /// Imports a `RESPONSE` port of another process, as [`import`] does a port its owner
@@ -115,13 +136,13 @@ pub(crate) trait Take<Req, Rep>: Send + 'static {
     fn next(&mut self) -> impl Future<Output = Option<(Req, ReplyHandle<Rep>)>> + Send + '_;
 }
 
-impl<Req: Wire, Rep: Wire> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
+impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
     async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
         self.receive().await.ok()
     }
 }
 
-impl<Req: Wire, Rep: Wire> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
+impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
     async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
         loop {
             std::future::poll_fn(|cx| self.poll_pending(cx))
@@ -134,39 +155,76 @@ impl<Req: Wire, Rep: Wire> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
     }
 }
 
-fn bridge<Req, Rep, U, T>(
+/// Imports port `port` for `module`: a local port of message types `M` and `R`, whose
+/// owner's end, `own`, is the bridge; what crosses is of wire types `Req` and `Rep`.
+fn bridge<Req, Rep, M, R, U, T>(
     remote: &Remote,
     port: &str,
     module: &str,
-    own: impl FnOnce(&Port<Req, Rep, U, AnyUser, 1>) -> Result<T, WireError>,
+    own: impl FnOnce(&Port<M, R, U, AnyUser, 1>) -> Result<T, WireError>,
     owner: &str,
-) -> Result<Imported<Req, Rep, U>, IpcError>
+) -> Result<Imported<M, R, U>, IpcError>
 where
     Req: Wire,
     Rep: Wire,
+    M: Carry<Req> + Lent<Req, Rep>,
+    R: Carry<Rep>,
     U: Usage,
-    T: Take<Req, Rep>,
+    T: Take<M, R>,
 {
     let name = Name::from(port);
-    let local: Port<Req, Rep, U, AnyUser, 1> =
+    let local: Port<M, R, U, AnyUser, 1> =
         Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
     let taken = own(&local).map_err(IpcError::Local)?;
-    let relay = relay(remote, &name, module, taken)?;
-    Ok(Imported::new(local, relay))
+    let (relay, client) = relay::<Req, Rep, M, R, T>(remote, &name, module, taken)?;
+    Ok(Imported::new(M::lend_from(local, client, name), relay))
+}
+
+/// Where the importing module's loans come from: nowhere, for a port of values; the
+/// client's shared memory, for a port of [`Shared`] messages.
+pub(crate) trait Lent<Req: Wire, Rep: Wire>: Sized {
+    /// `port`, lending from `client` if its messages are built in place.
+    fn lend_from<R: Send + 'static, U: Usage>(
+        port: Port<Self, R, U, AnyUser, 1>,
+        client: SharedAsker<Req, Rep>,
+        name: Name,
+    ) -> Port<Self, R, U, AnyUser, 1>;
+}
+
+impl<Req: Wire, Rep: Wire> Lent<Req, Rep> for Req {
+    fn lend_from<R: Send + 'static, U: Usage>(
+        port: Port<Self, R, U, AnyUser, 1>,
+        _: SharedAsker<Req, Rep>,
+        _: Name,
+    ) -> Port<Self, R, U, AnyUser, 1> {
+        port
+    }
+}
+
+impl<Req: Wire, Rep: Wire> Lent<Req, Rep> for Shared<Req> {
+    fn lend_from<R: Send + 'static, U: Usage>(
+        port: Port<Self, R, U, AnyUser, 1>,
+        client: SharedAsker<Req, Rep>,
+        name: Name,
+    ) -> Port<Self, R, U, AnyUser, 1> {
+        port.lend_with(move || lend(&client, &name))
+    }
 }
 
 /// Relays what `taken` takes to port `name`'s owner in another process, as module
 /// `module`, and hands each reply back; connects first. Call it within a tokio runtime.
-pub(crate) fn relay<Req, Rep, T>(
+pub(crate) fn relay<Req, Rep, M, R, T>(
     remote: &Remote,
     name: &Name,
     module: &str,
     mut taken: T,
-) -> Result<Relay, IpcError>
+) -> Result<(Relay, SharedAsker<Req, Rep>), IpcError>
 where
     Req: Wire,
     Rep: Wire,
-    T: Take<Req, Rep>,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    T: Take<M, R>,
 {
     let name = name.clone();
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
@@ -186,18 +244,19 @@ where
     let waiter = runtime.spawn(async move {
         // The channel lives as long as the waiter: its node keeps the services open.
         let _channel = channel;
-        hand_back_replies(&readiness, incoming).await;
+        hand_back_replies::<Req, Rep, R>(&readiness, incoming).await;
     });
 
     let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
+    let lender = Arc::clone(&client);
     let wake_owner = Arc::new(Mutex::new(wake_owner));
     let forwarder = runtime.spawn(async move {
         while let Some((request, reply)) = taken.next().await {
             let sent = {
                 let client = client.lock().unwrap_or_else(PoisonError::into_inner);
-                client.loan_uninit().ok().and_then(|mut loan| {
+                request.into_request(&client).and_then(|mut loan| {
                     *loan.user_header_mut() = RequestMeta::new(SEND, &module);
-                    loan.write_payload(request).send().ok()
+                    loan.send().ok()
                 })
             };
             // Not sent (no room, no owner): the reply handle is dropped, and the local
@@ -212,7 +271,7 @@ where
                 .notify();
         }
     });
-    Ok(Relay { waiter, forwarder })
+    Ok((Relay { waiter, forwarder }, lender))
 }
 
 /// A user process's connection to a port's owner: the services, the client, and the
@@ -302,11 +361,11 @@ fn handshake<Req: Wire, Rep: Wire>(
 /// The waiter: woken by the owner's notify, or by a request sent; hands each reply to its
 /// local sender, and drops the handles of requests whose owner is gone, so that their
 /// senders fail at once.
-async fn hand_back_replies<Req: Wire, Rep: Wire>(
+async fn hand_back_replies<Req: Wire, Rep: Wire, R: Carry<Rep>>(
     readiness: &Readiness,
-    mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<Rep>)>,
+    mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<R>)>,
 ) {
-    let mut waiting: Vec<Waiting<Req, Rep>> = Vec::new();
+    let mut waiting: Vec<Waiting<Req, Rep, R>> = Vec::new();
     // Every half second while something waits: see whether a peer died.
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     loop {
@@ -331,7 +390,7 @@ async fn hand_back_replies<Req: Wire, Rep: Wire>(
 
 /// Hands each reply that came to its sender, and lets go of the requests that are done:
 /// answered, or whose owner is gone (their reply handles drop, and their senders fail).
-fn look<Req: Wire, Rep: Wire>(waiting: &mut Vec<Waiting<Req, Rep>>) {
+fn look<Req: Wire, Rep: Wire, R: Carry<Rep>>(waiting: &mut Vec<Waiting<Req, Rep, R>>) {
     waiting.retain_mut(|(pending, reply)| {
         // Whether the owner still holds the request, read before looking for its reply: an
         // owner replies, then lets the request go, so a reply sent before it let go is
@@ -342,7 +401,7 @@ fn look<Req: Wire, Rep: Wire>(waiting: &mut Vec<Waiting<Req, Rep>>) {
                 if let Some(reply) = reply.take()
                     && response.user_header().status == OK
                 {
-                    reply.reply(*response.payload());
+                    reply.reply(R::from_answer(response));
                 }
                 false
             }

@@ -70,6 +70,7 @@
 //! give such a cell's runtime larger stacks (`thread_stack_size`).
 
 mod bridge;
+mod carry;
 mod error;
 mod export;
 mod import;
@@ -77,8 +78,8 @@ mod send_all;
 mod wire;
 
 pub use error::IpcError;
-pub use export::{Exported, export, export_response};
-pub use import::{Imported, import, import_response};
+pub use export::{Exported, export, export_response, export_shared};
+pub use import::{Imported, import, import_response, import_shared};
 pub use send_all::{
     export_call_all, export_query, export_send_all, import_call_all, import_query, import_send_all,
 };

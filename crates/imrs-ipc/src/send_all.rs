@@ -24,7 +24,7 @@ struct Relayed {
     _relay: Relay,
 }
 
-impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for Relayed {
+impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for Relayed {
     async fn forward(&mut self, _: Req) -> Option<Rep> {
         None
     }
@@ -118,12 +118,12 @@ where
     // The owner starts each rendezvous here; its relays are parked.
     // Attaching a remote module connects a relay back to its process: a wait of its own,
     // kept off tokio's workers.
-    bridge::<Req, Rep, _, _>(remote, name, N, true, move |module: &str| {
+    bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, move |module: &str| {
         // The module's own end of the real port: what it receives goes to its process.
         let end = user_end(&port, module)?;
         let _entered = runtime.enter();
-        relay(&cell, &to_module(&served, module), owner.as_str(), end)
-            .map(|relay| Relayed { _relay: relay })
+        relay::<Req, Rep, Req, Rep, T>(&cell, &to_module(&served, module), owner.as_str(), end)
+            .map(|(relay, _)| Relayed { _relay: relay })
             .map_err(|_| Refusal::Failed)
     })
 }
@@ -187,7 +187,7 @@ where
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
     // Its one user is the owner's relay.
-    let server = bridge(
+    let server = bridge::<Req, Rep, Req, Rep, _, _>(
         remote,
         to_module(&name, module),
         1,

@@ -7,8 +7,8 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_core::imrs_ports::{SendError, WireError};
-use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import};
+use imrs_core::imrs_ports::{SendError, Shared, WireError};
+use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import, import_shared};
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -25,6 +25,32 @@ struct Number {
 struct Wide {
     value: u64,
     more: u64,
+}
+
+/// The peer's 64 KiB frame, carried by handle (`Shared`).
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, FromBytes)]
+#[repr(C)]
+#[type_name("imrs_ipc_tests::Frame")]
+struct Frame {
+    words: [u64; 8192],
+}
+
+impl Default for Frame {
+    fn default() -> Self {
+        Self { words: [0; 8192] }
+    }
+}
+
+fn sum(frame: &Frame) -> u64 {
+    frame
+        .words
+        .iter()
+        .fold(0u64, |sum, &word| sum.wrapping_add(word))
+}
+
+/// Frame `seed`'s words, as a sender writes them.
+fn word(seed: u64, at: usize) -> u64 {
+    seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ at as u64
 }
 
 fn cell(test: &str) -> String {
@@ -806,4 +832,108 @@ fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
         );
         assert!(error.to_string().contains("I/O driver"), "{error}");
     });
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
+    let cell = cell("shared");
+    let _vision = started_owner("vision", &cell, "IMAGE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let mut camera = imported.port().user_named("CAMERA").unwrap();
+    let mut replies = Vec::new();
+    let mut sums = Vec::new();
+    for seed in 1..=20u64 {
+        let mut frame = camera.loan().unwrap();
+        // Lent by the transport, not the heap; and zeroed, whatever the sample held before.
+        assert!(!frame.buffer().is::<Box<Frame>>());
+        assert!(frame.words.iter().all(|&word| word == 0));
+        for (at, out) in frame.words.iter_mut().enumerate() {
+            *out = word(seed, at);
+        }
+        sums.push(sum(&frame));
+        let reply = within(10, camera.send(frame)).await.unwrap();
+        assert_eq!(reply.words[0], 1, "the owner read frame {seed} in a copy");
+        replies.push(reply);
+    }
+    // Every reply still reads as it was written, after the round trips that came after it:
+    // a reply lies in its own sample for as long as it is kept.
+    for (index, reply) in replies.iter_mut().enumerate() {
+        let seed = index as u64 + 1;
+        assert!(
+            !reply.is_writable(),
+            "reply {seed} lies in shared memory, read-only"
+        );
+        assert_eq!(reply.words[2], sums[index]);
+        // The owner kept the previous frame past its reply, and read it again: unchanged.
+        let previous = if index == 0 { 0 } else { sums[index - 1] };
+        assert_eq!(reply.words[1], previous);
+        for at in [3, 4, 4096, 8191] {
+            assert_eq!(reply.words[at], word(seed, at).wrapping_mul(3));
+        }
+    }
+    // Changing a reply copies it to the heap first; the copy is the reply's.
+    let reply = &mut replies[0];
+    reply.words[3] = 7;
+    assert!(reply.is_writable());
+    assert_eq!(reply.words[4], word(1, 4).wrapping_mul(3));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn loans_beyond_what_the_port_allows_are_refused_by_name_and_one_given_back_is_lent_again() {
+    let cell = cell("loans");
+    let _vision = started_owner("vision", &cell, "IMAGE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let mut camera = imported.port().user_named("CAMERA").unwrap();
+    let mut loans = Vec::new();
+    let refused = loop {
+        match camera.loan() {
+            Ok(loan) => loans.push(loan),
+            Err(error) => break error,
+        }
+        assert!(
+            loans.len() <= 64,
+            "loans without end: the port's memory is unbounded"
+        );
+    };
+    assert!(!loans.is_empty());
+    assert_eq!(refused.port.as_str(), "IMAGE");
+    assert!(refused.to_string().contains("IMAGE"), "{refused}");
+    // One given back is lent again; and a loan held all that while is still sent and served.
+    // Every loan the port allows is out again then: each send succeeds only because the
+    // frame goes as it lies, taking no loan more — a copy would find no room.
+    drop(loans.pop());
+    let mut again = camera.loan().unwrap();
+    again.words[5] = 11;
+    let reply = within(10, camera.send(again)).await.unwrap();
+    assert_eq!(reply.words[5], 33);
+    let mut held = loans.pop().unwrap();
+    held.words[6] = 2;
+    let reply = within(10, camera.send(held)).await.unwrap();
+    assert_eq!(reply.words[6], 6);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served() {
+    let cell = cell("copied");
+    let _vision = started_owner("vision", &cell, "IMAGE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let other = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA_2").unwrap();
+    let mut camera = imported.port().user_named("CAMERA").unwrap();
+    let second = other.port().user_named("CAMERA_2").unwrap();
+    // A loan of the other module's: sent on this port, it must be copied, not sent through
+    // the client it came from (whose reply would never reach this sender).
+    let mut borrowed = second.loan().unwrap();
+    borrowed.words[3] = 5;
+    let reply = within(10, camera.send(borrowed)).await.unwrap();
+    assert_eq!(reply.words[3], 15);
+    // A frame on the heap.
+    let mut frame = Box::new(Frame { words: [0; 8192] });
+    frame.words[8191] = 4;
+    let reply = within(10, camera.send(Shared::in_buffer(frame)))
+        .await
+        .unwrap();
+    assert_eq!(reply.words[8191], 12);
 }

@@ -11,6 +11,7 @@ use crate::clock::SharedClock;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
+use crate::shared::Lender;
 use crate::shown::Shown;
 use crate::slot::Slot;
 use crate::urgency::wake_at;
@@ -115,6 +116,9 @@ pub(crate) struct Core<Req, Rep> {
     pub(crate) users: Box<[UserSlot<Req, Rep>]>,
     /// How the port's values read in event logs, if the port says.
     pub(crate) shown: OnceLock<Shown<Req, Rep>>,
+    /// Where a sender's messages are built, if a transport lends memory of its own
+    /// ([`Port::lend_with`](crate::Port::lend_with)).
+    pub(crate) lender: OnceLock<Lender<Req>>,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -132,6 +136,7 @@ impl<Req, Rep> Core<Req, Rep> {
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
             shown: OnceLock::new(),
+            lender: OnceLock::new(),
         }
     }
 

@@ -10,6 +10,7 @@ use crate::meta::Name;
 use crate::post::{Posting, QueryOutcome, SendOutcome};
 use crate::priority::Priority;
 use crate::receive::{Receiving, ReplyHandle};
+use crate::shared::{LoanError, Shared};
 use crate::shown::Shown;
 use crate::usage::{CallsAll, Queries, Receives, Sends, SendsAll, Usage};
 
@@ -158,5 +159,19 @@ impl<Req, Rep, U: Usage> fmt::Debug for End<Req, Rep, U> {
             .field("usage", &U::KIND)
             .field("owner", &self.attachment.is_owner())
             .finish()
+    }
+}
+
+impl<T: Default + Send + 'static, Rep: Send + 'static, U: Usage> End<Shared<T>, Rep, U> {
+    /// A message to build in place and send: in the memory the port's transport lends
+    /// ([`Port::lend_with`](crate::Port::lend_with)) — shared memory, for a port that
+    /// crosses processes — or, in one process, on the heap. It starts as `T::default()`
+    /// (all zeros, for a message that crosses processes). Refused, naming the port, when the
+    /// transport has no memory left: every loan and every request out.
+    pub fn loan(&self) -> Result<Shared<T>, LoanError> {
+        match self.attachment.core.lender.get() {
+            Some(lender) => lender(),
+            None => Ok(Shared::default()),
+        }
     }
 }

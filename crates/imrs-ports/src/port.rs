@@ -16,6 +16,7 @@ use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
 use crate::response::ResponseEnd;
+use crate::shared::LoanError;
 use crate::shown::Shown;
 use crate::usage::{self, Answers, Plain, Usage, UsageKind};
 use crate::user_list::{Admits, AnyUser, UserList};
@@ -162,6 +163,20 @@ where
             core: Arc::new(Core::new(meta, clock, N)),
             _restrictions: PhantomData,
         }
+    }
+
+    /// Lends the memory the port's messages are built in: each [`End::loan`] of the port
+    /// calls `lender`. For a transport whose messages lie in memory of its own (shared
+    /// memory, across processes); without a lender, a loan is on the heap. The first lender
+    /// set holds, for every handle of the port.
+    ///
+    /// [`End::loan`]: crate::End::loan
+    pub fn lend_with(
+        self,
+        lender: impl Fn() -> Result<Req, LoanError> + Send + Sync + 'static,
+    ) -> Self {
+        let _first_holds = self.core.lender.set(Box::new(lender));
+        self
     }
 
     /// Shows the port's messages and replies as `Debug` writes them, in the event log of a

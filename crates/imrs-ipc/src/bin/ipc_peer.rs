@@ -14,6 +14,11 @@
 //! - `ipc_peer child CELL PORT MODULE N`: imports the `QUERY` port PORT (owner PARENT) for
 //!   MODULE, whose response handler answers N queries with five times their number, printing
 //!   each; then exits.
+//! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
+//!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
+//!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
+//!   previous frame's words as read now — after it was answered — word 2 the sum of this
+//!   frame's, and every further word three times the frame's. Prints `ready` once exported.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -21,10 +26,10 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use imrs_core::imrs_ports::usage::Usage;
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, usage};
+use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
-    FromBytes, Remote, ZeroCopySend, export, export_response, import, import_call_all,
-    import_query, import_send_all,
+    FromBytes, Remote, ZeroCopySend, export, export_response, export_shared, import,
+    import_call_all, import_query, import_send_all,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -33,6 +38,20 @@ use imrs_ipc::{
 #[type_name("imrs_ipc_tests::Number")]
 struct Number {
     value: u64,
+}
+
+/// The tests' frame: 64 KiB, the same by name, size and alignment as theirs.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend, FromBytes)]
+#[repr(C)]
+#[type_name("imrs_ipc_tests::Frame")]
+struct Frame {
+    words: [u64; 8192],
+}
+
+impl Default for Frame {
+    fn default() -> Self {
+        Self { words: [0; 8192] }
+    }
 }
 
 fn main() -> ExitCode {
@@ -47,6 +66,7 @@ fn main() -> ExitCode {
             ["owner", cell, port] => owner(cell, port, ProcessType::Indep).await,
             ["tight-owner", cell, port] => owner(cell, port, ProcessType::Tight).await,
             ["responder", cell, port] => responder(cell, port).await,
+            ["vision", cell, port] => vision(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["child", cell, port, module, n] => child(cell, port, module, n).await,
@@ -85,6 +105,34 @@ async fn owner(cell: &str, port: &str, process_type: ProcessType) -> Result<(), 
         reply.reply(Number {
             value: 2 * number.value,
         });
+    }
+}
+
+async fn vision(cell: &str, port: &str) -> Result<(), Error> {
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::Receive, AnyUser, 2> =
+        Port::declare(PortSpec::new(port, "VISION").user_list(["CAMERA", "CAMERA_2"]));
+    let _exported = export_shared(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut vision = port.owner()?;
+    let sum = |frame: &Frame| {
+        frame
+            .words
+            .iter()
+            .fold(0u64, |sum, &word| sum.wrapping_add(word))
+    };
+    // The last frame, kept past its reply: it must still read as it did.
+    let mut previous: Option<Shared<Frame>> = None;
+    loop {
+        let (mut frame, reply) = vision.receive().await?;
+        let mut answer = Shared::new(Frame::default());
+        answer.words[0] = u64::from(!frame.is_writable());
+        answer.words[1] = previous.as_deref().map_or(0, sum);
+        answer.words[2] = sum(&frame);
+        for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(3) {
+            *out = word.wrapping_mul(3);
+        }
+        reply.reply(answer);
+        previous = Some(frame);
     }
 }
 

@@ -1,0 +1,181 @@
+//! Messages built in place. A port of [`Shared<T>`] moves a handle to its message, never the
+//! message itself: a sender loans the memory from its end ([`End::loan`](crate::End::loan)),
+//! writes the message there, and sends the handle; the receiver reads it where it lies.
+//!
+//! In one process the memory is the heap. A transport across processes lends its own: a
+//! sample of shared memory, which crosses to the other process with nothing copied, and is
+//! read there in place. The module's code is the same either way — where its port's memory
+//! comes from is decided when the cell is wired, by whoever lends it
+//! ([`Port::lend_with`](crate::Port::lend_with)).
+//!
+//! ```
+//! use imrs_ports::{Port, PortSpec, Shared, usage};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! # let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+//! # runtime.block_on(async {
+//! // An image, too large to copy on every hop.
+//! #[derive(Clone)]
+//! struct Image {
+//!     pixels: [u8; 65536],
+//! }
+//! impl Default for Image {
+//!     fn default() -> Self {
+//!         Self { pixels: [0; 65536] }
+//!     }
+//! }
+//! let port = Port::<Shared<Image>, Shared<u64>, usage::Receive>::declare(PortSpec::new("IMAGE", "VISION"));
+//! let mut vision = port.owner()?;
+//! let mut camera = port.user_named("CAMERA")?;
+//!
+//! let seeing = tokio::spawn(async move {
+//!     let (image, reply) = vision.receive().await?;
+//!     // Read where the camera wrote it.
+//!     let lit = image.pixels.iter().filter(|&&byte| byte > 0).count() as u64;
+//!     reply.reply(Shared::new(lit));
+//!     Ok::<_, imrs_ports::ReceiveError>(())
+//! });
+//! let mut image = camera.loan()?;
+//! image.pixels[..100].fill(255);
+//! assert_eq!(*camera.send(image).await?, 100);
+//! seeing.await??;
+//! # Ok::<_, Box<dyn std::error::Error>>(())
+//! # })?;
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! A message received from another process lies where its sender wrote it, and is read-only
+//! there: changing it ([`DerefMut`]) first copies it to the heap, once.
+
+use std::any::Any;
+use std::fmt;
+use std::ops::{Deref, DerefMut};
+
+use crate::Name;
+
+/// Memory a [`Shared`] message lies in: the heap, or a transport's.
+pub trait Buffer<T>: Send + 'static {
+    /// The message.
+    fn get(&self) -> &T;
+    /// The message, to change in place; `None` where it is read-only (a message received
+    /// from another process, which lies where its sender wrote it).
+    fn get_mut(&mut self) -> Option<&mut T>;
+    /// The buffer, for its transport to recognise one of its own.
+    fn as_any(&self) -> &dyn Any;
+    /// The buffer, for its transport to take back (a loan of its own, sent in place).
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send>;
+}
+
+impl<T: Send + 'static> Buffer<T> for Box<T> {
+    fn get(&self) -> &T {
+        self
+    }
+
+    fn get_mut(&mut self) -> Option<&mut T> {
+        Some(self)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
+        self
+    }
+}
+
+/// A message a port moves by handle: it lies in a [`Buffer`] — the heap, or a transport's
+/// shared memory — and is read (and, where it is writable, written) in place.
+pub struct Shared<T: 'static> {
+    buffer: Box<dyn Buffer<T>>,
+}
+
+impl<T: Send + 'static> Shared<T> {
+    /// `value`, on the heap.
+    pub fn new(value: T) -> Self {
+        Self::in_buffer(Box::new(value))
+    }
+
+    /// The message in `buffer`: how a transport hands over memory of its own.
+    pub fn in_buffer(buffer: impl Buffer<T>) -> Self {
+        Self {
+            buffer: Box::new(buffer),
+        }
+    }
+
+    /// The buffer the message lies in, for a transport to recognise one of its own.
+    pub fn buffer(&self) -> &dyn Any {
+        self.buffer.as_any()
+    }
+
+    /// The buffer the message lies in, for a transport to take back and send in place.
+    pub fn into_buffer(self) -> Box<dyn Any + Send> {
+        self.buffer.into_any()
+    }
+
+    /// Whether the message can be changed where it lies; if not, [`DerefMut`] copies it to
+    /// the heap first.
+    pub fn is_writable(&mut self) -> bool {
+        self.buffer.get_mut().is_some()
+    }
+}
+
+impl<T: 'static> Deref for Shared<T> {
+    type Target = T;
+
+    fn deref(&self) -> &T {
+        self.buffer.get()
+    }
+}
+
+/// Changing a read-only message (one received from another process) copies it to the heap
+/// first, once; a writable one is changed where it lies.
+impl<T: Clone + Send + 'static> DerefMut for Shared<T> {
+    fn deref_mut(&mut self) -> &mut T {
+        if self.buffer.get_mut().is_none() {
+            let copy: Box<T> = Box::new(self.buffer.get().clone());
+            self.buffer = Box::new(copy);
+        }
+        self.buffer
+            .get_mut()
+            .expect("a message just copied to the heap is writable")
+    }
+}
+
+impl<T: fmt::Debug + 'static> fmt::Debug for Shared<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_tuple("Shared").field(self.buffer.get()).finish()
+    }
+}
+
+impl<T: Default + Send + 'static> Default for Shared<T> {
+    fn default() -> Self {
+        Self::new(T::default())
+    }
+}
+
+/// How a port's lender makes a message: a loan of memory to build it in place.
+pub(crate) type Lender<Req> = Box<dyn Fn() -> Result<Req, LoanError> + Send + Sync>;
+
+/// A loan its port could not make: the transport's memory is used up (every loan and every
+/// request out), or the transport is gone.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoanError {
+    /// The port.
+    pub port: Name,
+    /// What the transport said.
+    pub detail: String,
+}
+
+impl fmt::Display for LoanError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "port {}: no message could be loaned: {}",
+            self.port, self.detail
+        )
+    }
+}
+
+impl std::error::Error for LoanError {}

@@ -1,0 +1,118 @@
+//! Messages built in place (`Shared`): moved by handle, never copied, in one process; lent
+//! by whoever the port says; and copied once, to the heap, only when a read-only message is
+//! changed.
+
+use std::any::Any;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use imrs_ports::shared::Buffer;
+use imrs_ports::{LoanError, Name, Port, PortSpec, Shared, usage};
+
+/// An image, too large to copy on every hop.
+#[derive(Debug, Clone, PartialEq)]
+struct Image {
+    pixels: [u8; 4096],
+}
+
+impl Default for Image {
+    fn default() -> Self {
+        Self { pixels: [0; 4096] }
+    }
+}
+
+type ImagePort = Port<Shared<Image>, Shared<u64>, usage::Receive>;
+
+#[tokio::test]
+async fn a_loaned_message_reaches_its_receiver_where_its_sender_built_it() {
+    let port = ImagePort::declare(PortSpec::new("IMAGE", "VISION"));
+    let mut vision = port.owner().unwrap();
+    let mut camera = port.user_named("CAMERA").unwrap();
+    let mut image = camera.loan().unwrap();
+    // No lender: the heap, starting from the default.
+    assert!(image.buffer().is::<Box<Image>>());
+    assert!(image.pixels.iter().all(|&pixel| pixel == 0));
+    image.pixels[..10].fill(9);
+    let built_at = image.pixels.as_ptr();
+    let seeing = tokio::spawn(async move {
+        let (image, reply) = vision.receive().await.unwrap();
+        let read_at = image.pixels.as_ptr() as usize;
+        let lit = image.pixels.iter().filter(|&&pixel| pixel == 9).count() as u64;
+        reply.reply(Shared::new(lit));
+        read_at
+    });
+    assert_eq!(*camera.send(image).await.unwrap(), 10);
+    assert_eq!(
+        seeing.await.unwrap(),
+        built_at as usize,
+        "the image was copied"
+    );
+}
+
+/// A transport's memory that is read-only: what a message received from another process
+/// lies in.
+struct ReadOnly(Arc<Image>);
+
+impl Buffer<Image> for ReadOnly {
+    fn get(&self) -> &Image {
+        &self.0
+    }
+
+    fn get_mut(&mut self) -> Option<&mut Image> {
+        None
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
+        self
+    }
+}
+
+#[test]
+fn changing_a_read_only_message_copies_it_once_and_leaves_the_original_as_it_was() {
+    let mut original = Image::default();
+    original.pixels[0] = 1;
+    let original = Arc::new(original);
+    let mut message = Shared::in_buffer(ReadOnly(Arc::clone(&original)));
+    assert!(!message.is_writable());
+    assert_eq!(message.pixels[0], 1);
+    message.pixels[1] = 2;
+    assert!(message.is_writable());
+    let copy_at = message.pixels.as_ptr();
+    message.pixels[2] = 3;
+    assert_eq!(message.pixels.as_ptr(), copy_at, "copied a second time");
+    assert_eq!(&message.pixels[..3], &[1, 2, 3]);
+    assert_eq!(&original.pixels[..3], &[1, 0, 0]);
+    assert!(message.buffer().is::<Box<Image>>());
+}
+
+#[tokio::test]
+async fn a_ports_lender_makes_every_loan_and_its_refusal_names_the_port() {
+    let lent = Arc::new(AtomicUsize::new(0));
+    let counted = Arc::clone(&lent);
+    let port = ImagePort::declare(PortSpec::new("IMAGE", "VISION")).lend_with(move || {
+        // Two loans, then the transport's memory is used up.
+        if counted.fetch_add(1, Ordering::SeqCst) >= 2 {
+            return Err(LoanError {
+                port: Name::from("IMAGE"),
+                detail: "every sample is out".into(),
+            });
+        }
+        let mut image = Image::default();
+        image.pixels[0] = 7;
+        Ok(Shared::new(image))
+    });
+    let camera = port.user_named("CAMERA").unwrap();
+    let (first, second) = (camera.loan().unwrap(), camera.loan().unwrap());
+    assert_eq!((first.pixels[0], second.pixels[0]), (7, 7));
+    let refused = camera.loan().unwrap_err();
+    assert_eq!(refused.port.as_str(), "IMAGE");
+    assert!(refused.to_string().contains("IMAGE"), "{refused}");
+    assert_eq!(lent.load(Ordering::SeqCst), 3);
+    // The first lender holds: a second is ignored.
+    let _ = port.clone().lend_with(|| Ok(Shared::new(Image::default())));
+    assert!(camera.loan().is_err());
+}
