@@ -64,10 +64,53 @@
 //! that must agree on one time build it from one epoch
 //! ([`RealClock::from_epoch`](imrs_core::imrs_ports::RealClock::from_epoch)).
 //!
-//! A message is copied once into shared memory and moved by value through the bridges'
-//! tasks: there is no loan yet to build it in place. Large messages (tens of KiB) therefore
-//! cost copies, and in a debug build they can overflow tokio's default 2 MiB worker stack;
-//! give such a cell's runtime larger stacks (`thread_stack_size`).
+//! A port of values copies each message into shared memory and moves it by value through
+//! the bridges' tasks: cheap for small messages, and costly for large ones (tens of KiB),
+//! which in a debug build can also overflow tokio's default 2 MiB worker stack. A port of
+//! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses with [`export_shared`] and
+//! [`import_shared`] instead: the sender loans a sample of shared memory from its end,
+//! builds its message there, and sends it with nothing copied; the owner reads it where it
+//! lies, and the reply is copied once into the sample that carries it back, where the
+//! sender reads it. The module's code is the one it would run in a single process, where a
+//! loan is on the heap:
+//!
+//! ```no_run
+//! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, Shared, usage};
+//! use imrs_ipc::{FromBytes, Remote, ZeroCopySend, export_shared, import_shared};
+//!
+//! #[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
+//! #[repr(C)]
+//! #[type_name("my_cell::Image")]
+//! struct Image {
+//!     pixels: [u8; 65536],
+//! }
+//! impl Default for Image {
+//!     fn default() -> Self {
+//!         Self { pixels: [0; 65536] }
+//!     }
+//! }
+//!
+//! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
+//! let port: Port<Shared<Image>, Shared<u64>, usage::Receive, AnyUser, 1> =
+//!     Port::declare(PortSpec::new("IMAGE", "VISION"));
+//! let _bridge = export_shared(&Remote::new("my_cell")?, &port)?;
+//! let mut vision = port.owner()?;
+//! let (image, reply) = vision.receive().await?; // read where the camera wrote it
+//! reply.reply(Shared::new(image.pixels.iter().filter(|&&p| p > 0).count() as u64));
+//! # Ok(()) }
+//! # async fn user() -> Result<(), Box<dyn std::error::Error>> {
+//! let imported = import_shared::<Image, u64>(&Remote::new("my_cell")?, "IMAGE", "VISION", "CAMERA")?;
+//! let mut camera = imported.port().user_named("CAMERA")?;
+//! let mut image = camera.loan()?; // a sample of shared memory, zeroed
+//! image.pixels[..100].fill(255);
+//! let lit = camera.send(image).await?;
+//! assert_eq!(*lit, 100);
+//! # Ok(()) }
+//! ```
+//!
+//! A loan is refused, naming the port, while the module holds as many loans and requests as
+//! the port allows at once (16). A `Shared` message that does not lie in one of the port's
+//! own loans — a heap value, or another port's loan — is copied into one when sent.
 
 mod bridge;
 mod carry;
