@@ -43,8 +43,9 @@ pub(crate) trait Carry<W: Wire>: Send + Sized + 'static {
     /// The request to send as `client`: in place, if it lies in a loan of `client`'s own;
     /// otherwise copied into a new loan. `None` if there is no room.
     fn into_request<Rep: Wire>(self, client: &Asker<W, Rep>) -> Option<Loan<W, Rep>>;
-    /// The reply, copied into `loan`.
-    fn into_reply(self, loan: ReplyUninit<W>) -> Reply<W>;
+    /// The reply to `request`: in place, if it lies in a loan made for that very request;
+    /// otherwise copied into a new loan. `None` if there is no room.
+    fn into_reply<Req: Wire>(self, request: &Held<Req, W>) -> Option<Reply<W>>;
 }
 
 /// By value: copied into each sample, and out of it.
@@ -61,19 +62,18 @@ impl<W: Wire> Carry<W> for W {
         Some(client.loan_uninit().ok()?.write_payload(self))
     }
 
-    fn into_reply(self, loan: ReplyUninit<W>) -> Reply<W> {
-        loan.write_payload(self)
+    fn into_reply<Req: Wire>(self, request: &Held<Req, W>) -> Option<Reply<W>> {
+        Some(lock(request).loan_uninit().ok()?.write_payload(self))
     }
 }
 
-/// By handle: a request built in a loan is sent in place, and read in place; a reply is
-/// read in place, after one copy into its sample.
+/// By handle: a request or a reply built in a loan is sent in place, and read in place.
 impl<W: Wire> Carry<W> for Shared<W> {
     fn from_request<Rep: Wire>(request: &Held<W, Rep>) -> Self {
         let payload = NonNull::from(lock(request).payload());
         Shared::in_buffer(Received {
             payload,
-            _request: Arc::clone(request),
+            request: Arc::clone(request),
         })
     }
 
@@ -107,14 +107,28 @@ impl<W: Wire> Carry<W> for Shared<W> {
         })
     }
 
-    fn into_reply(self, mut loan: ReplyUninit<W>) -> Reply<W> {
+    fn into_reply<Req: Wire>(self, request: &Held<Req, W>) -> Option<Reply<W>> {
+        // A loan made for this very request is sent as it lies. One made for another
+        // request would answer that request's sender: it is copied, as a heap reply is.
+        let own = self
+            .buffer()
+            .downcast_ref::<Replying<Req, W>>()
+            .is_some_and(|replying| Arc::ptr_eq(&replying.request, request));
+        if own {
+            let replying: Box<dyn Any + Send> = self.into_buffer();
+            return replying
+                .downcast::<Replying<Req, W>>()
+                .ok()
+                .map(|replying| replying.reply);
+        }
+        let mut loan: ReplyUninit<W> = lock(request).loan_uninit().ok()?;
         // SAFETY: as for a request: a valid `W`, copied whole into a sample of its own.
-        unsafe {
+        Some(unsafe {
             loan.payload_mut()
                 .as_mut_ptr()
                 .copy_from_nonoverlapping(&*self, 1);
             loan.assume_init()
-        }
+        })
     }
 }
 
@@ -167,17 +181,17 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Loaned<Req, Rep> {
 struct Received<Req: Wire, Rep: Wire> {
     payload: NonNull<Req>,
     /// Keeps the request's sample, where `payload` lies.
-    _request: Held<Req, Rep>,
+    request: Held<Req, Rep>,
 }
 
 // SAFETY: `payload` is only ever read (`Req: Sync`, a bound of `Wire`), and the sample it
-// points into is kept by `_request`, which may move between threads (`Arc` of a `Mutex` of
+// points into is kept by `request`, which may move between threads (`Arc` of a `Mutex` of
 // an `ActiveRequest`, which is `Send`).
 unsafe impl<Req: Wire, Rep: Wire> Send for Received<Req, Rep> {}
 
 impl<Req: Wire, Rep: Wire> Buffer<Req> for Received<Req, Rep> {
     fn get(&self) -> &Req {
-        // SAFETY: `payload` is the payload of the request `_request` holds: a sample in
+        // SAFETY: `payload` is the payload of the request `request` holds: a sample in
         // shared memory that stays mapped, at the same address, and unwritten (the client
         // gave it up when it sent it) for as long as the request is held — at least as long
         // as `self`. It was a valid `Req` when received, and `Req: FromBytes`, so it is one
@@ -187,6 +201,46 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Received<Req, Rep> {
 
     fn get_mut(&mut self) -> Option<&mut Req> {
         None
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
+        self
+    }
+
+    fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
+        let mut loan: ReplyUninit<Rep> = lock(&self.request).loan_uninit().ok()?;
+        // SAFETY: `Rep: FromBytes` (a bound of `Wire`), so all zeros are one of its values;
+        // the whole payload is written before it is assumed initialised.
+        let reply = unsafe {
+            loan.payload_mut().as_mut_ptr().write_bytes(0, 1);
+            loan.assume_init()
+        };
+        let replying = Replying {
+            reply,
+            request: Arc::clone(&self.request),
+        };
+        Some(Box::new(Shared::in_buffer(replying)))
+    }
+}
+
+/// A reply being built by the owner's module, in a loan made for the request it answers.
+struct Replying<Req: Wire, Rep: Wire> {
+    reply: Reply<Rep>,
+    /// The request answered: only its reply is sent as it lies.
+    request: Held<Req, Rep>,
+}
+
+impl<Req: Wire, Rep: Wire> Buffer<Rep> for Replying<Req, Rep> {
+    fn get(&self) -> &Rep {
+        self.reply.payload()
+    }
+
+    fn get_mut(&mut self) -> Option<&mut Rep> {
+        Some(self.reply.payload_mut())
     }
 
     fn as_any(&self) -> &dyn Any {

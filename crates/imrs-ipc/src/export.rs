@@ -106,8 +106,9 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 
 /// Exports `port`, a port of messages built in place ([`Shared`]), as [`export`] does a
 /// port of values: a remote module's request is read where its sender built it, in shared
-/// memory, with nothing copied on the way; the owner's reply is copied once, into the
-/// sample that carries it back, and read there.
+/// memory, with nothing copied on the way. The owner's reply, built in a loan made for the
+/// request ([`Shared::loan_reply`]), crosses back the same way; one built on the heap is
+/// copied once into its sample.
 pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
@@ -313,14 +314,10 @@ fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(
     reply: R,
     notifier: &Mutex<Notifier<Svc>>,
 ) {
-    let loaned = active
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .loan_uninit();
-    if let Ok(mut response) = loaned {
+    if let Some(mut response) = reply.into_reply(active) {
         *response.user_header_mut() = ReplyMeta { status, detail };
         // A user that died meanwhile cannot be answered; nothing else is lost.
-        let _ = reply.into_reply(response).send();
+        let _ = response.send();
     }
     let _ = notifier
         .lock()

@@ -70,9 +70,10 @@
 //! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses with [`export_shared`] and
 //! [`import_shared`] instead: the sender loans a sample of shared memory from its end,
 //! builds its message there, and sends it with nothing copied; the owner reads it where it
-//! lies, and the reply is copied once into the sample that carries it back, where the
-//! sender reads it. The module's code is the one it would run in a single process, where a
-//! loan is on the heap:
+//! lies, and builds its reply in a loan made for the request
+//! ([`Shared::loan_reply`](imrs_core::imrs_ports::Shared::loan_reply)), which crosses back
+//! the same way (a reply built on the heap is copied once), to be read where it lies. The
+//! module's code is the one it would run in a single process, where a loan is on the heap:
 //!
 //! ```no_run
 //! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, Shared, usage};
@@ -96,7 +97,9 @@
 //! let _bridge = export_shared(&Remote::new("my_cell")?, &port)?;
 //! let mut vision = port.owner()?;
 //! let (image, reply) = vision.receive().await?; // read where the camera wrote it
-//! reply.reply(Shared::new(image.pixels.iter().filter(|&&p| p > 0).count() as u64));
+//! let mut lit = image.loan_reply(); // where the reply will cross back
+//! *lit = image.pixels.iter().filter(|&&p| p > 0).count() as u64;
+//! reply.reply(lit);
 //! # Ok(()) }
 //! # async fn user() -> Result<(), Box<dyn std::error::Error>> {
 //! let imported = import_shared::<Image, u64>(&Remote::new("my_cell")?, "IMAGE", "VISION", "CAMERA")?;

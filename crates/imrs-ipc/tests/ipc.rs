@@ -848,12 +848,19 @@ async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
         // Lent by the transport, not the heap; and zeroed, whatever the sample held before.
         assert!(!frame.buffer().is::<Box<Frame>>());
         assert!(frame.words.iter().all(|&word| word == 0));
-        for (at, out) in frame.words.iter_mut().enumerate() {
+        for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
             *out = word(seed, at);
         }
+        // Frame 10 is answered in a loan the owner made for frame 9: sent as it lies, that
+        // answer would go to frame 9's sender, long answered; it must come here.
+        frame.words[3] = u64::from(seed == 10);
         sums.push(sum(&frame));
         let reply = within(10, camera.send(frame)).await.unwrap();
         assert_eq!(reply.words[0], 1, "the owner read frame {seed} in a copy");
+        assert_eq!(
+            reply.words[3], 1,
+            "the owner built answer {seed} on the heap"
+        );
         replies.push(reply);
     }
     // Every reply still reads as it was written, after the round trips that came after it:
@@ -868,15 +875,15 @@ async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
         // The owner kept the previous frame past its reply, and read it again: unchanged.
         let previous = if index == 0 { 0 } else { sums[index - 1] };
         assert_eq!(reply.words[1], previous);
-        for at in [3, 4, 4096, 8191] {
+        for at in [4, 5, 4096, 8191] {
             assert_eq!(reply.words[at], word(seed, at).wrapping_mul(3));
         }
     }
     // Changing a reply copies it to the heap first; the copy is the reply's.
     let reply = &mut replies[0];
-    reply.words[3] = 7;
+    reply.words[4] = 7;
     assert!(reply.is_writable());
-    assert_eq!(reply.words[4], word(1, 4).wrapping_mul(3));
+    assert_eq!(reply.words[5], word(1, 5).wrapping_mul(3));
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -908,6 +915,7 @@ async fn loans_beyond_what_the_port_allows_are_refused_by_name_and_one_given_bac
     again.words[5] = 11;
     let reply = within(10, camera.send(again)).await.unwrap();
     assert_eq!(reply.words[5], 33);
+    drop(reply);
     let mut held = loans.pop().unwrap();
     held.words[6] = 2;
     let reply = within(10, camera.send(held)).await.unwrap();
@@ -926,9 +934,9 @@ async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served(
     // A loan of the other module's: sent on this port, it must be copied, not sent through
     // the client it came from (whose reply would never reach this sender).
     let mut borrowed = second.loan().unwrap();
-    borrowed.words[3] = 5;
+    borrowed.words[4] = 5;
     let reply = within(10, camera.send(borrowed)).await.unwrap();
-    assert_eq!(reply.words[3], 15);
+    assert_eq!(reply.words[4], 15);
     // A frame on the heap.
     let mut frame = Box::new(Frame { words: [0; 8192] });
     frame.words[8191] = 4;

@@ -31,8 +31,10 @@
 //! let seeing = tokio::spawn(async move {
 //!     let (image, reply) = vision.receive().await?;
 //!     // Read where the camera wrote it.
-//!     let lit = image.pixels.iter().filter(|&&byte| byte > 0).count() as u64;
-//!     reply.reply(Shared::new(lit));
+//!     // The reply, built where it will cross back: here, the heap.
+//!     let mut lit = image.loan_reply();
+//!     *lit = image.pixels.iter().filter(|&&byte| byte > 0).count() as u64;
+//!     reply.reply(lit);
 //!     Ok::<_, imrs_ports::ReceiveError>(())
 //! });
 //! let mut image = camera.loan()?;
@@ -45,8 +47,10 @@
 //! # }
 //! ```
 //!
-//! A message received from another process lies where its sender wrote it, and is read-only
-//! there: changing it ([`DerefMut`]) first copies it to the heap, once.
+//! The receiver builds its reply the same way, in memory its message's transport lends for
+//! it ([`Shared::loan_reply`]). A message received from another process lies where its
+//! sender wrote it, and is read-only there: changing it ([`DerefMut`]) first copies it to
+//! the heap, once.
 
 use std::any::Any;
 use std::fmt;
@@ -65,6 +69,12 @@ pub trait Buffer<T>: Send + 'static {
     fn as_any(&self) -> &dyn Any;
     /// The buffer, for its transport to take back (a loan of its own, sent in place).
     fn into_any(self: Box<Self>) -> Box<dyn Any + Send>;
+    /// Memory for the reply to this message, where its transport carries the reply back: a
+    /// [`Shared`] of the reply's type, boxed as `Any`. `None` (the default) where the
+    /// transport lends none, and the reply is built on the heap.
+    fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
+        None
+    }
 }
 
 impl<T: Send + 'static> Buffer<T> for Box<T> {
@@ -112,6 +122,19 @@ impl<T: Send + 'static> Shared<T> {
     /// The buffer the message lies in, for a transport to take back and send in place.
     pub fn into_buffer(self) -> Box<dyn Any + Send> {
         self.buffer.into_any()
+    }
+
+    /// Memory for the reply to this message, to build it in place: where the message's
+    /// transport carries the reply back — for a message from another process, a sample of
+    /// shared memory, all zeros, which the reply then crosses in with nothing copied — or
+    /// else the heap, starting as `R::default()`. The heap, too, when the transport has no
+    /// memory left or `R` is not the port's reply type; such a reply is copied once when
+    /// sent.
+    pub fn loan_reply<R: Default + Send + 'static>(&self) -> Shared<R> {
+        self.buffer
+            .lend_reply()
+            .and_then(|reply| reply.downcast::<Shared<R>>().ok())
+            .map_or_else(Shared::default, |reply| *reply)
     }
 
     /// Whether the message can be changed where it lies; if not, [`DerefMut`] copies it to

@@ -116,3 +116,42 @@ async fn a_ports_lender_makes_every_loan_and_its_refusal_names_the_port() {
     let _ = port.clone().lend_with(|| Ok(Shared::new(Image::default())));
     assert!(camera.loan().is_err());
 }
+
+/// A transport's request that lends memory for its reply.
+struct Lending(Image);
+
+impl Buffer<Image> for Lending {
+    fn get(&self) -> &Image {
+        &self.0
+    }
+
+    fn get_mut(&mut self) -> Option<&mut Image> {
+        Some(&mut self.0)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
+        self
+    }
+
+    fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
+        Some(Box::new(Shared::new(41u64)))
+    }
+}
+
+#[test]
+fn a_reply_is_loaned_where_the_transport_lends_it_and_on_the_heap_otherwise() {
+    // The transport's memory, for the port's reply type.
+    let request = Shared::in_buffer(Lending(Image::default()));
+    assert_eq!(*request.loan_reply::<u64>(), 41);
+    // A type the transport does not carry back: the heap, from the default.
+    assert_eq!(*request.loan_reply::<u32>(), 0);
+    // In one process: the heap.
+    let request = Shared::new(Image::default());
+    let reply = request.loan_reply::<u64>();
+    assert!(reply.buffer().is::<Box<u64>>());
+    assert_eq!(*reply, 0);
+}

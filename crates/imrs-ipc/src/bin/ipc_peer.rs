@@ -18,7 +18,10 @@
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
 //!   previous frame's words as read now — after it was answered — word 2 the sum of this
-//!   frame's, and every further word three times the frame's. Prints `ready` once exported.
+//!   frame's, word 3 1 if the answer was built in a loan of shared memory, and every further
+//!   word three times the frame's. The answer is built in a loan made for the frame; for a
+//!   frame whose word 3 is 1, in one made for the previous frame. Prints `ready` once
+//!   exported.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -124,11 +127,15 @@ async fn vision(cell: &str, port: &str) -> Result<(), Error> {
     let mut previous: Option<Shared<Frame>> = None;
     loop {
         let (mut frame, reply) = vision.receive().await?;
-        let mut answer = Shared::new(Frame::default());
+        let mut answer: Shared<Frame> = match &previous {
+            Some(previous) if frame.words[3] == 1 => previous.loan_reply(),
+            _ => frame.loan_reply(),
+        };
         answer.words[0] = u64::from(!frame.is_writable());
         answer.words[1] = previous.as_deref().map_or(0, sum);
         answer.words[2] = sum(&frame);
-        for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(3) {
+        answer.words[3] = u64::from(!answer.buffer().is::<Box<Frame>>());
+        for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(4) {
             *out = word.wrapping_mul(3);
         }
         reply.reply(answer);
