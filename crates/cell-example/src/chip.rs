@@ -4,20 +4,21 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
-use imrs_coord::zones::{Reservations, Sweep};
+use imrs_coord::zones::Reservations;
 use imrs_sim::imrs_core::imrs_ports::{End, ReplyHandle, select, usage};
 use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::layout::LINK_RADIUS;
 use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station, Target};
 
 use crate::alarms::{AlarmKind, alarm};
-use crate::devices::{Devices, RobotDevice};
+use crate::devices::{Devices, MAX_SWEEP_SAMPLES, RobotDevice};
 use crate::help::{drive_relay, insisted, retried};
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
 };
 use crate::ports::{CellPorts, ModuleName, ZoneLink};
+use crate::reservation::{MAX_POSES, Reservation};
 
 /// How the two chip robots share the feeder zone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -138,13 +139,16 @@ enum Access {
         release: End<ModuleName, (), usage::Send>,
     },
     Coordinator {
-        reserve: End<(String, Sweep), (), usage::Send>,
+        reserve: End<Reservation, (), usage::Send>,
         free: End<ModuleName, (), usage::Send>,
     },
 }
 
 /// How finely a trajectory's sweep is sampled: a pose every few centimetres of tool travel.
 const SWEEP_SAMPLES: usize = 12;
+
+// A step's two sweeps fit a reservation, and each fits a device's answer across processes.
+const _: () = assert!(2 * (SWEEP_SAMPLES + 1) <= MAX_POSES && SWEEP_SAMPLES <= MAX_SWEEP_SAMPLES);
 
 impl Access {
     /// Asks to enter the zone, and counts the wait; whether it may.
@@ -181,18 +185,28 @@ impl Access {
             return Ok(());
         };
         let (feeder, place) = (step.feeder, step.place());
-        let mut sweep = robot.sweep(None, Target::Feeder(feeder), SWEEP_SAMPLES)?;
-        sweep.extend(robot.sweep(
-            Some(Target::Feeder(feeder)),
-            Target::OnCard(place),
-            SWEEP_SAMPLES,
-        )?);
+        let mut sweep = robot
+            .sweep(None, Target::Feeder(feeder), SWEEP_SAMPLES)
+            .await?;
+        sweep.extend(
+            robot
+                .sweep(
+                    Some(Target::Feeder(feeder)),
+                    Target::OnCard(place),
+                    SWEEP_SAMPLES,
+                )
+                .await?,
+        );
+        // Two sweeps of `SWEEP_SAMPLES + 1` poses at most always fit (checked below, at
+        // compile time).
+        let Some(reservation) = Reservation::new(ctx.module().as_str(), &sweep) else {
+            unreachable!(
+                "a step's sweep has at most {} poses",
+                2 * (SWEEP_SAMPLES + 1)
+            );
+        };
         let asked = ctx.now();
-        while ctx
-            .send(reserve, (ctx.module().to_string(), sweep.clone()))
-            .await
-            .is_err()
-        {
+        while ctx.send(reserve, reservation).await.is_err() {
             ctx.delay(Duration::from_secs(1)).await;
         }
         let waited = (ctx.now() - asked).as_secs_f64();
@@ -314,8 +328,8 @@ pub fn chip_it(
                     release: zone_release.user_named(&name)?,
                 },
                 FeederPolicy::Coordinator => Access::Coordinator {
-                    reserve: zone_reserve.user_named(name.clone())?,
-                    free: zone_free.user_named(name.clone())?,
+                    reserve: zone_reserve.user_named(&name)?,
+                    free: zone_free.user_named(&name)?,
                 },
             };
             let mut work = work_schedule();
@@ -454,18 +468,25 @@ pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
                 let mut asleep = Vec::new();
                 loop {
                     enum Event {
-                        Reserve(String, Sweep, ReplyHandle<()>),
+                        // Boxed: a reservation is a record of 1.6 KiB.
+                        Reserve(Box<Reservation>, ReplyHandle<()>),
                         Free(ModuleName, ReplyHandle<()>),
                     }
                     let event = select()
                         .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
-                        .or(&mut reserve, |((robot, sweep), reply)| {
-                            Event::Reserve(robot, sweep, reply)
+                        .or(&mut reserve, |(reservation, reply)| {
+                            Event::Reserve(Box::new(reservation), reply)
                         })
                         .await?;
                     match event {
-                        Event::Reserve(robot, sweep, reply) => {
-                            if space.request(robot.as_str(), &sweep) {
+                        Event::Reserve(reservation, reply) => {
+                            // A record no robot wrote (a garbled peer) is not answered:
+                            // its sender fails, and asks again.
+                            let Some(sweep) = reservation.sweep() else {
+                                continue;
+                            };
+                            let robot = *reservation.robot();
+                            if space.request(robot.as_str(), &sweep.to_vec()) {
                                 reply.reply(());
                             } else {
                                 asleep.push((robot, reply));

@@ -25,6 +25,7 @@ pub mod names;
 pub mod ports;
 pub mod processes;
 pub mod report;
+pub mod reservation;
 pub mod run;
 pub mod tally;
 

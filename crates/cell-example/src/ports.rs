@@ -17,6 +17,7 @@ use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
 };
+use crate::reservation::Reservation;
 
 /// FREQUENCY(TASK_NUM: INTEGER; TIME_FOR_ONE: REAL), through the bounded buffer.
 pub type Frequency = BoundedBufferPort<(i32, f64), AnyUser, 2>;
@@ -34,9 +35,9 @@ pub type CardInPlace = Port<PalletId, i32, usage::Send>;
 pub type ReadyToChip = Port<PalletId, (), usage::Receive, AnyUser, 1>;
 /// SHARE_FEEDER(CLEAR: INTEGER): USAGE=QUERY, USERLIST=(twin), TIMEOUT=3 SEC.
 pub type ShareFeeder = Port<(), i32, usage::Query>;
-/// The arbiter's ports: a chip robot sends its name and waits until it may enter (or has
-/// left).
-pub type ZonePort = Port<ModuleName, (), usage::Receive, AnyUser, 2>;
+/// The feeder zone's ports: a chip robot sends its name (or, to the coordinator, the space
+/// it will sweep) and waits until it may enter (or has left).
+pub type ZonePort<Req = ModuleName> = Port<Req, (), usage::Receive, AnyUser, 2>;
 
 /// The longest module name a [`ModuleName`] holds.
 const MODULE_NAME: usize = 32;
@@ -87,17 +88,17 @@ impl fmt::Display for ModuleName {
     }
 }
 
-/// Where a chip robot finds the arbiter's port: declared in this process, or imported from
-/// the process the arbiter runs in.
+/// Where a chip robot finds a port of the feeder zone's keeper — the arbiter or the
+/// coordinator: declared in this process, or imported from the process the keeper runs in.
 #[derive(Clone)]
-pub enum ZoneLink {
+pub enum ZoneLink<Req: Send + 'static = ModuleName> {
     /// The port itself.
-    Here(ZonePort),
+    Here(ZonePort<Req>),
     /// The port of another process, through its bridge.
-    Imported(Arc<Imported<ModuleName, ()>>),
+    Imported(Arc<Imported<Req, ()>>),
 }
 
-impl fmt::Debug for ZoneLink {
+impl<Req: Send + 'static> fmt::Debug for ZoneLink<Req> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ZoneLink::Here(port) => f.debug_tuple("Here").field(port.name()).finish(),
@@ -108,9 +109,9 @@ impl fmt::Debug for ZoneLink {
     }
 }
 
-impl ZoneLink {
+impl<Req: Send + 'static> ZoneLink<Req> {
     /// `module`'s end to send on.
-    pub fn user_named(&self, module: &str) -> Result<End<ModuleName, (), usage::Send>, WireError> {
+    pub fn user_named(&self, module: &str) -> Result<End<Req, (), usage::Send>, WireError> {
         match self {
             ZoneLink::Here(port) => port.user_named(module),
             ZoneLink::Imported(port) => port.port().user_named(module),
@@ -119,7 +120,7 @@ impl ZoneLink {
 
     /// The owner's end: refused with the port's own error if the port was imported (its
     /// owner runs in another process).
-    pub fn owner(&self) -> Result<End<ModuleName, (), usage::Receive>, WireError> {
+    pub fn owner(&self) -> Result<End<Req, (), usage::Receive>, WireError> {
         match self {
             ZoneLink::Here(port) => port.owner(),
             ZoneLink::Imported(port) => port.port().owner(),
@@ -127,7 +128,7 @@ impl ZoneLink {
     }
 
     /// The port in this process, to own and to declare; `None` if it was imported.
-    pub fn here(&self) -> Option<&ZonePort> {
+    pub fn here(&self) -> Option<&ZonePort<Req>> {
         match self {
             ZoneLink::Here(port) => Some(port),
             ZoneLink::Imported(_) => None,
@@ -137,7 +138,7 @@ impl ZoneLink {
 
 /// The coordinator's reservation port: a chip robot sends the space its trajectory will
 /// sweep and waits until that space is its own.
-pub type ReservePort = Port<(String, imrs_coord::zones::Sweep), (), usage::Receive, AnyUser, 2>;
+pub type ReservePort = ZonePort<Reservation>;
 
 /// One line's ports.
 #[derive(Debug, Clone)]
@@ -170,9 +171,9 @@ pub struct CellPorts {
     /// The arbiter's release port.
     pub zone_release: ZoneLink,
     /// The coordinator's reservation port.
-    pub zone_reserve: ReservePort,
+    pub zone_reserve: ZoneLink<Reservation>,
     /// The coordinator's port for freeing a reservation.
-    pub zone_free: ZonePort,
+    pub zone_free: ZoneLink,
 }
 
 fn spec(name: &str, owner: &str, clock: &SharedClock) -> PortSpec {
@@ -260,8 +261,12 @@ impl CellPorts {
             zone_release: ZoneLink::Here(
                 ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
             ),
-            zone_reserve: ReservePort::declare(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)),
-            zone_free: ZonePort::declare(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
+            zone_reserve: ZoneLink::Here(
+                ReservePort::declare(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)).shown(),
+            ),
+            zone_free: ZoneLink::Here(
+                ZonePort::declare(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
+            ),
         }
     }
 
@@ -281,8 +286,12 @@ impl CellPorts {
                 }
             }
             FeederPolicy::Coordinator => {
-                cell.declare(&ports.zone_reserve)?;
-                cell.declare(&ports.zone_free)?;
+                if let Some(port) = ports.zone_reserve.here() {
+                    cell.declare(port)?;
+                }
+                if let Some(port) = ports.zone_free.here() {
+                    cell.declare(port)?;
+                }
             }
             FeederPolicy::Appendix => {}
         }

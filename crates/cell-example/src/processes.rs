@@ -32,12 +32,16 @@ use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::alarms::AlarmKind;
-use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_monitor};
+use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_coordinator, feeder_monitor};
 use crate::devices::{DevicePorts, Devices, RemoteDevices, world};
 use crate::faults::CellFaultKind;
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
-use crate::names::{FEEDER_MONITOR, LineNames, ZONE_RELEASE, ZONE_REQUEST};
+use crate::names::{
+    FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
+    ZONE_RESERVE,
+};
 use crate::ports::{CellPorts, ModuleName, ZoneLink};
+use crate::reservation::Reservation;
 use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject, lock};
 use crate::tally::Tally;
 
@@ -72,9 +76,7 @@ fn refused(process: &str, why: impl std::fmt::Display) -> RunError {
 
 /// What `--processes` cannot do yet, refused before anything starts.
 pub(crate) fn check_config(config: &CellConfig) -> Result<(), RunError> {
-    let unsupported = if config.feeder == FeederPolicy::Coordinator {
-        Some("--feeder coordinator: its sweeps are computed where the simulation runs")
-    } else if config.record.is_some() || config.timeline.is_some() {
+    let unsupported = if config.record.is_some() || config.timeline.is_some() {
         Some("--record and --timeline: a recording sees one process's modules")
     } else if config.show_tree {
         Some("--tree: each process has a module tree of its own")
@@ -147,28 +149,42 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     inject(config, &sim, &Default::default());
 
     let ports = CellPorts::new(&clock);
-    // The arbiter runs here; under the Appendix's policy the lines ask each other.
-    let arbiter = config.feeder == FeederPolicy::Arbiter;
-    let zone: Vec<_> = [&ports.zone_request, &ports.zone_release]
-        .into_iter()
-        .filter(|_| arbiter)
-        .filter_map(ZoneLink::here)
-        .collect();
+    // The arbiter, or the coordinator, runs here; under the Appendix's policy the lines ask
+    // each other.
+    let coordinator = config.feeder == FeederPolicy::Coordinator;
+    let zone: Vec<_> = match config.feeder {
+        FeederPolicy::Arbiter => vec![&ports.zone_request, &ports.zone_release],
+        FeederPolicy::Coordinator => vec![&ports.zone_free],
+        FeederPolicy::Appendix => Vec::new(),
+    }
+    .into_iter()
+    .filter_map(ZoneLink::here)
+    .collect();
+    let reserve = ports.zone_reserve.here().filter(|_| coordinator);
     let devices = DevicePorts::declare(&clock);
     for port in &zone {
         cell.declare(*port).map_err(CellErrors::from)?;
     }
+    if let Some(port) = reserve {
+        cell.declare(port).map_err(CellErrors::from)?;
+    }
     for port in devices.iter() {
         cell.declare(port).map_err(CellErrors::from)?;
     }
+    let keeper = match config.feeder {
+        FeederPolicy::Arbiter => Some(feeder_monitor(&ports)),
+        FeederPolicy::Coordinator => Some(feeder_coordinator(&ports)),
+        FeederPolicy::Appendix => None,
+    };
     let mut declarations = vec![world(&devices, &sim).declaration()];
-    if arbiter {
-        declarations.push(feeder_monitor(&ports).declaration());
-    }
+    declarations.extend(keeper.iter().map(ModuleSpec::declaration));
     cell.check(&declarations)?;
     // Exported before a line starts: a line imports them at once.
     let mut exported: Vec<Exported> = Vec::new();
     for port in zone {
+        exported.push(export(&remote, port).map_err(ipc("world"))?);
+    }
+    if let Some(port) = reserve {
         exported.push(export(&remote, port).map_err(ipc("world"))?);
     }
     for port in devices.iter() {
@@ -176,8 +192,8 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     }
     sim.spawn();
     cell.start(world(&devices, &sim))?;
-    if arbiter {
-        cell.start(feeder_monitor(&ports))?;
+    if let Some(keeper) = keeper {
+        cell.start(keeper)?;
     }
 
     let (said, mut hear) = unbounded_channel();
@@ -413,17 +429,29 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
 
     let (names, twin) = (LineNames::of(line), LineNames::of(line.other()));
     let mut ports = CellPorts::new(&clock);
-    if config.feeder == FeederPolicy::Arbiter {
-        for (link, port) in [
-            (&mut ports.zone_request, ZONE_REQUEST),
-            (&mut ports.zone_release, ZONE_RELEASE),
-        ] {
-            let imported = import::<ModuleName, ()>(&remote, port, FEEDER_MONITOR, &names.chip_it)
+    // The feeder zone's keeper runs in the world's process: its ports are imported.
+    let keeper_ports = match config.feeder {
+        FeederPolicy::Arbiter => vec![
+            (&mut ports.zone_request, ZONE_REQUEST, FEEDER_MONITOR),
+            (&mut ports.zone_release, ZONE_RELEASE, FEEDER_MONITOR),
+        ],
+        FeederPolicy::Coordinator => vec![(&mut ports.zone_free, ZONE_FREE, FEEDER_COORDINATOR)],
+        FeederPolicy::Appendix => Vec::new(),
+    };
+    for (link, port, keeper) in keeper_ports {
+        let imported =
+            import::<ModuleName, ()>(&remote, port, keeper, &names.chip_it).map_err(ipc(name))?;
+        cell.declare_imported(imported.port())
+            .map_err(CellErrors::from)?;
+        *link = ZoneLink::Imported(Arc::new(imported));
+    }
+    if config.feeder == FeederPolicy::Coordinator {
+        let imported =
+            import::<Reservation, ()>(&remote, ZONE_RESERVE, FEEDER_COORDINATOR, &names.chip_it)
                 .map_err(ipc(name))?;
-            cell.declare_imported(imported.port())
-                .map_err(CellErrors::from)?;
-            *link = ZoneLink::Imported(Arc::new(imported));
-        }
+        cell.declare_imported(imported.port())
+            .map_err(CellErrors::from)?;
+        ports.zone_reserve = ZoneLink::Imported(Arc::new(imported));
     }
     ports.lines[line.index()]
         .declare_to(&cell)

@@ -395,14 +395,15 @@ impl fmt::Display for Report {
             writeln!(f, "faults injected: {}", self.faults.join(", "))?;
         }
         if let Some(speed) = self.processes {
-            let arbiter = if self.policy == FeederPolicy::Arbiter {
-                ", FEEDER_MONITOR"
-            } else {
-                ""
+            // The feeder zone's keeper, if the policy has one, runs in the world.
+            let keeper = match self.policy {
+                FeederPolicy::Arbiter => ", FEEDER_MONITOR",
+                FeederPolicy::Coordinator => ", FEEDER_COORDINATOR",
+                FeederPolicy::Appendix => "",
             };
             writeln!(
                 f,
-                "processes: world (simulation, WORLD{arbiter}), line A, line B over iceoryx2, \
+                "processes: world (simulation, WORLD{keeper}), line A, line B over iceoryx2, \
                  on the wall clock x {speed}"
             )?;
         }

@@ -224,6 +224,34 @@ fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process
 }
 
 #[test]
+fn under_the_coordinator_each_chip_robot_reserves_its_sweep_in_the_worlds_process() {
+    let world = World::start(&["--feeder", "coordinator", "--hours", "0.1", "--speed", "60"]);
+    let report = world.report(Duration::from_secs(120));
+    assert!(
+        report.contains("processes: world (simulation, WORLD, FEEDER_COORDINATOR), line A, line B"),
+        "{report}"
+    );
+    // Each step's sweep was computed by the world's simulation, for a chip robot in a line's
+    // process, and reserved with the coordinator back in the world: cards done on both
+    // lines are reservations granted across processes.
+    let (a, b) = row(&report, "pallets completed");
+    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
+    for (requests, refused) in zone_requests(&report) {
+        assert!(
+            requests > 0 && refused == 0,
+            "{requests}/{refused}\n{report}"
+        );
+    }
+    // What the reservations kept apart, rapier measured.
+    assert!(
+        report.contains("[ok] no two arms touching (rapier)"),
+        "{report}"
+    );
+    assert!(!report.contains("[FAILED]"), "{report}");
+}
+
+#[test]
 fn faults_reach_the_process_they_belong_to_and_their_alarms_come_back() {
     // RELEASE dies in line A's process; line B's chip robot faults in the world's
     // simulation, and the fault reaches CHIP_IT2 across processes as the device's error.
@@ -293,7 +321,6 @@ fn a_world_killed_mid_run_takes_its_lines_with_it() {
 #[test]
 fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
     for (flags, named) in [
-        (&["--feeder", "coordinator"][..], "--feeder coordinator"),
         (&["--record", "x.mcap"][..], "--record"),
         (&["--tree"][..], "--tree"),
         (&["--realtime"][..], "--realtime"),

@@ -16,7 +16,7 @@ use imrs_sim::{
 
 pub use remote::{Device, Link, RemoteDevices};
 pub use server::{DevicePort, DevicePorts, WORLD, world};
-pub use wire::{Answer, DeviceAnswer, DeviceCall, Op};
+pub use wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op, Pose};
 
 /// Where the cell's devices are.
 #[derive(Debug, Clone)]
@@ -78,20 +78,17 @@ impl RobotDevice {
     }
 
     /// The space the arm's links sweep from `from` (or where the tool is) to `to`: see
-    /// [`Robot::sweep`]. Computed where the simulation runs, so a robot of another process
-    /// has none to give.
-    pub fn sweep(
+    /// [`Robot::sweep`]. Computed where the simulation runs: for a robot of another process,
+    /// by a call to the world's, in at most [`MAX_SWEEP_SAMPLES`] steps.
+    pub async fn sweep(
         &self,
         from: Option<Target>,
         to: Target,
         samples: usize,
-    ) -> Result<Vec<[[f32; 2]; 3]>, DeviceError> {
+    ) -> Result<Vec<Pose>, DeviceError> {
         match self {
             RobotDevice::Local(robot) => robot.sweep(from, to, samples),
-            RobotDevice::Remote(robot, _) => Err(DeviceError::NotThere {
-                robot: *robot,
-                at: "the world's process, where sweeps are computed",
-            }),
+            RobotDevice::Remote(id, link) => link.sweep(*id, from, to, samples).await,
         }
     }
 

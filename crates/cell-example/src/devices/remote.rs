@@ -6,11 +6,11 @@ use std::sync::Arc;
 
 use imrs_ipc::{Imported, IpcError, Remote, import};
 use imrs_sim::imrs_core::imrs_ports::{End, usage};
-use imrs_sim::{DeviceError, Line, RobotId, Role, Station};
+use imrs_sim::{DeviceError, Line, RobotId, Role, Station, Target};
 use tokio::sync::Mutex;
 
 use super::server::WORLD;
-use super::wire::{Answer, DeviceAnswer, DeviceCall, Op};
+use super::wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op, Pose};
 use crate::names::LineNames;
 
 /// A device of the cell, as the world serves it.
@@ -111,7 +111,27 @@ impl Link {
             Some(Answer::Done) => Ok(0),
             Some(Answer::Value(value)) => Ok(value),
             Some(Answer::Failed(error)) => Err(error),
-            Some(Answer::Malformed) | None => Err(DeviceError::RobotFault { robot }),
+            Some(Answer::Malformed | Answer::Sweep(_)) | None => {
+                Err(DeviceError::RobotFault { robot })
+            }
+        }
+    }
+
+    /// A robot's sweep, computed in the world's process: its poses, or its error. A world
+    /// that cannot be reached is a faulted robot, as for any call.
+    pub async fn sweep(
+        &self,
+        robot: RobotId,
+        from: Option<Target>,
+        to: Target,
+        samples: usize,
+    ) -> Result<Vec<Pose>, DeviceError> {
+        // No more steps than the answer has room for: a coarser sweep, never a cut one.
+        let samples = samples.min(MAX_SWEEP_SAMPLES) as u32;
+        match self.call(Op::Sweep { from, to, samples }).await {
+            Some(Answer::Sweep(poses)) => Ok(poses),
+            Some(Answer::Failed(error)) => Err(error),
+            Some(_) | None => Err(DeviceError::RobotFault { robot }),
         }
     }
 
@@ -121,7 +141,7 @@ impl Link {
         match self.call(op).await {
             Some(Answer::Value(pallet)) => Ok(pallet),
             Some(Answer::Failed(error)) => Err(error),
-            Some(Answer::Done | Answer::Malformed) | None => {
+            Some(Answer::Done | Answer::Malformed | Answer::Sweep(_)) | None => {
                 Err(DeviceError::NoPallet { line, station })
             }
         }

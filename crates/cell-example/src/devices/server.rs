@@ -6,7 +6,7 @@ use imrs_sim::imrs_core::prelude::*;
 use imrs_sim::{Line, Sim};
 
 use super::remote::Device;
-use super::wire::{Answer, DeviceAnswer, DeviceCall, Op};
+use super::wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op};
 use super::{Devices, GateDevice, RelayDevice, RobotDevice};
 
 /// The module of the world's process that serves the devices.
@@ -87,6 +87,14 @@ async fn robot(robot: &RobotDevice, op: Op) -> DeviceAnswer {
         Op::PickCard => DeviceAnswer::of(robot.pick_card().await.map(|()| None)),
         Op::PlaceCard => DeviceAnswer::of(robot.place_card().await.map(|()| None)),
         Op::Screw => DeviceAnswer::of(robot.screw().await.map(|()| None)),
+        Op::Sweep { from, to, samples } => {
+            // No more steps than the answer has room for, whatever the call asks.
+            let samples = (samples as usize).min(MAX_SWEEP_SAMPLES);
+            DeviceAnswer::new(&match robot.sweep(from, to, samples).await {
+                Ok(poses) => Answer::Sweep(poses),
+                Err(error) => Answer::Failed(error),
+            })
+        }
         // A gate's or relay's call on a robot's port: a call the world cannot carry out.
         _ => DeviceAnswer::new(&Answer::Malformed),
     }

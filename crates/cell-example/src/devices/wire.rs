@@ -29,7 +29,26 @@ pub enum Op {
     LetGo,
     /// A relay's jammed pallet is taken off the line.
     ClearJam,
+    /// A robot computes the space its arm sweeps from `from` (or where its tool is) to
+    /// `to`, in `samples` steps: at most [`MAX_SWEEP_SAMPLES`], the answer's room.
+    Sweep {
+        /// Where the move starts; `None`: where the tool is.
+        from: Option<Target>,
+        /// Where it ends.
+        to: Target,
+        /// In how many steps.
+        samples: u32,
+    },
 }
+
+/// The most steps a sweep that crosses processes has: its poses (one more) fill an answer.
+pub const MAX_SWEEP_SAMPLES: usize = SWEEP_POSES - 1;
+
+/// The poses an answer has room for.
+const SWEEP_POSES: usize = 32;
+
+/// One pose of a sweep: the arm's base, elbow and tool in the working plane.
+pub type Pose = [[f32; 2]; 3];
 
 /// An [`Op`] in shared memory.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -40,6 +59,11 @@ pub struct DeviceCall {
     target: u32,
     feeder: u32,
     at: [f32; 2],
+    /// A sweep's start: [`NO_TARGET`], or a target as `target` is.
+    from: u32,
+    from_feeder: u32,
+    from_at: [f32; 2],
+    samples: u32,
 }
 
 const MOVE: u32 = 1;
@@ -52,6 +76,7 @@ const RELEASE_PALLET: u32 = 7;
 const WAIT_IN_PLACE: u32 = 8;
 const LET_GO: u32 = 9;
 const CLEAR_JAM: u32 = 10;
+const SWEEP: u32 = 11;
 
 const HOME: u32 = 0;
 const FEEDER: u32 = 1;
@@ -59,6 +84,33 @@ const CARD: u32 = 2;
 const ON_CARD: u32 = 3;
 const MAGAZINE: u32 = 4;
 const POINT: u32 = 5;
+/// A sweep from where the tool is.
+const NO_TARGET: u32 = u32::MAX;
+
+/// `target`, encoded: its kind, its feeder and its point.
+fn encode_target(target: Target) -> (u32, u32, [f32; 2]) {
+    match target {
+        Target::Home => (HOME, 0, [0.0; 2]),
+        Target::Feeder(feeder) => (FEEDER, u32::from(feeder.0), [0.0; 2]),
+        Target::Card => (CARD, 0, [0.0; 2]),
+        Target::OnCard(at) => (ON_CARD, 0, at),
+        Target::Magazine => (MAGAZINE, 0, [0.0; 2]),
+        Target::Point(at) => (POINT, 0, at),
+    }
+}
+
+/// The target encoded; `None` for a kind or feeder no [`encode_target`] wrote.
+fn decode_target(kind: u32, feeder: u32, at: [f32; 2]) -> Option<Target> {
+    Some(match kind {
+        HOME => Target::Home,
+        FEEDER => Target::Feeder(FeederId(u8::try_from(feeder).ok()?)),
+        CARD => Target::Card,
+        ON_CARD => Target::OnCard(at),
+        MAGAZINE => Target::Magazine,
+        POINT => Target::Point(at),
+        _ => return None,
+    })
+}
 
 impl DeviceCall {
     /// `op`, encoded.
@@ -66,14 +118,7 @@ impl DeviceCall {
         let mut call = Self::default();
         call.op = match op {
             Op::Move(target) => {
-                (call.target, call.feeder, call.at) = match target {
-                    Target::Home => (HOME, 0, [0.0; 2]),
-                    Target::Feeder(feeder) => (FEEDER, u32::from(feeder.0), [0.0; 2]),
-                    Target::Card => (CARD, 0, [0.0; 2]),
-                    Target::OnCard(at) => (ON_CARD, 0, at),
-                    Target::Magazine => (MAGAZINE, 0, [0.0; 2]),
-                    Target::Point(at) => (POINT, 0, at),
-                };
+                (call.target, call.feeder, call.at) = encode_target(target);
                 MOVE
             }
             Op::Grasp(feeder) => {
@@ -88,6 +133,13 @@ impl DeviceCall {
             Op::WaitInPlace => WAIT_IN_PLACE,
             Op::LetGo => LET_GO,
             Op::ClearJam => CLEAR_JAM,
+            Op::Sweep { from, to, samples } => {
+                (call.target, call.feeder, call.at) = encode_target(to);
+                (call.from, call.from_feeder, call.from_at) =
+                    from.map_or((NO_TARGET, 0, [0.0; 2]), encode_target);
+                call.samples = samples;
+                SWEEP
+            }
         };
         call
     }
@@ -96,15 +148,7 @@ impl DeviceCall {
     pub fn op(&self) -> Option<Op> {
         let feeder = || u8::try_from(self.feeder).ok().map(FeederId);
         Some(match self.op {
-            MOVE => Op::Move(match self.target {
-                HOME => Target::Home,
-                FEEDER => Target::Feeder(feeder()?),
-                CARD => Target::Card,
-                ON_CARD => Target::OnCard(self.at),
-                MAGAZINE => Target::Magazine,
-                POINT => Target::Point(self.at),
-                _ => return None,
-            }),
+            MOVE => Op::Move(decode_target(self.target, self.feeder, self.at)?),
             GRASP => Op::Grasp(feeder()?),
             INSERT => Op::Insert,
             PICK_CARD => Op::PickCard,
@@ -114,6 +158,14 @@ impl DeviceCall {
             WAIT_IN_PLACE => Op::WaitInPlace,
             LET_GO => Op::LetGo,
             CLEAR_JAM => Op::ClearJam,
+            SWEEP => Op::Sweep {
+                from: match self.from {
+                    NO_TARGET => None,
+                    kind => Some(decode_target(kind, self.from_feeder, self.from_at)?),
+                },
+                to: decode_target(self.target, self.feeder, self.at)?,
+                samples: self.samples,
+            },
             _ => return None,
         })
     }
@@ -126,14 +178,17 @@ impl DeviceCall {
 #[type_name("cell_example::DeviceAnswer")]
 pub struct DeviceAnswer {
     status: u32,
+    /// A value; for a sweep, how many of `poses` it has.
     value: u32,
     error: [i32; 4],
+    poses: [Pose; SWEEP_POSES],
 }
 
 const DONE: u32 = 0;
 const VALUE: u32 = 1;
 const FAILED: u32 = 2;
 const MALFORMED: u32 = 3;
+const SWEPT: u32 = 4;
 
 /// What a device answered, decoded.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,6 +201,8 @@ pub enum Answer {
     Failed(DeviceError),
     /// The world could not read the call.
     Malformed,
+    /// A sweep's poses: at most [`MAX_SWEEP_SAMPLES`] + 1.
+    Sweep(Vec<Pose>),
 }
 
 /// The places a robot can be found not to be at (`DeviceError::NotThere`).
@@ -165,9 +222,20 @@ impl DeviceAnswer {
             },
             Answer::Failed(error) => Self {
                 status: FAILED,
-                value: 0,
                 error: encode_error(error),
+                ..Self::default()
             },
+            Answer::Sweep(sweep) => {
+                let mut answer = Self {
+                    status: SWEPT,
+                    ..Self::default()
+                };
+                // The world asks for no more samples than fit (see `MAX_SWEEP_SAMPLES`).
+                let poses = sweep.len().min(SWEEP_POSES);
+                answer.poses[..poses].copy_from_slice(&sweep[..poses]);
+                answer.value = poses as u32;
+                answer
+            }
             Answer::Malformed => Self {
                 status: MALFORMED,
                 ..Self::default()
@@ -199,6 +267,11 @@ impl DeviceAnswer {
             VALUE => Answer::Value(self.value),
             FAILED => Answer::Failed(decode_error(self.error)?),
             MALFORMED => Answer::Malformed,
+            SWEPT => Answer::Sweep(
+                self.poses
+                    .get(..usize::try_from(self.value).ok()?)?
+                    .to_vec(),
+            ),
             _ => return None,
         })
     }
@@ -210,7 +283,7 @@ impl Answer {
         match self {
             Answer::Value(pallet) => Some(Release::Released(PalletId(*pallet))),
             Answer::Done => Some(Release::BackedUp),
-            Answer::Failed(_) | Answer::Malformed => None,
+            Answer::Failed(_) | Answer::Malformed | Answer::Sweep(_) => None,
         }
     }
 }
@@ -361,6 +434,16 @@ mod tests {
             Op::WaitInPlace,
             Op::LetGo,
             Op::ClearJam,
+            Op::Sweep {
+                from: None,
+                to: Target::Feeder(FeederId(1)),
+                samples: 12,
+            },
+            Op::Sweep {
+                from: Some(Target::Feeder(FeederId(0))),
+                to: Target::OnCard([0.03, 0.04]),
+                samples: 31,
+            },
         ];
         for op in ops {
             assert_eq!(DeviceCall::new(op).op(), Some(op));
@@ -405,7 +488,16 @@ mod tests {
             let answer = Answer::Failed(error);
             assert_eq!(DeviceAnswer::new(&answer).answer(), Some(answer));
         }
-        for answer in [Answer::Done, Answer::Value(7), Answer::Malformed] {
+        let sweep = (0..13)
+            .map(|i| [[0.0, 0.0], [0.1 * i as f32, 0.2], [0.3, -0.01 * i as f32]])
+            .collect();
+        for answer in [
+            Answer::Done,
+            Answer::Value(7),
+            Answer::Malformed,
+            Answer::Sweep(sweep),
+            Answer::Sweep(Vec::new()),
+        ] {
             assert_eq!(DeviceAnswer::new(&answer).answer(), Some(answer.clone()));
         }
     }
@@ -429,6 +521,18 @@ mod tests {
             ..DeviceCall::default()
         };
         assert_eq!(bad_feeder.op(), None);
+        let bad_start = DeviceCall {
+            op: SWEEP,
+            from: 42,
+            ..DeviceCall::default()
+        };
+        assert_eq!(bad_start.op(), None);
+        let too_many_poses = DeviceAnswer {
+            status: SWEPT,
+            value: SWEEP_POSES as u32 + 1,
+            ..DeviceAnswer::default()
+        };
+        assert_eq!(too_many_poses.answer(), None);
         for error in [
             [0, 0, 0, 0],
             [1, 6, 0, 0],
@@ -438,8 +542,8 @@ mod tests {
         ] {
             let answer = DeviceAnswer {
                 status: FAILED,
-                value: 0,
                 error,
+                ..DeviceAnswer::default()
             };
             assert_eq!(answer.answer(), None, "{error:?}");
         }
