@@ -56,7 +56,7 @@ struct Flags {
     /// Show no progress bar (it is shown only on a terminal anyway).
     #[arg(long)]
     no_progress: bool,
-    /// Run across three processes: the world (simulation, devices, feeder arbiter) in this
+    /// Run across three processes: the world (simulation, devices, feeder zone's keeper) in this
     /// one, each line's modules in its own, talking over iceoryx2; on the wall clock sped
     /// up by --speed.
     #[arg(long)]

@@ -1,10 +1,12 @@
 //! The chip cell split over processes (`chip_cell --processes`): the world — the simulation,
-//! WORLD serving the devices, and FEEDER_MONITOR under the arbiter's policy — in the process
-//! started by the command, and each line's modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD,
-//! CHIP_IT) in a process of its own, which the world starts. The lines reach their robots,
-//! gate and relays through the world's device ports, and the feeder zone through the
-//! arbiter's ports or, under the Appendix's policy, through each other's SHARE_FEEDER, all
-//! carried by iceoryx2 (`imrs-ipc`); the modules' code is that of the single-process cell.
+//! WORLD serving the devices, and the feeder zone's keeper (FEEDER_MONITOR under the
+//! arbiter's policy, FEEDER_COORDINATOR under the coordinator's) — in the process started by
+//! the command, and each line's modules (GATE, LOAD_IT, LOAD_CARD, SCREW_IN_CARD, CHIP_IT)
+//! in a process of its own, which the world starts. The lines reach their robots, gate and
+//! relays through the world's device ports (a chip robot's sweep, too, is computed there),
+//! and the feeder zone through the keeper's ports or, under the Appendix's policy, through
+//! each other's SHARE_FEEDER, all carried by iceoryx2 (`imrs-ipc`); the modules' code is
+//! that of the single-process cell.
 //!
 //! Time: every process runs on the wall clock sped up by `--speed`, from one epoch the world
 //! chooses and hands to the lines when it starts them, so the processes agree on one time
