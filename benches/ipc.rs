@@ -275,37 +275,33 @@ async fn loaned_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> V
     let remote = Remote::new(cell).expect("a cell name");
     let imported = import_shared::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
-    let mut round_trip = async || {
+    timed(rounds, async || {
         let message = asker.loan().expect("a loan");
         let reply = asker.send(message).await.expect("a round trip");
         std::hint::black_box(&*reply);
-    };
-    for _ in 0..rounds / 10 {
-        round_trip().await;
-    }
-    let mut times = Vec::with_capacity(rounds);
-    for _ in 0..rounds {
-        let start = Instant::now();
-        round_trip().await;
-        times.push(start.elapsed());
-    }
-    times
+    })
+    .await
 }
 
 async fn imrs_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
     let remote = Remote::new(cell).expect("a cell name");
     let imported = import::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
+    timed(rounds, async || {
+        std::hint::black_box(asker.send(T::default()).await.expect("a round trip"));
+    })
+    .await
+}
+
+/// `rounds` round trips, each timed, after a tenth as many to warm up.
+async fn timed(rounds: usize, mut round_trip: impl AsyncFnMut()) -> Vec<Duration> {
     for _ in 0..rounds / 10 {
-        asker
-            .send(T::default())
-            .await
-            .expect("a warm-up round trip");
+        round_trip().await;
     }
     let mut times = Vec::with_capacity(rounds);
     for _ in 0..rounds {
         let start = Instant::now();
-        std::hint::black_box(asker.send(T::default()).await.expect("a round trip"));
+        round_trip().await;
         times.push(start.elapsed());
     }
     times

@@ -167,14 +167,6 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Loaned<Req, Rep> {
     fn get_mut(&mut self) -> Option<&mut Req> {
         Some(self.0.payload_mut())
     }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
-    }
 }
 
 /// A request received from another process, read where its sender wrote it.
@@ -201,14 +193,6 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Received<Req, Rep> {
 
     fn get_mut(&mut self) -> Option<&mut Req> {
         None
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
     }
 
     fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
@@ -242,14 +226,6 @@ impl<Req: Wire, Rep: Wire> Buffer<Rep> for Replying<Req, Rep> {
     fn get_mut(&mut self) -> Option<&mut Rep> {
         Some(self.reply.payload_mut())
     }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
-    }
 }
 
 /// A reply received from another process, read where its sender wrote it.
@@ -262,13 +238,5 @@ impl<Rep: Wire> Buffer<Rep> for Answered<Rep> {
 
     fn get_mut(&mut self) -> Option<&mut Rep> {
         None
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
     }
 }

@@ -58,17 +58,14 @@ use std::ops::{Deref, DerefMut};
 
 use crate::Name;
 
-/// Memory a [`Shared`] message lies in: the heap, or a transport's.
-pub trait Buffer<T>: Send + 'static {
+/// Memory a [`Shared`] message lies in: the heap, or a transport's. A transport recognises
+/// a buffer of its own by its type ([`Shared::buffer`] is the buffer as `Any`).
+pub trait Buffer<T>: Any + Send {
     /// The message.
     fn get(&self) -> &T;
     /// The message, to change in place; `None` where it is read-only (a message received
     /// from another process, which lies where its sender wrote it).
     fn get_mut(&mut self) -> Option<&mut T>;
-    /// The buffer, for its transport to recognise one of its own.
-    fn as_any(&self) -> &dyn Any;
-    /// The buffer, for its transport to take back (a loan of its own, sent in place).
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send>;
     /// Memory for the reply to this message, where its transport carries the reply back: a
     /// [`Shared`] of the reply's type, boxed as `Any`. `None` (the default) where the
     /// transport lends none, and the reply is built on the heap.
@@ -85,20 +82,12 @@ impl<T: Send + 'static> Buffer<T> for Box<T> {
     fn get_mut(&mut self) -> Option<&mut T> {
         Some(self)
     }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
-    }
 }
 
 /// A message a port moves by handle: it lies in a [`Buffer`] — the heap, or a transport's
 /// shared memory — and is read (and, where it is writable, written) in place.
 pub struct Shared<T: 'static> {
-    buffer: Box<dyn Buffer<T>>,
+    buffer: Box<dyn Buffer<T> + Send>,
 }
 
 impl<T: Send + 'static> Shared<T> {
@@ -116,12 +105,14 @@ impl<T: Send + 'static> Shared<T> {
 
     /// The buffer the message lies in, for a transport to recognise one of its own.
     pub fn buffer(&self) -> &dyn Any {
-        self.buffer.as_any()
+        // The buffer itself, not its box.
+        let buffer: &dyn Buffer<T> = &*self.buffer;
+        buffer
     }
 
     /// The buffer the message lies in, for a transport to take back and send in place.
     pub fn into_buffer(self) -> Box<dyn Any + Send> {
-        self.buffer.into_any()
+        self.buffer
     }
 
     /// Memory for the reply to this message, to build it in place: where the message's

@@ -61,14 +61,6 @@ impl Buffer<Image> for ReadOnly {
     fn get_mut(&mut self) -> Option<&mut Image> {
         None
     }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
-    }
 }
 
 #[test]
@@ -127,14 +119,6 @@ impl Buffer<Image> for Lending {
 
     fn get_mut(&mut self) -> Option<&mut Image> {
         Some(&mut self.0)
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
-    }
-
-    fn into_any(self: Box<Self>) -> Box<dyn Any + Send> {
-        self
     }
 
     fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
