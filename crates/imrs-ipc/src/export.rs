@@ -139,6 +139,24 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// Serves port `name`'s requests from other processes: each remote module is attached by
 /// `attach`, and its requests (wire type `Req`, carried in the port as `M`) go in through
 /// its end.
+/// Exports `port`, a `RESPONSE` port of messages built in place ([`Shared`]), as
+/// [`export_response`] does a port of values: a remote module's query is read in place by
+/// the owner's response handler, which runs when the owner's order says and can build its
+/// answer in place too ([`Shared::loan_reply`]).
+pub fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Shared<Req>, Shared<Rep>, usage::Response, L, N>,
+) -> Result<Exported, IpcError> {
+    let port = port.clone();
+    bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
+        remote,
+        Name::from(&port),
+        N,
+        false,
+        move |module: &str| Ok(port.user_named(module)?),
+    )
+}
+
 pub(crate) fn bridge<Req, Rep, M, R, E, A>(
     remote: &Remote,
     name: Name,

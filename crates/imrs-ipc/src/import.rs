@@ -129,6 +129,28 @@ pub fn import_response<Req: Wire, Rep: Wire>(
     )
 }
 
+/// Imports a `RESPONSE` port of messages built in place ([`Shared`]), exported with
+/// [`export_response_shared`](crate::export_response_shared), as [`import_shared`] does a
+/// port its owner receives on: `module` loans each query in shared memory
+/// ([`End::loan`]), and reads each answer where the owner's response handler built it.
+pub fn import_response_shared<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::Response>, IpcError> {
+    bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
+        remote,
+        port,
+        module,
+        // The handler never runs, as for `import_response`.
+        |local: &Port<Shared<Req>, Shared<Rep>, usage::Response, AnyUser, 1>| {
+            local.owner_responder(|_: &(), _: Shared<Req>| Shared::<Rep>::default())
+        },
+        owner,
+    )
+}
+
 /// The local owner's side of an imported port: where the bridge takes each request, and
 /// the right to answer it.
 pub(crate) trait Take<Req, Rep>: Send + 'static {

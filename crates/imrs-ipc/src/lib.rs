@@ -111,6 +111,10 @@
 //! # Ok(()) }
 //! ```
 //!
+//! `RESPONSE` ports of `Shared` messages cross the same way, with [`export_response_shared`]
+//! and [`import_response_shared`]: a query loaned and built in place, read in place by the
+//! owner's response handler, whose answer is built in a reply loan.
+//!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
 //! the port allows at once (16). A `Shared` message that does not lie in one of the port's
 //! own loans — a heap value, or another port's loan — is copied into one when sent.
@@ -124,8 +128,8 @@ mod send_all;
 mod wire;
 
 pub use error::IpcError;
-pub use export::{Exported, export, export_response, export_shared};
-pub use import::{Imported, import, import_response, import_shared};
+pub use export::{Exported, export, export_response, export_response_shared, export_shared};
+pub use import::{Imported, import, import_response, import_response_shared, import_shared};
 pub use send_all::{
     export_call_all, export_query, export_send_all, import_call_all, import_query, import_send_all,
 };

@@ -945,3 +945,37 @@ async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served(
         .unwrap();
     assert_eq!(reply.words[8191], 12);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_handler() {
+    let cell = cell("shared-query");
+    let _inspector = started_owner("inspector", &cell, "INSPECT");
+    let remote = Remote::new(&cell).unwrap();
+    let imported =
+        imrs_ipc::import_response_shared::<Frame, Frame>(&remote, "INSPECT", "INSPECTOR", "ASKER")
+            .unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    for seed in 1..=10u64 {
+        let mut frame = asker.loan().unwrap();
+        assert!(!frame.buffer().is::<Box<Frame>>());
+        for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
+            *out = word(seed, at);
+        }
+        let mut answer = within(10, asker.query(frame)).await.unwrap();
+        assert_eq!(
+            answer.words[0], 1,
+            "the handler read query {seed} in a copy"
+        );
+        assert_eq!(
+            answer.words[3], 1,
+            "the handler built answer {seed} on the heap"
+        );
+        assert!(
+            !answer.is_writable(),
+            "answer {seed} was copied out of its sample"
+        );
+        for at in [4, 5, 4096, 8191] {
+            assert_eq!(answer.words[at], word(seed, at).wrapping_mul(5));
+        }
+    }
+}

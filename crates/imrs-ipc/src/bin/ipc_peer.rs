@@ -22,6 +22,10 @@
 //!   word three times the frame's. The answer is built in a loan made for the frame; for a
 //!   frame whose word 3 is 1, in one made for the previous frame. Prints `ready` once
 //!   exported.
+//! - `ipc_peer inspector CELL PORT`: exports PORT, a `RESPONSE` port of frames built in
+//!   place (user ASKER), whose response handler answers each frame as `vision` does, with
+//!   every further word five times the frame's, building its answer in a reply loan.
+//!   Prints `ready` once exported.
 //! - `ipc_peer user CELL PORT MODULE N`: imports PORT for MODULE and asks the doubles of
 //!   1..=N, printing each; prints the error and exits with 2 if refused.
 
@@ -31,8 +35,8 @@ use std::time::Duration;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
-    FromBytes, Remote, ZeroCopySend, export, export_response, export_shared, import,
-    import_call_all, import_query, import_send_all,
+    FromBytes, Remote, ZeroCopySend, export, export_response, export_response_shared,
+    export_shared, import, import_call_all, import_query, import_send_all,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -70,6 +74,7 @@ fn main() -> ExitCode {
             ["tight-owner", cell, port] => owner(cell, port, ProcessType::Tight).await,
             ["responder", cell, port] => responder(cell, port).await,
             ["vision", cell, port] => vision(cell, port).await,
+            ["inspector", cell, port] => inspector(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["child", cell, port, module, n] => child(cell, port, module, n).await,
@@ -140,6 +145,26 @@ async fn vision(cell: &str, port: &str) -> Result<(), Error> {
         }
         reply.reply(answer);
         previous = Some(frame);
+    }
+}
+
+async fn inspector(cell: &str, port: &str) -> Result<(), Error> {
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::Response, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "INSPECTOR").user_list(["ASKER"]));
+    let _exported = export_response_shared(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let factor = 5;
+    let mut inspector = port.owner_responder(|factor: &u64, mut frame: Shared<Frame>| {
+        let mut answer: Shared<Frame> = frame.loan_reply();
+        answer.words[0] = u64::from(!frame.is_writable());
+        answer.words[3] = u64::from(!answer.buffer().is::<Box<Frame>>());
+        for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(4) {
+            *out = word.wrapping_mul(*factor);
+        }
+        answer
+    })?;
+    loop {
+        inspector.serve(&factor).await?;
     }
 }
 
