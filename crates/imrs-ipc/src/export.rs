@@ -99,6 +99,9 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
+    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
+    // port's spin would keep it off the worker the owner spins on.
+    port.park_waits();
     bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
         Ok(port.user_named(module)?)
     })
@@ -114,6 +117,9 @@ pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
+    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
+    // port's spin would keep it off the worker the owner spins on.
+    port.park_waits();
     bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
         remote,
         Name::from(&port),
@@ -131,6 +137,9 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
+    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
+    // port's spin would keep it off the worker the owner spins on.
+    port.park_waits();
     bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
         Ok(port.user_named(module)?)
     })
@@ -148,6 +157,9 @@ pub fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>
     port: &Port<Shared<Req>, Shared<Rep>, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
     let port = port.clone();
+    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
+    // port's spin would keep it off the worker the owner spins on.
+    port.park_waits();
     bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
         remote,
         Name::from(&port),

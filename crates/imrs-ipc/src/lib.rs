@@ -42,7 +42,10 @@
 //! request whose notify was lost waits a tick at most. Call the functions from within a
 //! runtime whose I/O driver is enabled (`enable_all`). A TIGHT port crosses as any other:
 //! spinning bridges were slower than woken ones on the 2-core machine measured (see the
-//! README), because a spinner takes the processor the other process needs.
+//! README), because a spinner takes the processor the other process needs. An exported
+//! port's waits park at once ([`Port::park_waits`](imrs_core::imrs_ports::Port::park_waits)):
+//! the bridge's side of each rendezvous is a task on the same runtime, which a spinning
+//! owner would keep off its worker.
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the

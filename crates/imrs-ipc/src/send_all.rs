@@ -114,6 +114,8 @@ where
         detail: "export it from within the tokio runtime its cell runs on".into(),
     })?;
     let (port, owner, cell) = (port.clone(), port.owner_module().clone(), remote.clone());
+    // As for `export`: the relays are tasks on this runtime.
+    port.park_waits();
     let served = name.clone();
     // The owner starts each rendezvous here; its relays are parked.
     // Attaching a remote module connects a relay back to its process: a wait of its own,

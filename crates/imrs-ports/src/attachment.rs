@@ -5,6 +5,7 @@ use std::task::{Context, Poll};
 use std::time::Duration;
 
 use crate::core::{Core, Gone, SlotId, hold};
+use crate::loom::Ordering;
 use crate::meta::Name;
 use crate::presence::Presence;
 use crate::slot::Slot;
@@ -144,6 +145,9 @@ impl<Req, Rep> Attachment<Req, Rep> {
 
     /// How long a wait on this end may spin before it parks.
     pub(crate) fn spins(&self) -> u32 {
+        if self.core.parked.load(Ordering::Relaxed) {
+            return 0;
+        }
         self.core.meta.process_type.spins()
     }
 }
@@ -154,5 +158,27 @@ impl<Req, Rep> Drop for Attachment<Req, Rep> {
             SlotId::Owner => self.core.detach_owner(),
             SlotId::User(index) => self.core.detach_user(index),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Port, PortSpec, ProcessType, usage};
+
+    #[test]
+    fn a_tight_port_whose_waits_are_parked_spins_no_more_on_any_end() {
+        let port = Port::<u32, u32, usage::Receive>::declare(
+            PortSpec::new("TIGHT", "OWNER").process_type(ProcessType::Tight),
+        );
+        let owner = port.owner().unwrap();
+        assert!(owner.attachment.spins() > 0);
+        // Set through another handle: it holds for every end, attached before or after.
+        port.clone().park_waits();
+        let user = port.user_named("USER").unwrap();
+        assert_eq!(owner.attachment.spins(), 0);
+        assert_eq!(user.attachment.spins(), 0);
+        // Ports of other process types never spun.
+        let loose = Port::<u32, u32, usage::Receive>::declare(PortSpec::new("LOOSE", "OWNER"));
+        assert_eq!(loose.owner().unwrap().attachment.spins(), 0);
     }
 }

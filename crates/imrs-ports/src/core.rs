@@ -119,6 +119,9 @@ pub(crate) struct Core<Req, Rep> {
     /// Where a sender's messages are built, if a transport lends memory of its own
     /// ([`Port::lend_with`](crate::Port::lend_with)).
     pub(crate) lender: OnceLock<Lender<Req>>,
+    /// Whether waits park at once, whatever the process type says
+    /// ([`Port::park_waits`](crate::Port::park_waits)).
+    pub(crate) parked: AtomicBool,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -137,6 +140,7 @@ impl<Req, Rep> Core<Req, Rep> {
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
             shown: OnceLock::new(),
             lender: OnceLock::new(),
+            parked: AtomicBool::new(false),
         }
     }
 

@@ -11,6 +11,7 @@ use crate::clock::{RealClock, SharedClock};
 use crate::core::{Core, SlotId, hold};
 use crate::end::End;
 use crate::error::WireError;
+use crate::loom::Ordering;
 use crate::meta::{Name, Named, PortMeta};
 use crate::presence::Presence;
 use crate::priority::Priority;
@@ -177,6 +178,14 @@ where
     ) -> Self {
         let _first_holds = self.core.lender.set(Box::new(lender));
         self
+    }
+
+    /// Makes every wait on the port park at once, whatever its process type says: for a
+    /// transport whose side of the rendezvous is a task on the same runtime as the module's,
+    /// which a TIGHT port's spin would keep off its worker until the spin ends. Holds for
+    /// every handle of the port.
+    pub fn park_waits(&self) {
+        self.core.parked.store(true, Ordering::Relaxed);
     }
 
     /// Shows the port's messages and replies as `Debug` writes them, in the event log of a
