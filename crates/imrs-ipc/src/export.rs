@@ -4,7 +4,7 @@
 //! back through shared memory.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
@@ -59,6 +59,37 @@ pub struct Exported {
     port: Name,
     stop: Arc<AtomicBool>,
     serving: Serving,
+    in_flight: Arc<InFlight>,
+}
+
+/// The requests from other processes taken and not yet answered there.
+#[derive(Default)]
+pub(crate) struct InFlight {
+    count: AtomicUsize,
+    idle: tokio::sync::Notify,
+}
+
+impl InFlight {
+    fn taken(&self) {
+        self.count.fetch_add(1, Ordering::AcqRel);
+    }
+
+    fn answered(&self) {
+        if self.count.fetch_sub(1, Ordering::AcqRel) == 1 {
+            self.idle.notify_waiters();
+        }
+    }
+
+    /// Waits until no request is in flight.
+    pub(crate) async fn settled(&self) {
+        loop {
+            let idle = self.idle.notified();
+            if self.count.load(Ordering::Acquire) == 0 {
+                return;
+            }
+            idle.await;
+        }
+    }
 }
 
 /// Who serves the port's requests: a tokio task woken by the users' notify through tokio's
@@ -73,6 +104,17 @@ impl Exported {
     /// The port.
     pub fn port(&self) -> &Name {
         &self.port
+    }
+
+    /// Waits until every request taken from another process has been answered there. A
+    /// reply crosses in a task of the runtime, after the module gave it: a process that ends
+    /// cleanly awaits this first, so that the replies its modules gave reach their senders.
+    pub async fn settled(&self) {
+        self.in_flight.settled().await;
+    }
+
+    pub(crate) fn in_flight(&self) -> Arc<InFlight> {
+        Arc::clone(&self.in_flight)
     }
 }
 
@@ -201,6 +243,8 @@ where
     let listener = channel.listener(&channel.requested)?;
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
+    let in_flight = Arc::new(InFlight::default());
+    let flying = Arc::clone(&in_flight);
     if !attach_blocks {
         // A task in the runtime the owner's module runs on, woken by the users' notify, so
         // that a request reaches the module with no hand-over between threads.
@@ -216,7 +260,14 @@ where
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take::<Req, Rep, M, R, E>(active, &mut attach, &mut users, &runtime, &notifier);
+                    take::<Req, Rep, M, R, E>(
+                        active,
+                        &mut attach,
+                        &mut users,
+                        &runtime,
+                        &notifier,
+                        &flying,
+                    );
                 }
                 tokio::select! {
                     notified = readiness.notified() => {
@@ -232,6 +283,7 @@ where
             port: name,
             stop,
             serving: Serving::Task(task),
+            in_flight,
         });
     }
     let halt = Arc::clone(&stop);
@@ -249,7 +301,14 @@ where
                 // An error is a connection iceoryx2 could not make yet: the next wake-up
                 // retries.
                 while let Ok(Some(active)) = server.receive() {
-                    take::<Req, Rep, M, R, E>(active, &mut attach, &mut users, &runtime, &notifier);
+                    take::<Req, Rep, M, R, E>(
+                        active,
+                        &mut attach,
+                        &mut users,
+                        &runtime,
+                        &notifier,
+                        &flying,
+                    );
                 }
             }
         })
@@ -261,6 +320,7 @@ where
         port: name,
         stop,
         serving: Serving::Thread(Some(thread)),
+        in_flight,
     })
 }
 
@@ -274,6 +334,7 @@ fn take<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, E: Forward<M, R>>(
     users: &mut Users<E>,
     runtime: &tokio::runtime::Handle,
     notifier: &Arc<Mutex<Notifier<Svc>>>,
+    in_flight: &Arc<InFlight>,
 ) {
     let meta = *active.user_header();
     let active: Held<Req, Rep> = Arc::new(Mutex::new(active));
@@ -296,7 +357,8 @@ fn take<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, E: Forward<M, R>>(
         CONNECT => respond(&active, OK, 0, Rep::default(), notifier),
         SEND => {
             let request = M::from_request(&active);
-            let notifier = Arc::clone(notifier);
+            let (notifier, in_flight) = (Arc::clone(notifier), Arc::clone(in_flight));
+            in_flight.taken();
             // Each request waits on tokio, so that several remote modules' requests are
             // pending at once and the owner's order decides which it takes.
             runtime.spawn(async move {
@@ -305,6 +367,7 @@ fn take<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, E: Forward<M, R>>(
                     Some(reply) => respond(&active, OK, 0, reply, &notifier),
                     None => respond(&active, NO_REPLY, 0, Rep::default(), &notifier),
                 }
+                in_flight.answered();
             });
         }
         _ => respond(&active, MALFORMED, 0, Rep::default(), notifier),

@@ -12,8 +12,10 @@ use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, Shared, WireError, usage,
 };
 
+use crate::Exported;
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
 use crate::carry::{Asker, Carry, Pending, lend};
+use crate::export::InFlight;
 use crate::wire::{CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TOO_MANY_USERS};
 use crate::{IpcError, Remote, Wire};
 
@@ -35,6 +37,9 @@ pub struct Imported<Req: Send + 'static, Rep: Send + 'static, U: Usage = usage::
     port: Port<Req, Rep, U, AnyUser, 1>,
     /// Whatever keeps the bridge working: dropped, it stops.
     _bridge: Mutex<Box<dyn Send>>,
+    /// For a port whose owner starts each rendezvous: the owner's requests this process
+    /// has taken and not yet answered.
+    in_flight: Option<Arc<InFlight>>,
 }
 
 /// The forwarder and the waiter of one port's requests into another process: working
@@ -49,12 +54,37 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
         Self {
             port,
             _bridge: Mutex::new(Box::new(bridge)),
+            in_flight: None,
+        }
+    }
+
+    /// The same, answering the owner's requests through `server`.
+    pub(crate) fn serving(
+        port: Port<Req, Rep, U, AnyUser, 1>,
+        server: Exported,
+        bridge: impl Send + 'static,
+    ) -> Self {
+        let in_flight = Some(server.in_flight());
+        Self {
+            in_flight,
+            ..Self::new(port, (server, bridge))
         }
     }
 
     /// The local port: attach the importing module to it as to any port.
     pub fn port(&self) -> &Port<Req, Rep, U, AnyUser, 1> {
         &self.port
+    }
+
+    /// For a port whose owner starts each rendezvous (`SENDALL`, `CALLALL`, `QUERY`): waits
+    /// until every broadcast or query this process took from the owner has been answered
+    /// back to it. The answer crosses in a task of the runtime, after the module gave it: a
+    /// process that ends cleanly awaits this first, so that its modules' last answers
+    /// arrive. For other ports there is nothing to wait for.
+    pub async fn settled(&self) {
+        if let Some(in_flight) = &self.in_flight {
+            in_flight.settled().await;
+        }
     }
 }
 

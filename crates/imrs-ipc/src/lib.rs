@@ -56,7 +56,9 @@
 //! [`WireError`](imrs_core::imrs_ports::WireError). A process that dies does not hang its
 //! peers: a user's pending sends to a dead owner fail with
 //! [`SendError::NoReply`](imrs_core::imrs_ports::SendError::NoReply), and a new copy of
-//! the owner that exports the port again is served.
+//! the owner that exports the port again is served. A process that answers requests from
+//! others awaits [`Exported::settled`] (or [`Imported::settled`]) before it ends cleanly, so
+//! that its modules' last answers, which cross in tasks of the runtime, are not cut off.
 //!
 //! Service names are derived from the cell's name and the port's, so two cells on one
 //! host never meet; no iceoryx2 configuration file is needed. The owner's process creates a

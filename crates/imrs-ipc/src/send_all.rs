@@ -206,5 +206,5 @@ where
     )?;
     // Then the connection, which keeps the module attached on the owner's side.
     let connection = connect::<Req, Rep>(remote, &name, module)?;
-    Ok(Imported::new(local, (server, connection)))
+    Ok(Imported::serving(local, server, connection))
 }

@@ -979,3 +979,43 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
         }
     }
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() {
+    let cell = cell("loan-kill");
+    let mut first = started_owner("vision", &cell, "IMAGE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let mut camera = imported.port().user_named("CAMERA").unwrap();
+    // Two frames built while the owner lives; then kill -9 it.
+    let (mut doomed, mut kept) = (camera.loan().unwrap(), camera.loan().unwrap());
+    doomed.words[4] = 1;
+    kept.words[4] = 2;
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    let result = within(5, camera.send(doomed)).await;
+    assert!(
+        matches!(result, Err(SendError::NoReply { ref port }) if port == "IMAGE"),
+        "{result:?}"
+    );
+    // A new copy of the owner exports the port again. Until its server is seen, a send
+    // finds nobody; then new loans are served.
+    let _second = started_owner("vision", &cell, "IMAGE");
+    within(10, async {
+        loop {
+            let mut probe = camera.loan().unwrap();
+            probe.words[4] = 3;
+            match camera.send(probe).await {
+                Ok(reply) => break assert_eq!(reply.words[4], 9),
+                Err(SendError::NoReply { .. }) => {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+                Err(other) => panic!("{other:?}"),
+            }
+        }
+    })
+    .await;
+    // And the frame built before the death is still the sender's, and is served.
+    let reply = within(10, camera.send(kept)).await.unwrap();
+    assert_eq!(reply.words[4], 6);
+}

@@ -194,17 +194,23 @@ async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
             value: 2 * number.value,
         });
     }
+    // The last reply crosses after the module gave it: ends once it has.
+    imported.settled().await;
     Ok(())
 }
 
 async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_call_all::<Number, Number>(&Remote::new(cell)?, port, "CALLER", module)?;
-    answer(imported.port(), module, 4, n).await
+    answer(imported.port(), module, 4, n).await?;
+    imported.settled().await;
+    Ok(())
 }
 
 async fn child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_query::<Number, Number>(&Remote::new(cell)?, port, "PARENT", module)?;
-    answer(imported.port(), module, 5, n).await
+    answer(imported.port(), module, 5, n).await?;
+    imported.settled().await;
+    Ok(())
 }
 
 /// Answers `n` queries on `port` as `module`, each with `factor` times its number, from a
