@@ -64,14 +64,16 @@ fn main() {
     let runtime = runtime();
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
-    let (imrs_small, imrs_large, loaned_small, loaned_large) = runtime.block_on(async {
-        (
-            imrs_round_trips::<Small>(&cell, "SMALL", rounds).await,
-            imrs_round_trips::<Large>(&cell, "LARGE", rounds).await,
-            loaned_round_trips::<Small>(&cell, "SMALL_LOANED", rounds).await,
-            loaned_round_trips::<Large>(&cell, "LARGE_LOANED", rounds).await,
-        )
-    });
+    let imrs_small = in_task(&runtime, imrs_round_trips::<Small>(&cell, "SMALL", rounds));
+    let imrs_large = in_task(&runtime, imrs_round_trips::<Large>(&cell, "LARGE", rounds));
+    let loaned_small = in_task(
+        &runtime,
+        loaned_round_trips::<Small>(&cell, "SMALL_LOANED", rounds),
+    );
+    let loaned_large = in_task(
+        &runtime,
+        loaned_round_trips::<Large>(&cell, "LARGE_LOANED", rounds),
+    );
     let _ = child.kill();
     let _ = child.wait();
 
@@ -81,7 +83,10 @@ fn main() {
     let _ = child.kill();
     let _ = child.wait();
     let mut child = start_peer(&tight_cell, Peer::Tight);
-    let imrs_tight = runtime.block_on(imrs_round_trips::<Small>(&tight_cell, "SMALL", rounds));
+    let imrs_tight = in_task(
+        &runtime,
+        imrs_round_trips::<Small>(&tight_cell, "SMALL", rounds),
+    );
     let _ = child.kill();
     let _ = child.wait();
 
@@ -269,42 +274,72 @@ fn loaned_echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<
     })
 }
 
+/// `rounds` round trips, each timed, after a tenth as many to warm up. A macro, not an
+/// async closure: the round trips run in a task, and the future of an async closure that
+/// borrows the port's end is not `Send` for every lifetime, as a task needs.
+macro_rules! timed {
+    ($rounds:expr, $round_trip:block) => {{
+        for _ in 0..$rounds / 10 {
+            $round_trip
+        }
+        let mut times = Vec::with_capacity($rounds);
+        for _ in 0..$rounds {
+            let start = Instant::now();
+            $round_trip
+            times.push(start.elapsed());
+        }
+        times
+    }};
+}
+
+/// Runs `round_trips` where a module runs: in a task on the runtime's workers.
+fn in_task(
+    runtime: &tokio::runtime::Runtime,
+    round_trips: impl Future<Output = Vec<Duration>> + Send + 'static,
+) -> Vec<Duration> {
+    runtime
+        .block_on(runtime.spawn(round_trips))
+        .expect("the round trips ran")
+}
+
 /// Round trips of messages built in place: each loaned from the port (zeroed, in shared
 /// memory), sent, and its reply read where the owner's process wrote it.
-async fn loaned_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
+fn loaned_round_trips<T: Wire>(
+    cell: &str,
+    port: &str,
+    rounds: usize,
+) -> impl Future<Output = Vec<Duration>> + Send + 'static {
+    let (cell, port) = (cell.to_owned(), port.to_owned());
+    async move { loaned_round_trips_of::<T>(&cell, &port, rounds).await }
+}
+
+async fn loaned_round_trips_of<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
     let remote = Remote::new(cell).expect("a cell name");
     let imported = import_shared::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
-    timed(rounds, async || {
+    timed!(rounds, {
         let message = asker.loan().expect("a loan");
         let reply = asker.send(message).await.expect("a round trip");
         std::hint::black_box(&*reply);
     })
-    .await
 }
 
-async fn imrs_round_trips<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
+fn imrs_round_trips<T: Wire>(
+    cell: &str,
+    port: &str,
+    rounds: usize,
+) -> impl Future<Output = Vec<Duration>> + Send + 'static {
+    let (cell, port) = (cell.to_owned(), port.to_owned());
+    async move { imrs_round_trips_of::<T>(&cell, &port, rounds).await }
+}
+
+async fn imrs_round_trips_of<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
     let remote = Remote::new(cell).expect("a cell name");
     let imported = import::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
-    timed(rounds, async || {
+    timed!(rounds, {
         std::hint::black_box(asker.send(T::default()).await.expect("a round trip"));
     })
-    .await
-}
-
-/// `rounds` round trips, each timed, after a tenth as many to warm up.
-async fn timed(rounds: usize, mut round_trip: impl AsyncFnMut()) -> Vec<Duration> {
-    for _ in 0..rounds / 10 {
-        round_trip().await;
-    }
-    let mut times = Vec::with_capacity(rounds);
-    for _ in 0..rounds {
-        let start = Instant::now();
-        round_trip().await;
-        times.push(start.elapsed());
-    }
-    times
 }
 
 type RawService<T> =

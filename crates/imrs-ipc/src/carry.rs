@@ -28,6 +28,8 @@ pub(crate) type Active<Req, Rep> = ActiveRequest<Svc, Req, RequestMeta, Rep, Rep
 pub(crate) type Held<Req, Rep> = Arc<Mutex<Active<Req, Rep>>>;
 pub(crate) type Pending<Req, Rep> = PendingResponse<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 pub(crate) type Asker<Req, Rep> = Client<Svc, Req, RequestMeta, Rep, ReplyMeta>;
+pub(crate) type Server<Req, Rep> =
+    iceoryx2::port::server::Server<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 pub(crate) type Answer<Rep> = Response<Svc, Rep, ReplyMeta>;
 pub(crate) type Loan<Req, Rep> = RequestMut<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 type LoanUninit<Req, Rep> = RequestMutUninit<Svc, MaybeUninit<Req>, RequestMeta, Rep, ReplyMeta>;

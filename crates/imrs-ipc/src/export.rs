@@ -4,17 +4,23 @@
 //! back through shared memory.
 
 use std::collections::HashMap;
+use std::marker::PhantomData;
+use std::pin::Pin;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex, PoisonError, Weak};
+use std::task::{Context, Poll, Wake, Waker};
 use std::thread::JoinHandle;
 
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::{End, Name, Port, Shared, UserList, WireError, usage};
+use imrs_core::imrs_ports::usage::{Plain, Usage};
+use imrs_core::imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
-use crate::carry::{Active, Carry, Held};
+use crate::carry::{Active, Carry, Held, Server};
+use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
-    CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TOO_MANY_USERS,
+    CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TIGHT,
+    TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -58,7 +64,7 @@ impl From<WireError> for Refusal {
 pub struct Exported {
     port: Name,
     stop: Arc<AtomicBool>,
-    serving: Serving,
+    worker: Worker,
     in_flight: Arc<InFlight>,
 }
 
@@ -95,7 +101,7 @@ impl InFlight {
 /// Who serves the port's requests: a tokio task woken by the users' notify through tokio's
 /// reactor, or, where attaching a user connects a relay back to its process (a wait of its
 /// own), a thread of ours.
-enum Serving {
+enum Worker {
     Task(tokio::task::JoinHandle<()>),
     Thread(Option<JoinHandle<()>>),
 }
@@ -121,9 +127,9 @@ impl Exported {
 impl Drop for Exported {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Release);
-        match &mut self.serving {
-            Serving::Task(task) => task.abort(),
-            Serving::Thread(thread) => {
+        match &mut self.worker {
+            Worker::Task(task) => task.abort(),
+            Worker::Thread(thread) => {
                 if let Some(thread) = thread.take() {
                     let _ = thread.join();
                 }
@@ -140,13 +146,7 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
-    let port = port.clone();
-    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
-    // port's spin would keep it off the worker the owner spins on.
-    port.park_waits();
-    bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
-        Ok(port.user_named(module)?)
-    })
+    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
 }
 
 /// Exports `port`, a port of messages built in place ([`Shared`]), as [`export`] does a
@@ -158,17 +158,7 @@ pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
-    let port = port.clone();
-    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
-    // port's spin would keep it off the worker the owner spins on.
-    port.park_waits();
-    bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
-        remote,
-        Name::from(&port),
-        N,
-        false,
-        move |module: &str| Ok(port.user_named(module)?),
-    )
+    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
 }
 
 /// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
@@ -178,18 +168,9 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
-    let port = port.clone();
-    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
-    // port's spin would keep it off the worker the owner spins on.
-    port.park_waits();
-    bridge::<Req, Rep, Req, Rep, _, _>(remote, Name::from(&port), N, false, move |module: &str| {
-        Ok(port.user_named(module)?)
-    })
+    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
 }
 
-/// Serves port `name`'s requests from other processes: each remote module is attached by
-/// `attach`, and its requests (wire type `Req`, carried in the port as `M`) go in through
-/// its end.
 /// Exports `port`, a `RESPONSE` port of messages built in place ([`Shared`]), as
 /// [`export_response`] does a port of values: a remote module's query is read in place by
 /// the owner's response handler, which runs when the owner's order says and can build its
@@ -198,26 +179,60 @@ pub fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
-    let port = port.clone();
-    // The remote modules' side of each rendezvous is a task on this runtime: a TIGHT
-    // port's spin would keep it off the worker the owner spins on.
-    port.park_waits();
-    bridge::<Req, Rep, Shared<Req>, Shared<Rep>, _, _>(
-        remote,
-        Name::from(&port),
-        N,
-        false,
-        move |module: &str| Ok(port.user_named(module)?),
-    )
+    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
 }
 
+/// Exports `port`, whose remote users' requests (wire type `Req`, carried in the port as
+/// `M`) go in through each remote module's own end. On a TIGHT port the owner's spinning
+/// waits also do the bridge's work, in the owner's thread.
+fn export_port<Req, Rep, M, R, U, L, const N: usize>(
+    remote: &Remote,
+    port: &Port<M, R, U, L, N>,
+) -> Result<Exported, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    U: Usage,
+    U::Complement: Plain,
+    L: UserList,
+    End<M, R, U::Complement>: Forward<M, R>,
+{
+    let tight = port.process_type() == ProcessType::Tight;
+    let attached = port.clone();
+    let (exported, side) = bridge::<Req, Rep, M, R, _, _>(
+        remote,
+        Name::from(port),
+        N,
+        false,
+        tight,
+        move |module: &str| {
+            // The remote module's end waits in the bridge's task, which a spinning wait
+            // would keep off its worker: it parks, whatever the port's process type.
+            let mut end = attached.user_named(module)?;
+            end.park_waits();
+            Ok(end)
+        },
+    )?;
+    if tight {
+        port.pump_with(Turn(side));
+    }
+    Ok(exported)
+}
+
+/// Serves port `name`'s requests from other processes: each remote module is attached by
+/// `attach`, and its requests (wire type `Req`, carried in the port as `M`) go in through
+/// its end. `tight`: the port is TIGHT, which its users' processes are told when they
+/// connect. Also gives the bridge's side, for a spinning owner's turns.
 pub(crate) fn bridge<Req, Rep, M, R, E, A>(
     remote: &Remote,
     name: Name,
     users: usize,
     attach_blocks: bool,
-    mut attach: A,
-) -> Result<Exported, IpcError>
+    tight: bool,
+    attach: A,
+) -> Result<(Exported, Weak<Mutex<dyn Turns>>), IpcError>
 where
     Req: Wire,
     Rep: Wire,
@@ -244,47 +259,62 @@ where
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
     let in_flight = Arc::new(InFlight::default());
-    let flying = Arc::clone(&in_flight);
+    let woken = Arc::new(Woken::default());
+    let side = Arc::new(Mutex::new(Serving {
+        server,
+        attach,
+        users: HashMap::new(),
+        flights: Vec::new(),
+        // A bridge thread cannot poll the requests in flight: each is a task of its own.
+        spawn_on: attach_blocks.then(|| runtime.clone()),
+        notifier,
+        in_flight: Arc::clone(&in_flight),
+        waker: Waker::from(Arc::clone(&woken)),
+        woken: Arc::clone(&woken),
+        answered: Vec::new(),
+        quiet: Quiet::default(),
+        tight,
+        _carried: PhantomData,
+    }));
+    let weak = Arc::downgrade(&side) as Weak<Mutex<dyn Turns>>;
+    let serve = |side: &Mutex<Serving<Req, Rep, M, R, E, A>>| {
+        let mut side = side.lock().unwrap_or_else(PoisonError::into_inner);
+        side.serve(true);
+        side.announce();
+    };
     if !attach_blocks {
         // A task in the runtime the owner's module runs on, woken by the users' notify, so
-        // that a request reaches the module with no hand-over between threads.
+        // that a request reaches the module with no hand-over between threads; and by the
+        // requests in flight, when their replies come.
         let readiness = Readiness::new(listener, &name)?;
-        let task = runtime.clone().spawn(async move {
+        let task = runtime.spawn(async move {
             // The channel lives as long as the task: its node keeps the services open.
             let _channel = channel;
-            let mut users: Users<E> = HashMap::new();
             // Woken by a user's notify; and at each tick all the same, so that a request
             // whose notify was lost (or a peer that never sent one) waits a tick at most.
             let mut tick = tokio::time::interval(TICK);
             loop {
-                // An error is a connection iceoryx2 could not make yet: the next wake-up
-                // retries.
-                while let Ok(Some(active)) = server.receive() {
-                    take::<Req, Rep, M, R, E>(
-                        active,
-                        &mut attach,
-                        &mut users,
-                        &runtime,
-                        &notifier,
-                        &flying,
-                    );
-                }
+                serve(&side);
                 tokio::select! {
                     notified = readiness.notified() => {
                         if notified.is_err() {
                             return;
                         }
                     }
+                    () = woken.notify.notified() => {}
                     _ = tick.tick() => {}
                 }
             }
         });
-        return Ok(Exported {
-            port: name,
-            stop,
-            serving: Serving::Task(task),
-            in_flight,
-        });
+        return Ok((
+            Exported {
+                port: name,
+                stop,
+                worker: Worker::Task(task),
+                in_flight,
+            },
+            weak,
+        ));
     }
     let halt = Arc::clone(&stop);
     let thread = std::thread::Builder::new()
@@ -292,85 +322,207 @@ where
         .spawn(move || {
             // The channel lives as long as the thread: its node keeps the services open.
             let _channel = channel;
-            let mut users: Users<E> = HashMap::new();
             while !halt.load(Ordering::Acquire) {
                 // Blocks until a request event or the tick: no polling of the data.
                 if listener.timed_wait(|_| {}, TICK).is_err() {
                     break;
                 }
-                // An error is a connection iceoryx2 could not make yet: the next wake-up
-                // retries.
-                while let Ok(Some(active)) = server.receive() {
-                    take::<Req, Rep, M, R, E>(
-                        active,
-                        &mut attach,
-                        &mut users,
-                        &runtime,
-                        &notifier,
-                        &flying,
-                    );
-                }
+                serve(&side);
             }
         })
         .map_err(|error| IpcError::Transport {
             port: name.clone(),
             detail: format!("starting its bridge thread: {error}"),
         })?;
-    Ok(Exported {
-        port: name,
-        stop,
-        serving: Serving::Thread(Some(thread)),
-        in_flight,
-    })
+    Ok((
+        Exported {
+            port: name,
+            stop,
+            worker: Worker::Thread(Some(thread)),
+            in_flight,
+        },
+        weak,
+    ))
 }
 
 /// The remote modules' ends, by module.
 type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 
-/// One request from another process.
-fn take<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, E: Forward<M, R>>(
-    active: Active<Req, Rep>,
-    attach: &mut impl FnMut(&str) -> Result<E, Refusal>,
-    users: &mut Users<E>,
-    runtime: &tokio::runtime::Handle,
-    notifier: &Arc<Mutex<Notifier<Svc>>>,
-    in_flight: &Arc<InFlight>,
-) {
-    let meta = *active.user_header();
-    let active: Held<Req, Rep> = Arc::new(Mutex::new(active));
-    // A header a peer wrote garbage into is refused; the bridge goes on serving. Borrowed
-    // from the header's copy: a request allocates no name.
-    let Some(module) = meta.module() else {
-        respond(&active, MALFORMED, 0, Rep::default(), notifier);
-        return;
-    };
-    // A module this copy of the owner has not seen yet — the owner was restarted since the
-    // module connected — is attached now, as at its connection.
-    let end = match user(attach, users, module) {
-        Ok(end) => end,
-        Err((status, detail)) => {
-            respond(&active, status, detail, Rep::default(), notifier);
+/// A request gone into the real port through its module's end: it ends with the request,
+/// and the reply, if the port gave one.
+type Flight<Req, Rep, R> = Pin<Box<dyn Future<Output = (Held<Req, Rep>, Option<R>)> + Send>>;
+
+/// Wakes the bridge's task when a reply comes for a request in flight.
+#[derive(Default)]
+struct Woken {
+    flag: AtomicBool,
+    notify: tokio::sync::Notify,
+}
+
+impl Wake for Woken {
+    fn wake(self: Arc<Self>) {
+        self.wake_by_ref();
+    }
+
+    fn wake_by_ref(self: &Arc<Self>) {
+        self.flag.store(true, Ordering::Release);
+        self.notify.notify_one();
+    }
+}
+
+/// A port's bridge in its owner's process: the server that takes the remote modules'
+/// requests from shared memory, their ends of the real port, and the requests gone in
+/// through them and waiting for their replies.
+struct Serving<Req: Wire, Rep: Wire, M, R, E, A> {
+    server: Server<Req, Rep>,
+    attach: A,
+    users: Users<E>,
+    flights: Vec<Flight<Req, Rep, R>>,
+    /// Where each flight is spawned as a task of its own, for a bridge that is a thread.
+    spawn_on: Option<tokio::runtime::Handle>,
+    notifier: Arc<Mutex<Notifier<Svc>>>,
+    in_flight: Arc<InFlight>,
+    /// The flights' waker, which wakes the task.
+    waker: Waker,
+    woken: Arc<Woken>,
+    /// Requests answered by a spinning owner's turn, whose users' processes were not woken.
+    answered: Vec<Held<Req, Rep>>,
+    quiet: Quiet,
+    tight: bool,
+    _carried: PhantomData<fn(M)>,
+}
+
+impl<Req, Rep, M, R, E, A> Serving<Req, Rep, M, R, E, A>
+where
+    Req: Wire,
+    Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    E: Forward<M, R>,
+    A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
+{
+    /// Takes the requests that came, and answers those whose replies came; wakes the users'
+    /// processes, or, from a spinning owner's turn (`wake` false), holds the wake-ups back.
+    fn serve(&mut self, wake: bool) {
+        let mut came = false;
+        // An error is a connection iceoryx2 could not make yet: the next wake-up retries.
+        while let Ok(Some(active)) = self.server.receive() {
+            let Some(flight) = self.take(active) else {
+                continue;
+            };
+            match &self.spawn_on {
+                Some(runtime) => {
+                    let (notifier, in_flight) =
+                        (Arc::clone(&self.notifier), Arc::clone(&self.in_flight));
+                    runtime.spawn(async move {
+                        let (active, reply) = flight.await;
+                        respond(&active, reply);
+                        notify(&notifier);
+                        in_flight.answered();
+                    });
+                }
+                None => {
+                    self.flights.push(flight);
+                    came = true;
+                }
+            }
+        }
+        // A new flight goes in at its first poll; the others move when their replies come.
+        if !(came || self.woken.flag.swap(false, Ordering::AcqRel)) {
             return;
         }
-    };
-    match meta.kind {
-        CONNECT => respond(&active, OK, 0, Rep::default(), notifier),
-        SEND => {
-            let request = M::from_request(&active);
-            let (notifier, in_flight) = (Arc::clone(notifier), Arc::clone(in_flight));
-            in_flight.taken();
-            // Each request waits on tokio, so that several remote modules' requests are
-            // pending at once and the owner's order decides which it takes.
-            runtime.spawn(async move {
-                let reply = end.lock().await.forward(request).await;
-                match reply {
-                    Some(reply) => respond(&active, OK, 0, reply, &notifier),
-                    None => respond(&active, NO_REPLY, 0, Rep::default(), &notifier),
-                }
-                in_flight.answered();
-            });
+        let mut cx = Context::from_waker(&self.waker);
+        let mut at = 0;
+        while at < self.flights.len() {
+            let Poll::Ready((active, reply)) = self.flights[at].as_mut().poll(&mut cx) else {
+                at += 1;
+                continue;
+            };
+            drop(self.flights.swap_remove(at));
+            respond(&active, reply);
+            if wake {
+                notify(&self.notifier);
+                self.in_flight.answered();
+            } else {
+                self.answered.push(active);
+                self.quiet.hold();
+            }
         }
-        _ => respond(&active, MALFORMED, 0, Rep::default(), notifier),
+    }
+
+    /// One request from another process: answered at once, or gone into the real port as
+    /// the flight returned.
+    fn take(&mut self, active: Active<Req, Rep>) -> Option<Flight<Req, Rep, R>> {
+        let meta = *active.user_header();
+        let active: Held<Req, Rep> = Arc::new(Mutex::new(active));
+        let answer = |status: u32, detail: u32| {
+            reply(&active, status, detail, Rep::default());
+            notify(&self.notifier);
+            None
+        };
+        // A header a peer wrote garbage into is refused; the bridge goes on serving.
+        // Borrowed from the header's copy: a request allocates no name.
+        let Some(module) = meta.module() else {
+            return answer(MALFORMED, 0);
+        };
+        // A module this copy of the owner has not seen yet — the owner was restarted since
+        // the module connected — is attached now, as at its connection.
+        let end = match user(&mut self.attach, &mut self.users, module) {
+            Ok(end) => end,
+            Err((status, detail)) => return answer(status, detail),
+        };
+        match meta.kind {
+            CONNECT => answer(OK, if self.tight { TIGHT } else { 0 }),
+            SEND => {
+                let request = M::from_request(&active);
+                self.in_flight.taken();
+                // Each request waits on its own, so that several remote modules' requests
+                // are pending at once and the owner's order decides which it takes.
+                Some(Box::pin(async move {
+                    let reply = end.lock().await.forward(request).await;
+                    (active, reply)
+                }))
+            }
+            _ => answer(MALFORMED, 0),
+        }
+    }
+}
+
+impl<Req, Rep, M, R, E, A> Turns for Serving<Req, Rep, M, R, E, A>
+where
+    Req: Wire,
+    Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    E: Forward<M, R>,
+    A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
+{
+    fn turn(&mut self) {
+        self.serve(false);
+        // A user's process that took its reply has let its request go: it was not parked,
+        // and needs no wake-up.
+        let in_flight = &self.in_flight;
+        self.answered.retain(|active| {
+            let waiting = lock(active).is_connected();
+            if !waiting {
+                in_flight.answered();
+            }
+            waiting
+        });
+        if self.quiet.turn(!self.answered.is_empty()) {
+            self.announce();
+        }
+    }
+
+    fn announce(&mut self) {
+        self.quiet.take();
+        if self.answered.is_empty() {
+            return;
+        }
+        notify(&self.notifier);
+        for _ in self.answered.drain(..) {
+            self.in_flight.answered();
+        }
     }
 }
 
@@ -398,22 +550,37 @@ fn user<E>(
     }
 }
 
-/// Replies through shared memory, then wakes the users' bridges. The request is let go
-/// when the last holder drops it: here, or, for a request read in place, the module.
-fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(
+/// Replies through shared memory, with `status` and `detail`. The request is let go when
+/// the last holder drops it: here, or, for a request read in place, the module.
+fn reply<Req: Wire, Rep: Wire, R: Carry<Rep>>(
     active: &Held<Req, Rep>,
     status: u32,
     detail: u32,
     reply: R,
-    notifier: &Mutex<Notifier<Svc>>,
 ) {
     if let Some(mut response) = reply.into_reply(active) {
         *response.user_header_mut() = ReplyMeta { status, detail };
         // A user that died meanwhile cannot be answered; nothing else is lost.
         let _ = response.send();
     }
+}
+
+/// Replies with the port's reply, or says there was none.
+fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(active: &Held<Req, Rep>, answer: Option<R>) {
+    match answer {
+        Some(answer) => reply(active, OK, 0, answer),
+        None => reply(active, NO_REPLY, 0, Rep::default()),
+    }
+}
+
+/// Wakes the users' bridges: a reply is there.
+fn notify(notifier: &Mutex<Notifier<Svc>>) {
     let _ = notifier
         .lock()
         .unwrap_or_else(PoisonError::into_inner)
         .notify();
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }

@@ -2,21 +2,27 @@
 //! name and types whose owner is a bridge: a tokio task takes each local send into shared
 //! memory, and a thread waiting on iceoryx2's reply events hands each reply back.
 
+use std::marker::PhantomData;
 use std::sync::{Arc, Mutex, PoisonError};
+use std::task::{Context, Poll};
 use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{
-    AnyUser, End, Name, Port, PortSpec, ReplyHandle, ResponseEnd, Shared, WireError, usage,
+    AnyUser, End, Name, Port, PortSpec, ProcessType, ReplyHandle, ResponseEnd, Shared, WireError,
+    usage,
 };
 
 use crate::Exported;
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
 use crate::carry::{Asker, Carry, Pending, lend};
 use crate::export::InFlight;
-use crate::wire::{CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TOO_MANY_USERS};
+use crate::turn::{Quiet, Turn, Turns};
+use crate::wire::{
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
+};
 use crate::{IpcError, Remote, Wire};
 
 /// A port's client, shared by its forwarder and its lender.
@@ -42,11 +48,10 @@ pub struct Imported<Req: Send + 'static, Rep: Send + 'static, U: Usage = usage::
     in_flight: Option<Arc<InFlight>>,
 }
 
-/// The forwarder and the waiter of one port's requests into another process: working
-/// while this is held.
+/// The task that carries one port's requests into another process: working while this is
+/// held.
 pub(crate) struct Relay {
-    waiter: tokio::task::JoinHandle<()>,
-    forwarder: tokio::task::JoinHandle<()>,
+    task: tokio::task::JoinHandle<()>,
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
@@ -90,8 +95,7 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
 
 impl Drop for Relay {
     fn drop(&mut self) {
-        self.forwarder.abort();
-        self.waiter.abort();
+        self.task.abort();
     }
 }
 
@@ -184,27 +188,52 @@ pub fn import_response_shared<Req: Wire, Rep: Wire>(
 /// The local owner's side of an imported port: where the bridge takes each request, and
 /// the right to answer it.
 pub(crate) trait Take<Req, Rep>: Send + 'static {
-    /// The next request, or `None` once the port is done.
-    fn next(&mut self) -> impl Future<Output = Option<(Req, ReplyHandle<Rep>)>> + Send + '_;
+    /// The next request, or `None` once the port is done; the task is woken when one comes.
+    fn poll_next(&mut self, cx: &mut Context<'_>) -> Poll<Option<(Req, ReplyHandle<Rep>)>>;
+    /// The next request, if one is waiting now.
+    fn try_next(&mut self) -> Option<(Req, ReplyHandle<Rep>)>;
+    /// Makes the bridge's waits park at once: the task waits here, and a spinning module's
+    /// turns take from here, which a spin of the task's own would hold up.
+    fn park(&mut self);
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
-    async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
-        self.receive().await.ok()
+    fn poll_next(&mut self, cx: &mut Context<'_>) -> Poll<Option<(Req, ReplyHandle<Rep>)>> {
+        // A receive dropped before it completes takes nothing: one made at each poll is as
+        // good as one kept.
+        std::pin::pin!(self.receive()).poll(cx).map(Result::ok)
+    }
+
+    fn try_next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+        self.try_receive()
+    }
+
+    fn park(&mut self) {
+        self.park_waits();
     }
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
-    async fn next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+    fn poll_next(&mut self, cx: &mut Context<'_>) -> Poll<Option<(Req, ReplyHandle<Rep>)>> {
         loop {
-            std::future::poll_fn(|cx| self.poll_pending(cx))
-                .await
-                .ok()?;
-            if let Some(taken) = self.take() {
-                return Some(taken);
+            match self.poll_pending(cx) {
+                Poll::Ready(Ok(())) => {
+                    if let Some(taken) = self.take() {
+                        return Poll::Ready(Some(taken));
+                    }
+                }
+                Poll::Ready(Err(_)) => return Poll::Ready(None),
+                Poll::Pending => return Poll::Pending,
             }
         }
     }
+
+    fn try_next(&mut self) -> Option<(Req, ReplyHandle<Rep>)> {
+        self.take()
+    }
+
+    // A response end's wait for its queries never spins.
+    fn park(&mut self) {}
 }
 
 /// Imports port `port` for `module`: a local port of message types `M` and `R`, whose
@@ -225,10 +254,25 @@ where
     T: Take<M, R>,
 {
     let name = Name::from(port);
-    let local: Port<M, R, U, AnyUser, 1> =
-        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
+    let connection = connect::<Req, Rep>(remote, &name, module)?;
+    // The port waits as its owner declared it: a TIGHT port's sends spin here too.
+    let process_type = if connection.tight {
+        ProcessType::Tight
+    } else {
+        ProcessType::default()
+    };
+    let local: Port<M, R, U, AnyUser, 1> = Port::declare(
+        PortSpec::new(name.clone(), owner)
+            .user_list([module])
+            .process_type(process_type),
+    );
     let taken = own(&local).map_err(IpcError::Local)?;
-    let (relay, client) = relay::<Req, Rep, M, R, T>(remote, &name, module, taken)?;
+    let tight = connection.tight;
+    let (relay, side) = relay_connected::<Req, Rep, M, R, T>(connection, &name, module, taken)?;
+    if tight {
+        local.pump_with(Turn(Arc::downgrade(&side)));
+    }
+    let client = Arc::clone(&side.lock().unwrap_or_else(PoisonError::into_inner).client);
     Ok(Imported::new(M::lend_from(local, client, name), relay))
 }
 
@@ -269,8 +313,8 @@ pub(crate) fn relay<Req, Rep, M, R, T>(
     remote: &Remote,
     name: &Name,
     module: &str,
-    mut taken: T,
-) -> Result<(Relay, SharedAsker<Req, Rep>), IpcError>
+    taken: T,
+) -> Result<Relay, IpcError>
 where
     Req: Wire,
     Rep: Wire,
@@ -278,7 +322,93 @@ where
     R: Carry<Rep>,
     T: Take<M, R>,
 {
-    let name = name.clone();
+    let connection = connect::<Req, Rep>(remote, name, module)?;
+    Ok(relay_connected::<Req, Rep, M, R, T>(connection, name, module, taken)?.0)
+}
+
+/// One port's bridge in a user's process: the local owner's end through which the
+/// importing module's requests are taken, the client that sends them into shared memory,
+/// and the requests sent and waiting for their replies.
+pub(crate) struct Relaying<Req: Wire, Rep: Wire, M, R, T> {
+    taken: T,
+    client: SharedAsker<Req, Rep>,
+    waiting: Vec<Waiting<Req, Rep, R>>,
+    module: String,
+    wake_owner: Notifier<Svc>,
+    /// Requests sent by a spinning module's turn, whose owner was not woken.
+    quiet: Quiet,
+    _carried: PhantomData<fn(M)>,
+}
+
+impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>
+    Relaying<Req, Rep, M, R, T>
+{
+    /// Sends `request` to the owner, and keeps `reply` for its answer; wakes the owner, or,
+    /// from a spinning module's turn, holds the wake-up back.
+    fn forward(&mut self, request: M, reply: ReplyHandle<R>, wake: bool) {
+        let sent = {
+            let client = self.client.lock().unwrap_or_else(PoisonError::into_inner);
+            request.into_request(&client).and_then(|mut loan| {
+                *loan.user_header_mut() = RequestMeta::new(SEND, &self.module);
+                loan.send().ok()
+            })
+        };
+        // Not sent (no room, no owner): the reply handle is dropped, and the local sender
+        // gets `SendError::NoReply` at once.
+        let Some(pending) = sent else { return };
+        self.waiting.push((pending, Some(reply)));
+        if wake {
+            self.announce_now();
+        } else {
+            self.quiet.hold();
+        }
+    }
+
+    fn announce_now(&mut self) {
+        self.quiet.take();
+        let _ = self.wake_owner.notify();
+    }
+}
+
+impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>> Turns
+    for Relaying<Req, Rep, M, R, T>
+{
+    fn turn(&mut self) {
+        while let Some((request, reply)) = self.taken.try_next() {
+            self.forward(request, reply, false);
+        }
+        look(&mut self.waiting);
+        if self.quiet.turn(!self.waiting.is_empty()) {
+            self.announce_now();
+        }
+    }
+
+    fn announce(&mut self) {
+        if self.quiet.take() {
+            let _ = self.wake_owner.notify();
+        }
+    }
+}
+
+type Relayed<Req, Rep, M, R, T> = Arc<Mutex<Relaying<Req, Rep, M, R, T>>>;
+
+/// A bridge's task, and its side, which a spinning module's turns share.
+type Bridged<Req, Rep, M, R, T> = (Relay, Relayed<Req, Rep, M, R, T>);
+
+/// [`relay`], over a connection made.
+fn relay_connected<Req, Rep, M, R, T>(
+    connection: Connection<Req, Rep>,
+    name: &Name,
+    module: &str,
+    mut taken: T,
+) -> Result<Bridged<Req, Rep, M, R, T>, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    T: Take<M, R>,
+{
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
         port: name.clone(),
         detail: "import it from within the tokio runtime its cell runs on".into(),
@@ -288,42 +418,31 @@ where
         client,
         listener,
         wake_owner,
-    } = connect(remote, &name, module)?;
+        tight: _,
+    } = connection;
+    taken.park();
     // A task in the runtime the importing module runs on, woken by the owner's notify
-    // through tokio's reactor: a reply reaches its sender with no hand-over between threads.
-    let readiness = Readiness::new(listener, &name)?;
-    let (to_waiter, incoming) = tokio::sync::mpsc::unbounded_channel();
-    let waiter = runtime.spawn(async move {
-        // The channel lives as long as the waiter: its node keeps the services open.
-        let _channel = channel;
-        hand_back_replies::<Req, Rep, R>(&readiness, incoming).await;
-    });
-
-    let (client, module) = (Arc::new(Mutex::new(client)), module.to_owned());
-    let lender = Arc::clone(&client);
-    let wake_owner = Arc::new(Mutex::new(wake_owner));
-    let forwarder = runtime.spawn(async move {
-        while let Some((request, reply)) = taken.next().await {
-            let sent = {
-                let client = client.lock().unwrap_or_else(PoisonError::into_inner);
-                request.into_request(&client).and_then(|mut loan| {
-                    *loan.user_header_mut() = RequestMeta::new(SEND, &module);
-                    loan.send().ok()
-                })
-            };
-            // Not sent (no room, no owner): the reply handle is dropped, and the local
-            // sender gets `SendError::NoReply` at once.
-            let Some(pending) = sent else { continue };
-            if to_waiter.send((pending, reply)).is_err() {
-                break;
-            }
-            let _ = wake_owner
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .notify();
+    // through tokio's reactor, and by the module's sends: a request reaches shared memory,
+    // and a reply its sender, with no hand-over between threads.
+    let readiness = Readiness::new(listener, name)?;
+    let side = Arc::new(Mutex::new(Relaying {
+        taken,
+        client: Arc::new(Mutex::new(client)),
+        waiting: Vec::new(),
+        module: module.to_owned(),
+        wake_owner,
+        quiet: Quiet::default(),
+        _carried: PhantomData,
+    }));
+    let task = runtime.spawn({
+        let side = Arc::clone(&side);
+        async move {
+            // The channel lives as long as the task: its node keeps the services open.
+            let _channel = channel;
+            relay_requests(&side, &readiness).await;
         }
     });
-    Ok((Relay { waiter, forwarder }, lender))
+    Ok((Relay { task }, side))
 }
 
 /// A user process's connection to a port's owner: the services, the client, and the
@@ -333,6 +452,8 @@ pub(crate) struct Connection<Req: Wire, Rep: Wire> {
     pub(crate) client: Asker<Req, Rep>,
     pub(crate) listener: Listener<Svc>,
     pub(crate) wake_owner: Notifier<Svc>,
+    /// Whether the owner declared the port TIGHT: its sends spin, and so may the owner.
+    pub(crate) tight: bool,
 }
 
 /// Opens port `name` of `remote` as a client and connects as module `module`: the owner
@@ -354,12 +475,13 @@ pub(crate) fn connect<Req: Wire, Rep: Wire>(
             })?;
     let listener = channel.listener(&channel.replied)?;
     let wake_owner = channel.notifier(&channel.requested)?;
-    handshake(&client, &listener, &wake_owner, name, module)?;
+    let tight = handshake(&client, &listener, &wake_owner, name, module)?;
     Ok(Connection {
         channel,
         client,
         listener,
         wake_owner,
+        tight,
     })
 }
 
@@ -371,7 +493,7 @@ fn handshake<Req: Wire, Rep: Wire>(
     wake_owner: &Notifier<Svc>,
     port: &Name,
     module: &str,
-) -> Result<(), IpcError> {
+) -> Result<bool, IpcError> {
     let transport = |detail: String| IpcError::Transport {
         port: port.clone(),
         detail,
@@ -391,7 +513,7 @@ fn handshake<Req: Wire, Rep: Wire>(
             let meta = *response.user_header();
             let (port, module) = (port.clone(), Name::from(module));
             return match meta.status {
-                OK => Ok(()),
+                OK => Ok(meta.detail == TIGHT),
                 NOT_ON_USER_LIST => {
                     Err(IpcError::Refused(WireError::NotOnUserList { port, module }))
                 }
@@ -410,20 +532,21 @@ fn handshake<Req: Wire, Rep: Wire>(
     Err(IpcError::NoOwner { port: port.clone() })
 }
 
-/// The waiter: woken by the owner's notify, or by a request sent; hands each reply to its
-/// local sender, and drops the handles of requests whose owner is gone, so that their
-/// senders fail at once.
-async fn hand_back_replies<Req: Wire, Rep: Wire, R: Carry<Rep>>(
+/// The bridge's task: forwards each request the importing module sends, and hands each
+/// reply back to its sender; woken by the module's send, by the owner's notify, and every
+/// half second while requests wait, to see whether the owner died (their senders then fail
+/// at once). A spinning module's turns do the same between its wake-ups.
+async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>(
+    side: &Mutex<Relaying<Req, Rep, M, R, T>>,
     readiness: &Readiness,
-    mut incoming: tokio::sync::mpsc::UnboundedReceiver<(Pending<Req, Rep>, ReplyHandle<R>)>,
 ) {
-    let mut waiting: Vec<Waiting<Req, Rep, R>> = Vec::new();
-    // Every half second while something waits: see whether a peer died.
+    let lock = || side.lock().unwrap_or_else(PoisonError::into_inner);
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     loop {
+        let waiting = !lock().waiting.is_empty();
         tokio::select! {
-            sent = incoming.recv() => match sent {
-                Some((pending, reply)) => waiting.push((pending, Some(reply))),
+            taken = std::future::poll_fn(|cx| lock().taken.poll_next(cx)) => match taken {
+                Some((request, reply)) => lock().forward(request, reply, true),
                 None => return,
             },
             notified = readiness.notified() => {
@@ -431,12 +554,16 @@ async fn hand_back_replies<Req: Wire, Rep: Wire, R: Carry<Rep>>(
                     return;
                 }
             }
-            _ = sweep.tick(), if !waiting.is_empty() => sweep_dead(),
+            _ = sweep.tick(), if waiting => sweep_dead(),
         }
-        while let Ok((pending, reply)) = incoming.try_recv() {
-            waiting.push((pending, Some(reply)));
+        let mut side = lock();
+        while let Some((request, reply)) = side.taken.try_next() {
+            side.forward(request, reply, true);
         }
-        look(&mut waiting);
+        // Wake-ups a spinning module's turns held back go now: the task runs when the
+        // module no longer spins.
+        side.announce();
+        look(&mut side.waiting);
     }
 }
 

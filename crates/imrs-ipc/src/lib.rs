@@ -130,6 +130,7 @@ mod error;
 mod export;
 mod import;
 mod send_all;
+mod turn;
 mod wire;
 
 pub use error::IpcError;

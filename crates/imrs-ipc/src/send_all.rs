@@ -120,14 +120,16 @@ where
     // The owner starts each rendezvous here; its relays are parked.
     // Attaching a remote module connects a relay back to its process: a wait of its own,
     // kept off tokio's workers.
-    bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, move |module: &str| {
-        // The module's own end of the real port: what it receives goes to its process.
-        let end = user_end(&port, module)?;
-        let _entered = runtime.enter();
-        relay::<Req, Rep, Req, Rep, T>(&cell, &to_module(&served, module), owner.as_str(), end)
-            .map(|(relay, _)| Relayed { _relay: relay })
-            .map_err(|_| Refusal::Failed)
-    })
+    let (exported, _) =
+        bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, false, move |module: &str| {
+            // The module's own end of the real port: what it receives goes to its process.
+            let end = user_end(&port, module)?;
+            let _entered = runtime.enter();
+            relay::<Req, Rep, Req, Rep, T>(&cell, &to_module(&served, module), owner.as_str(), end)
+                .map(|relay| Relayed { _relay: relay })
+                .map_err(|_| Refusal::Failed)
+        })?;
+    Ok(exported)
 }
 
 /// Imports a `SENDALL` port of another process for module `module` of this one: a port of
@@ -189,10 +191,11 @@ where
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
     // Its one user is the owner's relay.
-    let server = bridge::<Req, Rep, Req, Rep, _, _>(
+    let (server, _) = bridge::<Req, Rep, Req, Rep, _, _>(
         remote,
         to_module(&name, module),
         1,
+        false,
         false,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {

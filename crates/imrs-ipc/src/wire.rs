@@ -79,7 +79,8 @@ impl RequestMeta {
 #[type_name("imrs_ipc::ReplyMeta")]
 pub(crate) struct ReplyMeta {
     pub(crate) status: u32,
-    /// For a refused connection: the port's capacity, where it matters.
+    /// For a refused connection: the port's capacity, where it matters; for an accepted
+    /// one, how the port waits ([`TIGHT`] or not).
     pub(crate) detail: u32,
 }
 
@@ -90,6 +91,9 @@ pub(crate) const TOO_MANY_USERS: u32 = 2;
 pub(crate) const REFUSED: u32 = 3;
 pub(crate) const MALFORMED: u32 = 4;
 pub(crate) const NO_REPLY: u32 = 5;
+
+/// In the answer to a connection: the owner declared the port TIGHT.
+pub(crate) const TIGHT: u32 = 1;
 
 /// Where a cell's ports cross: the cell's name, from which every service name is derived, so
 /// that two cells on one host never meet.

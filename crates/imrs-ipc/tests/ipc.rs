@@ -7,7 +7,7 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_core::imrs_ports::{SendError, Shared, WireError};
+use imrs_core::imrs_ports::{ProcessType, SendError, Shared, WireError};
 use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import, import_shared};
 
 /// The peer's message: the same by name, size and alignment.
@@ -779,6 +779,37 @@ async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_send
         matches!(result, Err(SendError::NoReply { ref port }) if port == "DOUBLE"),
         "{result:?}"
     );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tight_port_is_served_whether_the_other_side_spins_or_has_parked() {
+    let cell = cell("tight-turns");
+    let _owner = started_owner("tight-owner", &cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    // The owner declared the port TIGHT: the importing module's waits spin too.
+    assert_eq!(imported.port().process_type(), ProcessType::Tight);
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    let mut ask = async move |value: u64| {
+        let reply = within(5, asker.send(Number { value })).await.unwrap();
+        assert_eq!(reply.value, 2 * value);
+    };
+    // Both spinning: the requests and replies move in the two modules' own turns.
+    for value in 1..=500 {
+        ask(value).await;
+    }
+    // The owner has parked between requests: each request's wake-up must reach it.
+    for value in 1..=5 {
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        ask(value).await;
+    }
+    // The owner answers a second later, long after the sender parked: the reply's wake-up
+    // must reach the sender.
+    ask(1001).await;
+    // And spinning again, as before.
+    for value in 1..=100 {
+        ask(value).await;
+    }
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -16,6 +16,8 @@ pub(crate) struct Attachment<Req, Rep> {
     pub(crate) at: SlotId,
     pub(crate) module: Name,
     pub(crate) timeout: Option<Duration>,
+    /// Whether this end's waits park at once ([`End::park_waits`](crate::End::park_waits)).
+    pub(crate) parked: bool,
 }
 
 impl<Req, Rep> Attachment<Req, Rep> {
@@ -145,10 +147,26 @@ impl<Req, Rep> Attachment<Req, Rep> {
 
     /// How long a wait on this end may spin before it parks.
     pub(crate) fn spins(&self) -> u32 {
-        if self.core.parked.load(Ordering::Relaxed) {
+        if self.parked || self.core.parked.load(Ordering::Relaxed) {
             return 0;
         }
         self.core.meta.process_type.spins()
+    }
+}
+
+impl<Req, Rep> Attachment<Req, Rep> {
+    /// The transport's turn between two looks of a spinning wait, if it has one.
+    pub(crate) fn pump(&self) {
+        if let Some(pump) = self.core.pump.get() {
+            pump.pump();
+        }
+    }
+
+    /// Tells the transport, if any, that a spinning wait parks now.
+    pub(crate) fn parking(&self) {
+        if let Some(pump) = self.core.pump.get() {
+            pump.parking();
+        }
     }
 }
 

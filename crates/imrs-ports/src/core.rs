@@ -11,6 +11,7 @@ use crate::clock::SharedClock;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
+use crate::pump::Pump;
 use crate::shared::Lender;
 use crate::shown::Shown;
 use crate::slot::Slot;
@@ -122,6 +123,9 @@ pub(crate) struct Core<Req, Rep> {
     /// Whether waits park at once, whatever the process type says
     /// ([`Port::park_waits`](crate::Port::park_waits)).
     pub(crate) parked: AtomicBool,
+    /// The transport's turn in a spinning wait, if a transport gives one
+    /// ([`Port::pump_with`](crate::Port::pump_with)).
+    pub(crate) pump: OnceLock<Box<dyn Pump>>,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -141,6 +145,7 @@ impl<Req, Rep> Core<Req, Rep> {
             shown: OnceLock::new(),
             lender: OnceLock::new(),
             parked: AtomicBool::new(false),
+            pump: OnceLock::new(),
         }
     }
 

@@ -43,6 +43,13 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         self.attachment.timeout
     }
 
+    /// Makes this end's waits park at once, whatever the port's process type says: for an
+    /// end a transport waits on in a task of its own, beside a module that spins on the
+    /// port's other end ([`Port::pump_with`](crate::Port::pump_with)).
+    pub fn park_waits(&mut self) {
+        self.attachment.parked = true;
+    }
+
     /// The port's name.
     pub fn port(&self) -> &Name {
         self.attachment.port()

@@ -16,6 +16,7 @@ use crate::meta::{Name, Named, PortMeta};
 use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
+use crate::pump::Pump;
 use crate::response::ResponseEnd;
 use crate::shared::LoanError;
 use crate::shown::Shown;
@@ -188,6 +189,17 @@ where
         self.core.parked.store(true, Ordering::Relaxed);
     }
 
+    /// Gives `pump` a turn between the looks of each wait on the port that spins (a TIGHT
+    /// port's), in the waiting module's own thread: for a transport that can move a message
+    /// there rather than in a task of its own, which would first have to be woken. The
+    /// ends the transport itself waits on should park ([`End::park_waits`]). The first pump
+    /// set holds, for every handle of the port.
+    ///
+    /// [`End::park_waits`]: crate::End::park_waits
+    pub fn pump_with(&self, pump: impl Pump) {
+        let _first_holds = self.core.pump.set(Box::new(pump));
+    }
+
     /// Shows the port's messages and replies as `Debug` writes them, in the event log of a
     /// cell that asks for them (a recorder does; see [`shown`](crate::shown)). The first way
     /// of showing set holds, for every handle of the port.
@@ -287,6 +299,7 @@ where
             at: SlotId::Owner,
             module: meta.owner.clone(),
             timeout: meta.timeout,
+            parked: false,
         })
     }
 
@@ -400,6 +413,7 @@ pub(crate) fn attach_user<Req: Send + 'static, Rep: Send + 'static>(
         at: SlotId::User(index),
         module,
         timeout: None,
+        parked: false,
     })
 }
 

@@ -197,13 +197,18 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
             panic!("a send or query polled after it completed");
         }
 
-        for _ in 0..attachment.spins() {
+        let spins = attachment.spins();
+        for _ in 0..spins {
             // SAFETY: as above, and the request is in the slot.
             if let Some(answer) = unsafe { slot.try_answer() } {
                 *this.stage = Stage::Done;
                 return Poll::Ready(finish::<Req, Rep, O>(answer, port));
             }
+            attachment.pump();
             std::hint::spin_loop();
+        }
+        if spins > 0 {
+            attachment.parking();
         }
         // SAFETY: as above.
         if let Poll::Ready(answer) = unsafe { slot.poll_answer(cx) } {

@@ -74,11 +74,18 @@ pub(crate) fn poll_take<Req, Rep>(
     attachment: &Attachment<Req, Rep>,
     cx: &mut Context<'_>,
 ) -> Poll<(Req, SlotId)> {
-    for _ in 0..=attachment.spins() {
+    let spins = attachment.spins();
+    for _ in 0..=spins {
         if let Some(taken) = attachment.try_take() {
             return Poll::Ready(taken);
         }
+        if spins > 0 {
+            attachment.pump();
+        }
         std::hint::spin_loop();
+    }
+    if spins > 0 {
+        attachment.parking();
     }
     attachment.register_server(cx);
     // A post between the last look and the registration would have found no waker.

@@ -1,0 +1,107 @@
+//! A bridge's turn in the thread of a module spinning on a TIGHT port.
+//!
+//! Raw iceoryx2 between two spinning processes is a round trip of a few microseconds: each
+//! side looks at shared memory in a loop, and nobody is woken. A bridge of tokio tasks adds
+//! to each crossing a task woken, a thread woken, and an event sent to the other process —
+//! ten times the round trip itself. So on a TIGHT port the bridge's work is also done in the
+//! spinning module's own thread ([`Pump`]): the user's send takes its request into shared
+//! memory itself and reads the reply there; the owner's receive takes the request from
+//! shared memory itself and sends the reply. The wake-up of the other process is held back
+//! while it may be spinning too, and sent as soon as it may not be: when the other side has
+//! not taken the message within [`QUIET_TURNS`] turns, when the spinning wait parks, or
+//! when the bridge's task runs. The tasks stay, for every wait that parks.
+
+use std::sync::{Mutex, PoisonError, Weak};
+
+use imrs_core::imrs_ports::Pump;
+
+/// How many turns a message waits, unannounced, for a spinning peer to take it before the
+/// peer is woken: a few tens of microseconds, against a round trip of a few.
+pub(crate) const QUIET_TURNS: u32 = 256;
+
+/// One side of a bridge, as a spinning module's turn sees it.
+pub(crate) trait Turns: Send + 'static {
+    /// Moves what has arrived, either way, holding back the wake-ups of the other process.
+    fn turn(&mut self);
+    /// Sends the wake-ups held back.
+    fn announce(&mut self);
+}
+
+/// The pump of a bridge side: a turn, skipped while the bridge's task is at work. The port
+/// holds its pump, and the bridge holds the port's ends: the pump holds the bridge weakly,
+/// so that the bridge still goes when its task ends.
+pub(crate) struct Turn<S: ?Sized>(pub(crate) Weak<Mutex<S>>);
+
+impl<S: Turns + ?Sized> Pump for Turn<S> {
+    fn pump(&self) {
+        let Some(side) = self.0.upgrade() else {
+            return;
+        };
+        // Busy: the task is moving the messages now; the next turn looks again.
+        if let Ok(mut side) = side.try_lock() {
+            side.turn();
+        }
+    }
+
+    fn parking(&self) {
+        if let Some(side) = self.0.upgrade() {
+            side.lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .announce();
+        }
+    }
+}
+
+/// Wake-ups held back from a peer that may be spinning, and the turns since the first.
+#[derive(Debug, Default)]
+pub(crate) struct Quiet {
+    turns: Option<u32>,
+}
+
+impl Quiet {
+    /// A message went without its wake-up.
+    pub(crate) fn hold(&mut self) {
+        self.turns.get_or_insert(0);
+    }
+
+    /// A turn passed with `waiting` messages not yet taken by the peer: whether to wake it
+    /// now, its held-back messages having waited long enough.
+    pub(crate) fn turn(&mut self, waiting: bool) -> bool {
+        let Some(turns) = &mut self.turns else {
+            return false;
+        };
+        if !waiting {
+            self.turns = None;
+            return false;
+        }
+        *turns += 1;
+        *turns > QUIET_TURNS
+    }
+
+    /// Whether a wake-up is held back; forgets it, as the caller sends it now.
+    pub(crate) fn take(&mut self) -> bool {
+        self.turns.take().is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_held_wake_up_goes_after_its_quiet_turns_unless_the_peer_took_the_message() {
+        let mut quiet = Quiet::default();
+        assert!(!quiet.turn(true), "nothing held, nothing to announce");
+        quiet.hold();
+        for _ in 0..QUIET_TURNS {
+            assert!(!quiet.turn(true));
+        }
+        assert!(quiet.turn(true), "the peer did not take it: wake it");
+        assert!(quiet.take());
+        assert!(!quiet.take(), "announced once");
+
+        quiet.hold();
+        assert!(!quiet.turn(false), "taken: nothing to announce");
+        assert!(!quiet.take());
+    }
+}
