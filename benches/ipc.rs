@@ -12,6 +12,9 @@
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
 //! a raw iceoryx2 round trip whose client and server both spin.
 //!
+//! Each IMRS case runs where a module runs, in a task on the runtime's workers; each raw
+//! case in a thread of its own.
+//!
 //! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
 //! that the benchmark cannot rot. The peers are this same binary, started again with
 //! `IMRS_IPC_BENCH_PEER` set.

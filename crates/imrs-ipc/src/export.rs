@@ -1,7 +1,8 @@
-//! The owner's side: a port exported to other processes. A bridge thread waits on
-//! iceoryx2's request events; each request goes into the real port from the remote module's
-//! own end — a send, or a query its owner's order answers — on tokio, and its reply goes
-//! back through shared memory.
+//! The owner's side: a port exported to other processes. The bridge's task, woken by
+//! iceoryx2's request events, takes each request into the real port from the remote
+//! module's own end — a send, or a query its owner's order answers — and, woken again when
+//! the reply comes, sends it back through shared memory. On a TIGHT port the owner's
+//! spinning receive does the same in its turns.
 
 use std::collections::HashMap;
 use std::marker::PhantomData;
@@ -348,9 +349,10 @@ where
 /// The remote modules' ends, by module.
 type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 
-/// A request gone into the real port through its module's end: it ends with the request,
-/// and the reply, if the port gave one.
-type Flight<Req, Rep, R> = Pin<Box<dyn Future<Output = (Held<Req, Rep>, Option<R>)> + Send>>;
+/// A request gone into the real port through its module's end: it ends with the request
+/// answered in shared memory, the other process not yet woken. It answers where the reply
+/// comes out, so that a large reply is not moved on.
+type Flight<Req, Rep> = Pin<Box<dyn Future<Output = Held<Req, Rep>> + Send>>;
 
 /// Wakes the bridge's task when a reply comes for a request in flight.
 #[derive(Default)]
@@ -377,7 +379,7 @@ struct Serving<Req: Wire, Rep: Wire, M, R, E, A> {
     server: Server<Req, Rep>,
     attach: A,
     users: Users<E>,
-    flights: Vec<Flight<Req, Rep, R>>,
+    flights: Vec<Flight<Req, Rep>>,
     /// Where each flight is spawned as a task of its own, for a bridge that is a thread.
     spawn_on: Option<tokio::runtime::Handle>,
     notifier: Arc<Mutex<Notifier<Svc>>>,
@@ -389,7 +391,7 @@ struct Serving<Req: Wire, Rep: Wire, M, R, E, A> {
     answered: Vec<Held<Req, Rep>>,
     quiet: Quiet,
     tight: bool,
-    _carried: PhantomData<fn(M)>,
+    _carried: PhantomData<fn(M, R)>,
 }
 
 impl<Req, Rep, M, R, E, A> Serving<Req, Rep, M, R, E, A>
@@ -415,8 +417,7 @@ where
                     let (notifier, in_flight) =
                         (Arc::clone(&self.notifier), Arc::clone(&self.in_flight));
                     runtime.spawn(async move {
-                        let (active, reply) = flight.await;
-                        respond(&active, reply);
+                        let _answered = flight.await;
                         notify(&notifier);
                         in_flight.answered();
                     });
@@ -434,12 +435,11 @@ where
         let mut cx = Context::from_waker(&self.waker);
         let mut at = 0;
         while at < self.flights.len() {
-            let Poll::Ready((active, reply)) = self.flights[at].as_mut().poll(&mut cx) else {
+            let Poll::Ready(active) = self.flights[at].as_mut().poll(&mut cx) else {
                 at += 1;
                 continue;
             };
             drop(self.flights.swap_remove(at));
-            respond(&active, reply);
             if wake {
                 notify(&self.notifier);
                 self.in_flight.answered();
@@ -452,7 +452,7 @@ where
 
     /// One request from another process: answered at once, or gone into the real port as
     /// the flight returned.
-    fn take(&mut self, active: Active<Req, Rep>) -> Option<Flight<Req, Rep, R>> {
+    fn take(&mut self, active: Active<Req, Rep>) -> Option<Flight<Req, Rep>> {
         let meta = *active.user_header();
         let active: Held<Req, Rep> = Arc::new(Mutex::new(active));
         let answer = |status: u32, detail: u32| {
@@ -480,7 +480,8 @@ where
                 // are pending at once and the owner's order decides which it takes.
                 Some(Box::pin(async move {
                     let reply = end.lock().await.forward(request).await;
-                    (active, reply)
+                    respond(&active, reply);
+                    active
                 }))
             }
             _ => answer(MALFORMED, 0),

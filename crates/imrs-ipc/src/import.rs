@@ -1,6 +1,7 @@
 //! A user's side: a port of another process, imported. Locally it is a port of the same
 //! name and types whose owner is a bridge: a tokio task takes each local send into shared
-//! memory, and a thread waiting on iceoryx2's reply events hands each reply back.
+//! memory and, woken by iceoryx2's reply events, hands each reply back. On a TIGHT port the
+//! user's spinning send does the same in its turns.
 
 use std::marker::PhantomData;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -545,9 +546,18 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
     loop {
         let waiting = !lock().waiting.is_empty();
         tokio::select! {
-            taken = std::future::poll_fn(|cx| lock().taken.poll_next(cx)) => match taken {
-                Some((request, reply)) => lock().forward(request, reply, true),
-                None => return,
+            // Forwarded where it is taken: a large message is not moved through the select.
+            open = std::future::poll_fn(|cx| {
+                let mut side = lock();
+                side.taken.poll_next(cx).map(|taken| match taken {
+                    Some((request, reply)) => {
+                        side.forward(request, reply, true);
+                        true
+                    }
+                    None => false,
+                })
+            }) => if !open {
+                return;
             },
             notified = readiness.notified() => {
                 if notified.is_err() {

@@ -40,12 +40,18 @@
 //! reaches the owner's module, and its reply the sender, with no hand-over between threads.
 //! They poll no message; an exported port's task also looks at each 50 ms tick, so that a
 //! request whose notify was lost waits a tick at most. Call the functions from within a
-//! runtime whose I/O driver is enabled (`enable_all`). A TIGHT port crosses as any other:
-//! spinning bridges were slower than woken ones on the 2-core machine measured (see the
-//! README), because a spinner takes the processor the other process needs. An exported
-//! port's waits park at once ([`Port::park_waits`](imrs_core::imrs_ports::Port::park_waits)):
-//! the bridge's side of each rendezvous is a task on the same runtime, which a spinning
-//! owner would keep off its worker.
+//! runtime whose I/O driver is enabled (`enable_all`).
+//!
+//! A TIGHT port's modules spin on both sides, and the bridges' work is done in their turns
+//! ([`Pump`](imrs_core::imrs_ports::Pump)): the user's spinning send puts its request into
+//! shared memory and reads the reply there itself, and the owner's spinning receive takes
+//! the request from shared memory and sends the reply itself, so that a round trip wakes
+//! no task and no thread. The importing process learns that the port is TIGHT when it
+//! connects, and declares its side of the port so. Each side holds back the wake-up of the
+//! other process while the other may be spinning too, and sends it once the other has left
+//! a message untaken for a few hundred turns, or when its own wait parks, or when its
+//! bridge's task next runs; so a side that has parked is woken as on any port. The bridges'
+//! own ends park at once ([`End::park_waits`](imrs_core::imrs_ports::End::park_waits)).
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
