@@ -246,6 +246,8 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                 .ok_or_else(|| refused(process_name(line), "its figures do not read"))?;
                 heard[i] = true;
             }
+            // A line that sent its figures may end before the other sends its own.
+            (line, Said::Ended(_)) if heard[line.index()] => {}
             (line, other) => return Err(other.refusal(line, "its figures")),
         }
     }
