@@ -152,7 +152,9 @@ pub(crate) fn lend<Req: Wire, Rep: Wire>(
     Ok(Shared::in_buffer(Loaned(loan)))
 }
 
-fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+/// Locks `mutex`: each critical section of the bridges leaves its data whole, so a panic
+/// elsewhere does not spoil it.
+pub(crate) fn lock<T: ?Sized>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)

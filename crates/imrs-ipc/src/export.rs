@@ -8,7 +8,7 @@ use std::collections::HashMap;
 use std::marker::PhantomData;
 use std::pin::Pin;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, PoisonError, Weak};
+use std::sync::{Arc, Mutex, Weak};
 use std::task::{Context, Poll, Wake, Waker};
 use std::thread::JoinHandle;
 
@@ -17,7 +17,7 @@ use imrs_core::imrs_ports::usage::{Plain, Usage};
 use imrs_core::imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
-use crate::carry::{Active, Carry, Held, Server};
+use crate::carry::{Active, Carry, Held, Server, lock};
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TIGHT,
@@ -279,7 +279,7 @@ where
     }));
     let weak = Arc::downgrade(&side) as Weak<Mutex<dyn Turns>>;
     let serve = |side: &Mutex<Serving<Req, Rep, M, R, E, A>>| {
-        let mut side = side.lock().unwrap_or_else(PoisonError::into_inner);
+        let mut side = lock(side);
         side.serve(true);
         side.announce();
     };
@@ -576,12 +576,5 @@ fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(active: &Held<Req, Rep>, answer:
 
 /// Wakes the users' bridges: a reply is there.
 fn notify(notifier: &Mutex<Notifier<Svc>>) {
-    let _ = notifier
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .notify();
-}
-
-fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+    let _ = lock(notifier).notify();
 }

@@ -4,7 +4,7 @@
 //! user's spinning send does the same in its turns.
 
 use std::marker::PhantomData;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll};
 use std::time::{Duration, Instant};
 
@@ -18,7 +18,7 @@ use imrs_core::imrs_ports::{
 
 use crate::Exported;
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
-use crate::carry::{Asker, Carry, Pending, lend};
+use crate::carry::{Asker, Carry, Pending, lend, lock};
 use crate::export::InFlight;
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
@@ -273,7 +273,7 @@ where
     if tight {
         local.pump_with(Turn(Arc::downgrade(&side)));
     }
-    let client = Arc::clone(&side.lock().unwrap_or_else(PoisonError::into_inner).client);
+    let client = Arc::clone(&lock(&side).client);
     Ok(Imported::new(M::lend_from(local, client, name), relay))
 }
 
@@ -348,7 +348,7 @@ impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>
     /// from a spinning module's turn, holds the wake-up back.
     fn forward(&mut self, request: M, reply: ReplyHandle<R>, wake: bool) {
         let sent = {
-            let client = self.client.lock().unwrap_or_else(PoisonError::into_inner);
+            let client = lock(&self.client);
             request.into_request(&client).and_then(|mut loan| {
                 *loan.user_header_mut() = RequestMeta::new(SEND, &self.module);
                 loan.send().ok()
@@ -541,14 +541,14 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
     side: &Mutex<Relaying<Req, Rep, M, R, T>>,
     readiness: &Readiness,
 ) {
-    let lock = || side.lock().unwrap_or_else(PoisonError::into_inner);
+    let locked = || lock(side);
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     loop {
-        let waiting = !lock().waiting.is_empty();
+        let waiting = !locked().waiting.is_empty();
         tokio::select! {
             // Forwarded where it is taken: a large message is not moved through the select.
             open = std::future::poll_fn(|cx| {
-                let mut side = lock();
+                let mut side = locked();
                 side.taken.poll_next(cx).map(|taken| match taken {
                     Some((request, reply)) => {
                         side.forward(request, reply, true);
@@ -566,7 +566,7 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
             }
             _ = sweep.tick(), if waiting => sweep_dead(),
         }
-        let mut side = lock();
+        let mut side = locked();
         while let Some((request, reply)) = side.taken.try_next() {
             side.forward(request, reply, true);
         }

@@ -11,15 +11,18 @@
 //! not taken the message within [`QUIET_TURNS`] turns, when the spinning wait parks, or
 //! when the bridge's task runs. The tasks stay, for every wait that parks.
 
-use std::sync::{Mutex, PoisonError, Weak};
+use std::sync::{Mutex, Weak};
 
 use imrs_core::imrs_ports::Pump;
 
+use crate::carry::lock;
+
 /// How many turns a message waits, unannounced, for a spinning peer to take it before the
 /// peer is woken: a few microseconds, about a round trip. Measured on two cores (see the
-/// README): with 256 turns the round trip's p99 was 6.5–36 µs, with 32 it was 6.4–57 µs
-/// and mostly under 7 µs; with no wake-up until the wait parks, a peer that had parked
-/// waited out the whole spin, and the p99 was 0.3–1.4 ms.
+/// README): with 256 turns the round trip's p99 was 6.5–37 µs over eight runs, with 32 it
+/// was 5.7–57 µs over eleven (under 7 µs in four): no clear difference. With no wake-up
+/// until the wait parks, a peer that had parked waited out the whole spin, and the p99 was
+/// 0.3–1.4 ms.
 pub(crate) const QUIET_TURNS: u32 = 32;
 
 /// One side of a bridge, as a spinning module's turn sees it.
@@ -48,9 +51,7 @@ impl<S: Turns + ?Sized> Pump for Turn<S> {
 
     fn parking(&self) {
         if let Some(side) = self.0.upgrade() {
-            side.lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .announce();
+            lock(&side).announce();
         }
     }
 }

@@ -813,6 +813,26 @@ async fn a_tight_port_is_served_whether_the_other_side_spins_or_has_parked() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_does() {
+    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, usage};
+
+    // The port keeps the bridge's turns, and the bridge keeps the port: dropping the export
+    // must still let the bridge go, with its hold on the port.
+    let cell = cell("tight-dropped");
+    let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
+    let exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut owner = port.owner().unwrap();
+    drop(exported);
+    drop(port);
+    let received = within(5, owner.receive()).await;
+    assert!(
+        matches!(received, Err(ReceiveError::Closed { ref port }) if port == "DOUBLE"),
+        "{received:?}"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fails_it() {
     use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, QueryError, usage};
 
