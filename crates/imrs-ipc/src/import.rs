@@ -535,7 +535,7 @@ fn handshake<Req: Wire, Rep: Wire>(
 
 /// The bridge's task: forwards each request the importing module sends, and hands each
 /// reply back to its sender; woken by the module's send, by the owner's notify, and every
-/// half second while requests wait, to see whether the owner died (their senders then fail
+/// half second, to see whether the owner died while requests wait (their senders then fail
 /// at once). A spinning module's turns do the same between its wake-ups.
 async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>(
     side: &Mutex<Relaying<Req, Rep, M, R, T>>,
@@ -543,8 +543,8 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
 ) {
     let locked = || lock(side);
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
+    sweep.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
-        let waiting = !locked().waiting.is_empty();
         tokio::select! {
             // Forwarded where it is taken: a large message is not moved through the select.
             open = std::future::poll_fn(|cx| {
@@ -564,7 +564,12 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
                     return;
                 }
             }
-            _ = sweep.tick(), if waiting => sweep_dead(),
+            // Ticking even with nothing waiting: a spinning module's turn may forward a
+            // request while this select waits, and the task would never learn that a
+            // request waits on an owner who then dies.
+            _ = sweep.tick() => if !locked().waiting.is_empty() {
+                sweep_dead();
+            },
         }
         let mut side = locked();
         while let Some((request, reply)) = side.taken.try_next() {
