@@ -48,9 +48,9 @@
 //! the request from shared memory and sends the reply itself, so that a round trip wakes
 //! no task and no thread. The importing process learns that the port is TIGHT when it
 //! connects, and declares its side of the port so. Each side holds back the wake-up of the
-//! other process while the other may be spinning too, and sends it once the other has left
-//! a message untaken for a few hundred turns, or when its own wait parks, or when its
-//! bridge's task next runs; so a side that has parked is woken as on any port. The bridges'
+//! other process while the other may be spinning too, and sends it once a message has
+//! waited a few tens of turns, or when its own wait parks, or when its bridge's task next
+//! runs; so a side that has parked is woken as on any port. The bridges'
 //! own ends park at once ([`End::park_waits`](imrs_core::imrs_ports::End::park_waits)).
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both

@@ -7,9 +7,9 @@
 //! spinning module's own thread ([`Pump`]): the user's send takes its request into shared
 //! memory itself and reads the reply there; the owner's receive takes the request from
 //! shared memory itself and sends the reply. The wake-up of the other process is held back
-//! while it may be spinning too, and sent as soon as it may not be: when the other side has
-//! not taken the message within [`QUIET_TURNS`] turns, when the spinning wait parks, or
-//! when the bridge's task runs. The tasks stay, for every wait that parks.
+//! while it may be spinning too, and sent as soon as it may not be: when the message has
+//! waited [`QUIET_TURNS`] turns, when the spinning wait parks, or when the bridge's task
+//! runs. The tasks stay, for every wait that parks.
 
 use std::sync::{Mutex, Weak};
 
@@ -17,8 +17,10 @@ use imrs_core::imrs_ports::Pump;
 
 use crate::carry::lock;
 
-/// How many turns a message waits, unannounced, for a spinning peer to take it before the
-/// peer is woken: a few microseconds, about a round trip. Measured on two cores (see the
+/// How many turns a message waits, unannounced, before the peer is woken: a few
+/// microseconds, about a round trip. The owner's side waits for the user to take its reply;
+/// the user's side, which cannot see the owner take a request, waits for the reply, so a
+/// round trip a little longer than usual wakes the owner all the same. Measured on two cores (see the
 /// README): with 256 turns the round trip's p99 was 6.5–37 µs over eight runs, with 32 it
 /// was 5.7–57 µs over eleven (under 7 µs in four): no clear difference. With no wake-up
 /// until the wait parks, a peer that had parked waited out the whole spin, and the p99 was

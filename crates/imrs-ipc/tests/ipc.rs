@@ -7,7 +7,7 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_core::imrs_ports::{ProcessType, SendError, Shared, WireError};
+use imrs_core::imrs_ports::{End, ProcessType, SendError, Shared, WireError, usage};
 use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import, import_shared};
 
 /// The peer's message: the same by name, size and alignment.
@@ -154,6 +154,42 @@ async fn finished(mut peer: Peer) -> String {
     .await
 }
 
+/// A module's end of an imported port of numbers.
+type Asker = End<Number, Number, usage::Send>;
+
+/// Sends 4000, which the owner sleeps 4 s before answering, and kills the owner with
+/// `kill -9` meanwhile: the asker back, and what its send returned (within 3 s).
+async fn send_while_the_owner_is_killed(
+    mut asker: Asker,
+    owner: &mut Peer,
+) -> (Asker, Result<Number, SendError<Number>>) {
+    let sending = tokio::spawn(async move {
+        let result = asker.send(Number { value: 4000 }).await;
+        (asker, result)
+    });
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    owner.0.kill().unwrap();
+    owner.0.wait().unwrap();
+    within(3, sending).await.unwrap()
+}
+
+/// The reply to `value` from a restarted owner (within 10 s): until its server is seen, a
+/// send finds nobody.
+async fn served_again(asker: &mut Asker, value: u64) -> Number {
+    within(10, async {
+        loop {
+            match asker.send(Number { value }).await {
+                Ok(reply) => break reply,
+                Err(SendError::NoReply { .. }) => {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+                Err(other) => panic!("{other:?}"),
+            }
+        }
+    })
+    .await
+}
+
 async fn within<T>(seconds: u64, future: impl Future<Output = T>) -> T {
     tokio::time::timeout(Duration::from_secs(seconds), future)
         .await
@@ -236,35 +272,14 @@ async fn an_owner_killed_mid_rendezvous_fails_the_sender_and_its_restart_is_serv
             .value,
         2
     );
-    // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile.
-    let sending = tokio::spawn(async move {
-        let result = asker.send(Number { value: 4000 }).await;
-        (asker, result)
-    });
-    tokio::time::sleep(Duration::from_millis(300)).await;
-    first.0.kill().unwrap();
-    first.0.wait().unwrap();
-    let (mut asker, result) = within(3, sending).await.unwrap();
+    let (mut asker, result) = send_while_the_owner_is_killed(asker, &mut first).await;
     assert!(
         matches!(result, Err(SendError::NoReply { ref port }) if port == "DOUBLE"),
         "{result:?}"
     );
     // A new copy of the owner exports the port again; the same importer is served.
     let _second = owner(&cell, "DOUBLE");
-    let reply = within(10, async {
-        loop {
-            match asker.send(Number { value: 21 }).await {
-                Ok(reply) => break reply,
-                // Until the new owner's server is seen, a send finds nobody.
-                Err(SendError::NoReply { .. }) => {
-                    tokio::time::sleep(Duration::from_millis(50)).await;
-                }
-                Err(other) => panic!("{other:?}"),
-            }
-        }
-    })
-    .await;
-    assert_eq!(reply.value, 42);
+    assert_eq!(served_again(&mut asker, 21).await.value, 42);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -769,35 +784,14 @@ async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_send
     // turn or the bridge's task forwarded the last request is a race, and the death must
     // be seen either way.
     for death in 1..=3 {
-        let served = within(10, async {
-            let mut value = 0;
-            while value < 200 {
-                match asker.send(Number { value: value + 1 }).await {
-                    Ok(reply) => {
-                        value += 1;
-                        assert_eq!(reply.value, 2 * value);
-                    }
-                    // Until a restarted owner's server is seen, a send finds nobody.
-                    Err(SendError::NoReply { .. }) if value == 0 && death > 1 => {
-                        tokio::time::sleep(Duration::from_millis(50)).await;
-                    }
-                    Err(other) => panic!("{other:?}"),
-                }
-            }
-            value
-        })
-        .await;
-        assert_eq!(served, 200);
-        // The owner sleeps 4 s before it answers 4000: kill -9 it meanwhile.
-        let sending = tokio::spawn(async move {
-            let result = asker.send(Number { value: 4000 }).await;
-            (asker, result)
-        });
-        tokio::time::sleep(Duration::from_millis(300)).await;
-        owner.0.kill().unwrap();
-        owner.0.wait().unwrap();
+        // A restarted owner is served once its server is seen.
+        assert_eq!(served_again(&mut asker, 1).await.value, 2);
+        for value in 2..=200 {
+            let reply = within(5, asker.send(Number { value })).await.unwrap();
+            assert_eq!(reply.value, 2 * value);
+        }
         let result;
-        (asker, result) = within(3, sending).await.unwrap();
+        (asker, result) = send_while_the_owner_is_killed(asker, &mut owner).await;
         assert!(
             matches!(result, Err(SendError::NoReply { ref port }) if port == "DOUBLE"),
             "death {death}: {result:?}"
