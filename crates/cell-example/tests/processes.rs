@@ -2,10 +2,16 @@
 //! it: the world's process reports as a single process does, a line's process that dies
 //! fails the run by name without hanging it, and a world that dies takes its lines with it.
 //!
-//! These run on the wall clock, sped up: time does not cross processes virtually.
+//! These run on the wall clock, sped up: time does not cross processes virtually. So each
+//! cell runs alone (a second cell's processes would take the processors this one's timing
+//! counts on), and at a speed that leaves its shortest timeout wall time to spare: LET_1_GO
+//! gives RELEASE 2 s to let a pallet go, and the gate takes 0.3 s of them, which at ×60
+//! leaves 28 ms of wall time for the round trip to the world and back; at ×20, 85 ms, and
+//! at ×10, 170 ms.
 
 use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
 /// The example binary, built beside this test by `cargo test`.
@@ -53,16 +59,23 @@ fn within(limit: Duration, mut condition: impl FnMut() -> bool) -> bool {
     condition()
 }
 
+/// Held by the cell that runs now: one at a time.
+static ONE_CELL: Mutex<()> = Mutex::new(());
+
 /// The world, started: killed, with its lines, if the test fails before it ends.
 struct World {
     child: Option<Child>,
     pid: u32,
     /// Its status was read: its pid may now name another process.
     reaped: bool,
+    /// Dropped last, once the world and its lines are gone.
+    _alone: MutexGuard<'static, ()>,
 }
 
 impl World {
     fn start(args: &[&str]) -> Self {
+        // A test that failed holding the lock left no cell behind: `Drop` killed it.
+        let alone = ONE_CELL.lock().unwrap_or_else(PoisonError::into_inner);
         let child = Command::new(chip_cell())
             .arg("--processes")
             .args(args)
@@ -74,6 +87,7 @@ impl World {
             pid: child.id(),
             child: Some(child),
             reaped: false,
+            _alone: alone,
         }
     }
 
@@ -166,8 +180,8 @@ fn zone_requests(report: &str) -> [(u32, u32); 2] {
 
 #[test]
 fn the_cell_across_three_processes_reports_as_a_single_process_does() {
-    // Six simulated minutes at sixty times the wall clock.
-    let world = World::start(&["--hours", "0.1", "--speed", "60"]);
+    // Six simulated minutes at twenty times the wall clock.
+    let world = World::start(&["--hours", "0.1", "--speed", "20"]);
     let lines = world.lines();
     assert!(lines.iter().all(|line| *line != world.pid()));
     let report = world.report(Duration::from_secs(120));
@@ -204,7 +218,7 @@ fn the_cell_across_three_processes_reports_as_a_single_process_does() {
 
 #[test]
 fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process() {
-    let world = World::start(&["--feeder", "appendix", "--hours", "0.1", "--speed", "60"]);
+    let world = World::start(&["--feeder", "appendix", "--hours", "0.1", "--speed", "20"]);
     let report = world.report(Duration::from_secs(120));
     // No arbiter in the world: the lines ask each other.
     assert!(
@@ -225,7 +239,7 @@ fn under_the_appendixs_policy_each_chip_robot_asks_its_twin_in_the_other_process
 
 #[test]
 fn under_the_coordinator_each_chip_robot_reserves_its_sweep_in_the_worlds_process() {
-    let world = World::start(&["--feeder", "coordinator", "--hours", "0.1", "--speed", "60"]);
+    let world = World::start(&["--feeder", "coordinator", "--hours", "0.1", "--speed", "20"]);
     let report = world.report(Duration::from_secs(120));
     assert!(
         report.contains("processes: world (simulation, WORLD, FEEDER_COORDINATOR), line A, line B"),
@@ -259,7 +273,7 @@ fn faults_reach_the_process_they_belong_to_and_their_alarms_come_back() {
         "--hours",
         "0.05",
         "--speed",
-        "30",
+        "10",
         "--fault",
         "release:A@60s",
         "--fault",
