@@ -207,14 +207,3 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
             .map_err(|error| transport(&self.port, "notifying", error))
     }
 }
-
-/// Removes what dead processes left behind: their nodes, and their ports' places in the
-/// services, so that the living see them gone.
-pub(crate) fn sweep_dead() {
-    let _ = Node::<Svc>::list(Config::global_config(), |state| {
-        if let NodeState::Dead(view) = state {
-            let _ = view.try_remove_stale_resources();
-        }
-        CallbackProgression::Continue
-    });
-}

@@ -17,9 +17,10 @@ use imrs_core::imrs_ports::{
 };
 
 use crate::Exported;
-use crate::bridge::{Channel, Readiness, Side, Svc, TICK, sweep_dead};
+use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Asker, Carry, Pending, lend, lock};
 use crate::export::InFlight;
+use crate::sweep::sweep_dead;
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
     CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
@@ -567,9 +568,12 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
             // Ticking even with nothing waiting: a spinning module's turn may forward a
             // request while this select waits, and the task would never learn that a
             // request waits on an owner who then dies.
-            _ = sweep.tick() => if !locked().waiting.is_empty() {
-                sweep_dead();
-            },
+            _ = sweep.tick() => {
+                let waiting = !locked().waiting.is_empty();
+                if waiting {
+                    sweep_dead().await;
+                }
+            }
         }
         let mut side = locked();
         while let Some((request, reply)) = side.taken.try_next() {

@@ -136,6 +136,7 @@ mod error;
 mod export;
 mod import;
 mod send_all;
+mod sweep;
 mod turn;
 mod wire;
 
