@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use std::io::{self, IsTerminal, Write};
 
 use cell_example::processes::run_line;
-use cell_example::{CellConfig, FeederPolicy, Report, parse, run, speed_line};
+use cell_example::{CellConfig, FeederPolicy, Report, keeping_up_line, parse, run, speed_line};
 use tracing_subscriber::EnvFilter;
 
 fn main() -> ExitCode {
@@ -95,6 +95,12 @@ fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::
     if config.processes {
         // The other policies do not run across processes: see `cell_example::processes`.
         writeln!(out)?;
+        if let Some(kept_up) = report
+            .processes
+            .and_then(|speed| keeping_up_line(speed, &report.lateness))
+        {
+            writeln!(out, "{kept_up}")?;
+        }
         writeln!(out, "{}", speed_line(report))?;
         return out.flush();
     }

@@ -15,9 +15,14 @@
 //! therefore not reproducible to the step, as a single-process run is; its figures are
 //! those of the same cell, measured by the same simulation.
 //!
+//! Each process measures how late its runtime wakes a timer ([`crate::lateness`]): that
+//! delay, times the speed, is lived in the cell's time, and the report says the worst, so
+//! that a timeout a machine too loaded for `--speed` caused can be told from one the cell
+//! did.
+//!
 //! At the end each line writes its modules' figures (timeouts, alarms, restarts, deadlocks,
-//! waits for the zone, GATE's cycle times) as one JSON line on its standard output; the
-//! world folds them into its own and reports as a single process does. A line whose world
+//! waits for the zone, GATE's cycle times, its lateness) as one JSON line on its standard
+//! output; the world folds them into its own and reports as a single process does. A line whose world
 //! dies sees its standard input close and exits.
 
 use std::io::{BufRead, BufReader, Write};
@@ -38,6 +43,7 @@ use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_coordinator, feed
 use crate::devices::{DevicePorts, Devices, RemoteDevices, world};
 use crate::faults::CellFaultKind;
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
+use crate::lateness::Lateness;
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
@@ -137,6 +143,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     // Unique on this host: two runs never meet.
     let remote =
         Remote::new(&format!("chip_cell-{}-{nanos}", std::process::id())).map_err(ipc("world"))?;
+    let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let cell = Cell::new(clock.clone());
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
     cell.events().set_capacity(config.kept_events);
@@ -216,6 +223,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     let total = Duration::from_secs_f64(config.hours * 3600.0);
     let mut waits = [ZoneWaits::default(); 2];
     let mut cycle_times: [CycleTimeHistory; 2] = Default::default();
+    let mut late = [Duration::ZERO; 2];
     let mut heard = [false; 2];
     // Until the end, a line that fails or dies fails the run at once; then each line's
     // figures are due.
@@ -241,6 +249,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                     &mut lock(&tally),
                     &mut waits[i],
                     &mut cycle_times[i],
+                    &mut late[i],
                     &figures,
                 )
                 .ok_or_else(|| refused(process_name(line), "its figures do not read"))?;
@@ -254,15 +263,14 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     lines.ended().await;
     drop(exported);
     let tally = lock(&tally).clone();
-    Ok(RunRecord::measured(
-        config,
-        tally,
-        &sim,
-        &cell,
-        waits,
-        cycle_times,
-        total,
-    ))
+    let mut record = RunRecord::measured(config, tally, &sim, &cell, waits, cycle_times, total);
+    record.lateness = vec![("world".into(), lateness.worst())];
+    record.lateness.extend(
+        Line::ALL
+            .into_iter()
+            .map(|line| (process_name(line).into(), late[line.index()])),
+    );
+    Ok(record)
 }
 
 fn process_name(line: Line) -> &'static str {
@@ -421,6 +429,7 @@ pub fn run_line(config: &CellConfig, process: &LineProcess) -> Result<(), RunErr
 async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Value, RunError> {
     let (line, name) = (process.line, process_name(process.line));
     let clock = clock(name, process.epoch, config.speed)?;
+    let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let remote = Remote::new(&process.remote).map_err(ipc(name))?;
     let cell = Cell::new(clock.clone());
     // The report counts the time lost to deadlocks from how long each wait lasted.
@@ -510,7 +519,7 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     drop(shared);
     let waits = lock(&waits)[line.index()];
     let history = lock(&history).clone();
-    let figures = figures(&lock(&tally), &waits, &history);
+    let figures = figures(&lock(&tally), &waits, &history, lateness.worst());
     Ok(figures)
 }
 
@@ -534,9 +543,14 @@ async fn import_twin(
     }
 }
 
-/// A line's figures: what its modules' events counted, its chip robot's waits, and its
-/// GATE's cycle times.
-fn figures(tally: &Tally, waits: &ZoneWaits, history: &CycleTimeHistory) -> Value {
+/// A line's figures: what its modules' events counted, its chip robot's waits, its GATE's
+/// cycle times, and how late its timer woke at worst.
+fn figures(
+    tally: &Tally,
+    waits: &ZoneWaits,
+    history: &CycleTimeHistory,
+    lateness: Duration,
+) -> Value {
     let alarm_kinds: Vec<Value> = tally
         .alarm_kinds
         .iter()
@@ -558,6 +572,7 @@ fn figures(tally: &Tally, waits: &ZoneWaits, history: &CycleTimeHistory) -> Valu
             "changes": history.changes,
             "recent": history.recent.iter().map(|(at, value)| [*at, *value]).collect::<Vec<_>>(),
         },
+        "lateness_us": u64::try_from(lateness.as_micros()).unwrap_or(u64::MAX),
     })
 }
 
@@ -566,6 +581,7 @@ fn absorb(
     tally: &mut Tally,
     waits: &mut ZoneWaits,
     history: &mut CycleTimeHistory,
+    lateness: &mut Duration,
     figures: &Value,
 ) -> Option<()> {
     let count = |value: &Value| value.as_u64().and_then(|n| u32::try_from(n).ok());
@@ -622,6 +638,7 @@ fn absorb(
             .map(pair)
             .collect::<Option<_>>()?,
     };
+    *lateness = Duration::from_micros(figures["lateness_us"].as_u64()?);
     Some(())
 }
 
@@ -653,13 +670,20 @@ mod tests {
             recent: vec![(100.0, 9.5), (200.0, 9.0)],
         };
         // Sent over a pipe as text, and read back.
-        let text = figures(&line, &waits, &history).to_string();
+        let text = figures(&line, &waits, &history, Duration::from_micros(2500)).to_string();
         let read: Value = serde_json::from_str(&text).unwrap();
         let mut world = Tally::default();
         world.timeouts.insert("LET_1_GO".into(), 1);
         world.alarms = 1;
-        let (mut got_waits, mut got_history) = Default::default();
-        absorb(&mut world, &mut got_waits, &mut got_history, &read).unwrap();
+        let (mut got_waits, mut got_history, mut got_lateness) = Default::default();
+        absorb(
+            &mut world,
+            &mut got_waits,
+            &mut got_history,
+            &mut got_lateness,
+            &read,
+        )
+        .unwrap();
         assert_eq!(world.timeouts["LET_1_GO"], 3);
         assert_eq!(world.restarts, 1);
         assert_eq!(world.alarms, 4);
@@ -669,16 +693,34 @@ mod tests {
         assert_eq!(world.deadlock_lost, 4.25);
         assert_eq!(got_waits, waits);
         assert_eq!(got_history, history);
+        assert_eq!(got_lateness, Duration::from_micros(2500));
     }
 
     #[test]
     fn figures_that_do_not_read_are_refused() {
-        let (mut waits, mut history) = Default::default();
-        let good = figures(&Tally::default(), &ZoneWaits::default(), &history);
-        for broken in ["restarts", "waits", "cycle_time", "alarm_kinds"] {
+        let (mut waits, mut history, mut lateness) = Default::default();
+        let good = figures(
+            &Tally::default(),
+            &ZoneWaits::default(),
+            &history,
+            Duration::ZERO,
+        );
+        for broken in [
+            "restarts",
+            "waits",
+            "cycle_time",
+            "alarm_kinds",
+            "lateness_us",
+        ] {
             let mut figures = good.clone();
             figures[broken] = json!("garbage");
-            let absorbed = absorb(&mut Tally::default(), &mut waits, &mut history, &figures);
+            let absorbed = absorb(
+                &mut Tally::default(),
+                &mut waits,
+                &mut history,
+                &mut lateness,
+                &figures,
+            );
             assert_eq!(absorbed, None, "{broken}");
         }
         let mut unknown_kind = good;
@@ -687,6 +729,7 @@ mod tests {
             &mut Tally::default(),
             &mut waits,
             &mut history,
+            &mut lateness,
             &unknown_kind,
         );
         assert_eq!(absorbed, None);

@@ -1,5 +1,5 @@
 //! The report of a run, readable at a glance, and the same byte for byte for the same seed
-//! and flags (the last line, wall time, aside).
+//! and flags (the last lines, on wall time, aside).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -137,6 +137,8 @@ pub struct Report {
     pub wall: f64,
     /// Across processes: how many times as fast as the wall clock the cell ran.
     pub processes: Option<f64>,
+    /// Across processes: how late each process's timer woke at worst, in wall seconds.
+    pub lateness: Vec<(String, f64)>,
 }
 
 impl Report {
@@ -290,6 +292,11 @@ impl Report {
             simulated: record.simulated.as_secs_f64(),
             wall: record.wall.as_secs_f64(),
             processes: record.config.processes.then_some(record.config.speed),
+            lateness: record
+                .lateness
+                .iter()
+                .map(|(process, late)| (process.clone(), late.as_secs_f64()))
+                .collect(),
         }
     }
 

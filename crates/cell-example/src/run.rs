@@ -119,6 +119,9 @@ pub struct RunRecord {
     pub simulated: Duration,
     /// Wall time the run took.
     pub wall: Duration,
+    /// Across processes: how late each process's timer woke at worst, in wall time (see
+    /// [`crate::lateness`]). Empty in one process, on virtual time.
+    pub lateness: Vec<(String, Duration)>,
 }
 
 /// The longest run: a year of shifts.
@@ -380,6 +383,7 @@ impl RunRecord {
             cycle_times,
             simulated,
             wall: Duration::ZERO,
+            lateness: Vec::new(),
         }
     }
 }
