@@ -22,8 +22,8 @@
 //!
 //! At the end each line writes its modules' figures (timeouts, alarms, restarts, deadlocks,
 //! waits for the zone, GATE's cycle times, its lateness) as one JSON line on its standard
-//! output; the world folds them into its own and reports as a single process does. A line whose world
-//! dies sees its standard input close and exits.
+//! output; the world folds them into its own and reports as a single process does. A line
+//! whose world dies sees its standard input close and exits.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};

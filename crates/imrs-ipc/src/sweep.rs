@@ -87,8 +87,7 @@ mod tests {
     }
 
     #[tokio::test(flavor = "current_thread")]
-    async fn a_sweep_leaves_the_runtimes_one_thread_to_its_tasks_and_serves_all_who_asked_meanwhile()
-     {
+    async fn a_sweep_frees_the_runtimes_thread_and_serves_all_who_asked_meanwhile() {
         let sweeps = Arc::new(Sweeps::new());
         let runs = Arc::new(AtomicU32::new(0));
         let (go, held) = channel();
