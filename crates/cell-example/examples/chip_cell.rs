@@ -95,10 +95,7 @@ fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::
     if config.processes {
         // The other policies do not run across processes: see `cell_example::processes`.
         writeln!(out)?;
-        if let Some(kept_up) = report
-            .processes
-            .and_then(|speed| keeping_up_line(speed, &report.lateness))
-        {
+        if let Some(kept_up) = keeping_up_line(report) {
             writeln!(out, "{kept_up}")?;
         }
         writeln!(out, "{}", speed_line(report))?;

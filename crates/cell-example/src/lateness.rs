@@ -12,6 +12,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
+use crate::report::Report;
+
 /// How often the probe sets its timer: often enough to catch a stall of a few ticks.
 const PROBE: Duration = Duration::from_millis(10);
 
@@ -20,7 +22,7 @@ const PROBE: Duration = Duration::from_millis(10);
 pub(crate) const SHORTEST_TIMEOUT: Duration = Duration::from_secs(2);
 
 /// How late a process's runtime woke its timer, at worst, while its probe ran.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Lateness {
     worst_micros: Arc<AtomicU64>,
 }
@@ -51,11 +53,17 @@ impl Lateness {
     }
 }
 
-/// The report's line on whether the processes kept up with `speed`: the worst lateness of
-/// each process (`(process, wall seconds)`), the worst named. A lateness beyond a quarter
-/// of the cell's shortest timeout, in simulated time, warns that the run's timeouts may be
-/// the machine's. `None` without processes.
-pub fn keeping_up_line(speed: f64, lateness: &[(String, f64)]) -> Option<String> {
+/// The line, beside [`crate::speed_line`], on whether the processes of a run across
+/// processes kept up with its speed: the worst lateness, and the process it was in. A
+/// lateness beyond a quarter of the cell's shortest timeout, in simulated time, warns that
+/// the run's timeouts may be the machine's. `None` for a run in one process.
+pub fn keeping_up_line(report: &Report) -> Option<String> {
+    verdict(report.processes?, &report.lateness)
+}
+
+/// The line for a run at `speed` whose processes were late at worst by `lateness`
+/// (`(process, wall seconds)`); `None` if no process measured.
+fn verdict(speed: f64, lateness: &[(String, f64)]) -> Option<String> {
     let (process, worst) = lateness
         .iter()
         .max_by(|a, b| a.1.total_cmp(&b.1))
@@ -123,15 +131,13 @@ mod tests {
 
     #[test]
     fn the_line_names_the_latest_process_and_warns_past_a_quarter_of_the_shortest_timeout() {
-        assert_eq!(keeping_up_line(60.0, &[]), None);
-        let kept =
-            keeping_up_line(60.0, &[("world".into(), 0.001), ("line B".into(), 0.008)]).unwrap();
+        assert_eq!(verdict(60.0, &[]), None);
+        let kept = verdict(60.0, &[("world".into(), 0.001), ("line B".into(), 0.008)]).unwrap();
         assert_eq!(
             kept,
             "kept up with x 60: timers woke at worst 8.0 ms late (0.48 s simulated), in line B"
         );
-        let behind =
-            keeping_up_line(60.0, &[("line A".into(), 0.009), ("world".into(), 0.002)]).unwrap();
+        let behind = verdict(60.0, &[("line A".into(), 0.009), ("world".into(), 0.002)]).unwrap();
         assert!(
             behind.starts_with(
                 "FELL BEHIND x 60: timers woke at worst 9.0 ms late (0.54 s simulated), in line A"

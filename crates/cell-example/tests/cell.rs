@@ -3,7 +3,9 @@
 
 use std::time::Duration;
 
-use cell_example::{CellConfig, CellFault, CellFaultKind, FeederPolicy, Report, run};
+use cell_example::{
+    CellConfig, CellFault, CellFaultKind, FeederPolicy, Report, keeping_up_line, run,
+};
 use imrs_sim::imrs_core::EventKind;
 use imrs_sim::{FeederId, Line, SimEventKind};
 
@@ -165,6 +167,8 @@ fn the_report_is_folded_from_every_event_whatever_the_logs_keep() {
         ..Report::of(record)
     };
     assert_eq!(report(&kept_little), report(&full));
+    // One process, on virtual time: no wall clock to keep up with, and no line about it.
+    assert_eq!(keeping_up_line(&Report::of(&full)), None);
     // What the fold keeps per pallet is dropped when the pallet leaves the line.
     assert!(full.tally.in_flight() <= 2 * full.pallets_left.len());
 }
