@@ -20,11 +20,10 @@ use crate::carry::lock;
 /// How many turns a message waits, unannounced, before the peer is woken: a few
 /// microseconds, about a round trip. The owner's side waits for the user to take its reply;
 /// the user's side, which cannot see the owner take a request, waits for the reply, so a
-/// round trip a little longer than usual wakes the owner all the same. Measured on two cores (see the
-/// README): with 256 turns the round trip's p99 was 6.5–37 µs over eight runs, with 32 it
-/// was 5.7–57 µs over eleven (under 7 µs in four): no clear difference. With no wake-up
-/// until the wait parks, a peer that had parked waited out the whole spin, and the p99 was
-/// 0.3–1.4 ms.
+/// round trip a little longer than usual wakes the owner all the same. Measured on two cores
+/// (see the README), three runs each: with 32 turns the round trip's p99 was 3.6–4.5 µs,
+/// with 256 it was 3.5–4.5 µs: no clear difference. With no wake-up until the wait parks,
+/// a peer that had parked waited out the whole spin, and the p99 was 14 µs–1.3 ms.
 pub(crate) const QUIET_TURNS: u32 = 32;
 
 /// One side of a bridge, as a spinning module's turn sees it.
