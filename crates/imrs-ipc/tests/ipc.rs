@@ -1089,3 +1089,48 @@ async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() 
     let reply = within(10, camera.send(kept)).await.unwrap();
     assert_eq!(reply.words[4], 6);
 }
+
+/// The states of the iceoryx2 nodes of process `pid` on this host: "alive", "dead", or
+/// "unknown" for one whose state iceoryx2 cannot tell.
+fn nodes_of(pid: u32) -> Vec<&'static str> {
+    use iceoryx2::node::NodeView;
+    use iceoryx2::prelude::*;
+
+    let of = |details: &Option<iceoryx2::node::NodeDetails>| {
+        details
+            .as_ref()
+            .is_some_and(|details| details.process_id().value() as u32 == pid)
+    };
+    let mut states = Vec::new();
+    Node::<ipc_threadsafe::Service>::list(Config::global_config(), |state| {
+        match &state {
+            NodeState::Alive(node) if of(node.details()) => states.push("alive"),
+            NodeState::Dead(node) if of(node.details()) => states.push("dead"),
+            _ => {}
+        }
+        CallbackProgression::Continue
+    })
+    .unwrap();
+    states
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_process_killed_while_nobody_waited_on_it_is_swept_by_the_next_to_start() {
+    let mut killed = owner(&cell("killed-idle"), "DOUBLE");
+    let pid = killed.0.id();
+    assert!(nodes_of(pid).contains(&"alive"), "{:?}", nodes_of(pid));
+    // Killed with no request waiting on it: no bridge looks for it, and its shared memory
+    // stays until another process sweeps.
+    killed.0.kill().unwrap();
+    killed.0.wait().unwrap();
+    // Dead, unless another test's process has already started and swept it.
+    assert!(!nodes_of(pid).contains(&"alive"), "{:?}", nodes_of(pid));
+    // The next process to wire a port across processes, in any cell, removes it: iceoryx2
+    // sweeps the host's dead nodes whenever a node is created, as each crossing port does.
+    let _next = owner(&cell("next"), "DOUBLE");
+    assert_eq!(
+        nodes_of(pid),
+        Vec::<&str>::new(),
+        "the killed process's node is left"
+    );
+}
