@@ -2,7 +2,9 @@
 //! (the user's send, through the bridges, to the owner's receive and back), beside a raw
 //! iceoryx2 request-response round trip that waits on iceoryx2 events — the same payloads,
 //! the same two processes, the same run. Each case: p50, p99 and p99.9 over its round
-//! trips, and the ratios the targets are stated in.
+//! trips, and the ratios the targets are stated in. Beside the raw round trip as iceoryx2
+//! sets it up by default, one whose events have one id, as the IMRS bridges size theirs:
+//! each wake-up clears every id an event service allows.
 //!
 //! The same round trips on ports of messages built in place (`Shared`): the sender builds
 //! each message in a sample of shared memory loaned from its port, the owner reads it
@@ -50,6 +52,8 @@ impl Default for Large {
 }
 
 const PEER: &str = "IMRS_IPC_BENCH_PEER";
+/// The suffix of a raw part whose events have one id, as the IMRS bridges' do.
+const ONE_ID: &str = "-one-id";
 const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
 
 fn main() {
@@ -67,6 +71,8 @@ fn main() {
     let runtime = runtime();
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
+    let raw_small_one_id =
+        raw_round_trips::<Small>(&cell, &format!("small{ONE_ID}"), rounds, Wait::Events);
     let imrs_small = in_task(&runtime, imrs_round_trips::<Small>(&cell, "SMALL", rounds));
     let imrs_large = in_task(&runtime, imrs_round_trips::<Large>(&cell, "LARGE", rounds));
     let loaned_small = in_task(
@@ -96,6 +102,7 @@ fn main() {
     println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
     for (name, times) in [
         ("raw iceoryx2, events, 8 B", &raw_small),
+        ("raw iceoryx2, events of one id, 8 B", &raw_small_one_id),
         ("IMRS port over iceoryx2, 8 B", &imrs_small),
         ("raw iceoryx2, events, 64 KiB", &raw_large),
         ("IMRS port over iceoryx2, 64 KiB", &imrs_large),
@@ -115,6 +122,10 @@ fn main() {
     println!(
         "  IMRS 8 B vs raw 8 B (target: no worse than raw on a parked port)   {}",
         show(ratio(&imrs_small, &raw_small).collect())
+    );
+    println!(
+        "  IMRS 8 B vs raw 8 B with events of one id, as IMRS sizes them        {}",
+        show(ratio(&imrs_small, &raw_small_one_id).collect())
     );
     println!(
         "  IMRS 64 KiB vs IMRS 8 B, by value                                  {}",
@@ -208,7 +219,7 @@ fn peer(cell: &str) {
         Err(_) => Peer::Parked,
     };
     let raw: &[&str] = match what {
-        Peer::Parked => &["small", "large"],
+        Peer::Parked => &["small", "large", "small-one-id"],
         Peer::RawSpinning => &["small"],
         Peer::Tight => &[],
     };
@@ -220,8 +231,8 @@ fn peer(cell: &str) {
     for part in raw {
         let (cell, part) = (cell.to_owned(), *part);
         std::thread::spawn(move || match part {
-            "small" => raw_server::<Small>(&cell, part, wait),
-            _ => raw_server::<Large>(&cell, part, wait),
+            "large" => raw_server::<Large>(&cell, part, wait),
+            _ => raw_server::<Small>(&cell, part, wait),
         });
     }
     let runtime = runtime();
@@ -368,10 +379,15 @@ fn raw_services<T: Wire>(
         .open_or_create()
         .expect("the service");
     let event = |what: &str| {
-        node.service_builder(&name(what))
-            .event()
-            .open_or_create()
-            .expect("events")
+        let events = node.service_builder(&name(what)).event();
+        // As the IMRS bridges size theirs: one event id, which a wake-up clears, rather
+        // than the default 256.
+        let events = if part.ends_with(ONE_ID) {
+            events.event_id_max_value(0)
+        } else {
+            events
+        };
+        events.open_or_create().expect("events")
     };
     let (requested, replied) = (event("requested"), event("replied"));
     (node, service, requested, replied)

@@ -168,7 +168,11 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
                 .service_builder(&remote.service(port.as_str(), part)?)
                 .event();
             match side {
+                // The events only wake: one event id. A listener clears, at every wake-up,
+                // each id the service allows, an atomic swap apiece: with iceoryx2's
+                // default of 256 ids that took about 0.65 µs of a wake-up's 2.6 µs.
                 Side::Owner { users } => events
+                    .event_id_max_value(0)
                     .max_notifiers(users + 3)
                     .max_listeners(users + 3)
                     .max_nodes(users + 2)
