@@ -1090,8 +1090,8 @@ async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() 
     assert_eq!(reply.words[4], 6);
 }
 
-/// The states of the iceoryx2 nodes of process `pid` on this host: "alive", "dead", or
-/// "unknown" for one whose state iceoryx2 cannot tell.
+/// The states of the iceoryx2 nodes of process `pid` on this host, "alive" or "dead". (A
+/// node whose state iceoryx2 cannot tell has no details, so no process to match.)
 fn nodes_of(pid: u32) -> Vec<&'static str> {
     use iceoryx2::node::NodeView;
     use iceoryx2::prelude::*;
