@@ -10,6 +10,13 @@
 //! each message in a sample of shared memory loaned from its port, the owner reads it
 //! there, and its reply is copied once into the sample that carries it back.
 //!
+//! Then the 8 B round trips again, taking turns one round trip at a time in one task, so
+//! that whatever else the shared machine does meanwhile weighs on all alike: raw iceoryx2
+//! with its client blocking its thread on the reply event, raw iceoryx2 with both ends
+//! waiting in tokio tasks through the reactor (as the IMRS bridges wait), and the IMRS port.
+//! Run one case after the other, a case's figures move by a fifth from run to run with the
+//! machine's load; taking turns, their ratios move far less.
+//!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
 //! a raw iceoryx2 round trip whose client and server both spin.
@@ -25,9 +32,12 @@ use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{FromBytes, Remote, Wire, export, export_shared, import, import_shared};
+use tokio::io::Interest;
+use tokio::io::unix::AsyncFd;
 
 type Svc = ipc_threadsafe::Service;
 
@@ -55,6 +65,8 @@ const PEER: &str = "IMRS_IPC_BENCH_PEER";
 /// The suffix of a raw part whose events have one id, as the IMRS bridges' do.
 const ONE_ID: &str = "-one-id";
 const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
+/// The raw part served by a task of the peer's runtime.
+const TASK_PART: &str = "task-one-id";
 
 fn main() {
     if let Ok(cell) = std::env::var(PEER) {
@@ -83,6 +95,9 @@ fn main() {
         &runtime,
         loaned_round_trips::<Large>(&cell, "LARGE_LOANED", rounds),
     );
+    let [raw_alternating, raw_task_alternating, imrs_alternating] = runtime
+        .block_on(runtime.spawn(alternating(cell.clone(), rounds)))
+        .expect("the round trips ran");
     let _ = child.kill();
     let _ = child.wait();
 
@@ -114,6 +129,15 @@ fn main() {
         let [p50, p99, p999] = percentiles(times);
         println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
     }
+    println!("the same 8 B round trips, taking turns one round trip at a time:");
+    for (name, times) in [
+        ("raw iceoryx2, events of one id", &raw_alternating),
+        ("raw iceoryx2, waited on in a task", &raw_task_alternating),
+        ("IMRS port over iceoryx2", &imrs_alternating),
+    ] {
+        let [p50, p99, p999] = percentiles(times);
+        println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
+    }
     let ratio = |a: &[Duration], b: &[Duration]| {
         let (a, b) = (percentiles(a), percentiles(b));
         (0..3).map(move |i| a[i].as_secs_f64() / b[i].as_secs_f64())
@@ -126,6 +150,14 @@ fn main() {
     println!(
         "  IMRS 8 B vs raw 8 B with events of one id, as IMRS sizes them        {}",
         show(ratio(&imrs_small, &raw_small_one_id).collect())
+    );
+    println!(
+        "  IMRS 8 B vs raw 8 B of one id, taking turns (target: no worse)     {}",
+        show(ratio(&imrs_alternating, &raw_alternating).collect())
+    );
+    println!(
+        "  raw waited on in a task vs raw 8 B of one id, taking turns         {}",
+        show(ratio(&raw_task_alternating, &raw_alternating).collect())
     );
     println!(
         "  IMRS 64 KiB vs IMRS 8 B, by value                                  {}",
@@ -238,6 +270,9 @@ fn peer(cell: &str) {
     let runtime = runtime();
     runtime.block_on(async {
         let remote = Remote::new(cell).expect("a cell name");
+        if what == Peer::Parked {
+            tokio::spawn(raw_task_server(cell.to_owned()));
+        }
         let _echoes = match what {
             Peer::Parked => vec![
                 echo::<Small>(&remote, "SMALL", ProcessType::Indep),
@@ -451,4 +486,108 @@ fn raw_round_trips<T: Wire>(cell: &str, part: &str, rounds: usize, wait: Wait) -
             start.elapsed()
         })
         .collect()
+}
+
+/// A listener's socket, as tokio's reactor names it.
+struct Socket(std::os::fd::RawFd);
+
+impl std::os::fd::AsRawFd for Socket {
+    fn as_raw_fd(&self) -> std::os::fd::RawFd {
+        self.0
+    }
+}
+
+/// `listener`'s wake-ups, through tokio's reactor: a task waits for them with no thread of
+/// its own, as the IMRS bridges do.
+fn readiness(listener: &Listener<Svc>) -> AsyncFd<Socket> {
+    // SAFETY: `native_handle` only reads the number of the listener's own socket.
+    let raw = unsafe { listener.file_descriptor().native_handle() };
+    // SAFETY: the socket is open for as long as `listener` lives, and each caller drops the
+    // registration before the listener.
+    unsafe { AsyncFd::register_with_interest(Socket(raw), Interest::READABLE) }
+        .expect("registered with the reactor")
+}
+
+/// Waits in a task until `listener` is notified, and takes its notifications.
+async fn notified(socket: &AsyncFd<Socket>, listener: &Listener<Svc>) {
+    let mut ready = socket.readable().await.expect("the reactor runs");
+    ready.clear_ready();
+    let _ = listener.try_wait(|_| {});
+}
+
+/// A raw iceoryx2 server in a tokio task, waiting on its request event through the reactor.
+async fn raw_task_server(cell: String) {
+    let (_node, service, requested, replied) = raw_services::<Small>(&cell, TASK_PART);
+    let server = service.server_builder().create().expect("a server");
+    let listener = requested.listener_builder().create().expect("a listener");
+    let notifier = replied.notifier_builder().create().expect("a notifier");
+    let socket = readiness(&listener);
+    loop {
+        notified(&socket, &listener).await;
+        while let Ok(Some(request)) = server.receive() {
+            let payload = *request.payload();
+            let _ = request.send_copy(payload);
+            let _ = notifier.notify();
+        }
+    }
+}
+
+/// The 8 B round trips, one of each in turn, `rounds` times in one task, so that whatever
+/// else the machine does weighs on all three alike: a raw round trip whose client blocks
+/// its thread on the reply event (events of one id, as the IMRS bridges size theirs); a raw
+/// round trip whose client and server wait in tasks, through tokio's reactor; and an IMRS
+/// port's.
+async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 3] {
+    struct Raw {
+        _node: Node<Svc>,
+        client: iceoryx2::port::client::Client<Svc, Small, (), Small, ()>,
+        listener: Listener<Svc>,
+        notifier: iceoryx2::port::notifier::Notifier<Svc>,
+    }
+    let raw = |part: &str| {
+        let (node, service, requested, replied) = raw_services::<Small>(&cell, part);
+        Raw {
+            _node: node,
+            client: service.client_builder().create().expect("a client"),
+            listener: replied.listener_builder().create().expect("a listener"),
+            notifier: requested.notifier_builder().create().expect("a notifier"),
+        }
+    };
+    let (blocking, in_task) = (raw(&format!("small{ONE_ID}")), raw(TASK_PART));
+    let socket = readiness(&in_task.listener);
+    let remote = Remote::new(&cell).expect("a cell name");
+    let imported = import::<Small, Small>(&remote, "SMALL", "ECHO", "ASKER").expect("imported");
+    let mut asker = imported.port().user_named("ASKER").expect("the user's end");
+    let mut times: [Vec<Duration>; 3] = Default::default();
+    for round in 0..rounds + rounds / 10 {
+        let start = Instant::now();
+        let pending = blocking.client.send_copy(Small::default()).expect("sent");
+        let _ = blocking.notifier.notify();
+        while !matches!(pending.receive(), Ok(Some(_))) {
+            let _ = blocking
+                .listener
+                .timed_wait(|_| {}, Duration::from_millis(50));
+        }
+        let raw_blocking = start.elapsed();
+
+        let start = Instant::now();
+        let pending = in_task.client.send_copy(Small::default()).expect("sent");
+        let _ = in_task.notifier.notify();
+        while !matches!(pending.receive(), Ok(Some(_))) {
+            notified(&socket, &in_task.listener).await;
+        }
+        let raw_in_task = start.elapsed();
+
+        let start = Instant::now();
+        std::hint::black_box(asker.send(Small::default()).await.expect("a round trip"));
+        let imrs = start.elapsed();
+        // The first tenth warms up.
+        if round >= rounds / 10 {
+            for (times, time) in times.iter_mut().zip([raw_blocking, raw_in_task, imrs]) {
+                times.push(time);
+            }
+        }
+    }
+    drop(socket);
+    times
 }

@@ -3,6 +3,7 @@
 //! replies for the users) — so that nobody polls.
 
 use std::os::fd::{AsRawFd, RawFd};
+use std::task::{Context, Poll};
 use std::time::Duration;
 
 use iceoryx2::port::listener::Listener;
@@ -28,9 +29,9 @@ pub(crate) const TICK: Duration = Duration::from_millis(50);
 pub(crate) type Service<Req, Rep> =
     request_response::PortFactory<Svc, Req, RequestMeta, Rep, ReplyMeta>;
 
-/// A listener whose wake-ups a tokio task awaits: its socket is registered with tokio's
-/// reactor, so that the other process's notify wakes the task directly, with no thread of
-/// ours between.
+/// A listener whose wake-ups reach a waker through tokio's reactor: its socket is
+/// registered there, so that the other process's notify wakes the bridge directly, with no
+/// thread of ours between.
 pub(crate) struct Readiness {
     // Declared first, so dropped first: deregistered before the listener closes its socket.
     socket: AsyncFd<Socket>,
@@ -75,15 +76,19 @@ impl Readiness {
         Ok(Self { socket, listener })
     }
 
-    /// Waits until the other side has notified since the last call, and takes its
-    /// notifications. `Err` if the reactor is gone.
-    pub(crate) async fn notified(&self) -> std::io::Result<()> {
-        let mut ready = self.socket.readable().await?;
-        // Cleared before the notifications are taken: one that comes after is a new edge,
-        // which wakes the next call.
-        ready.clear_ready();
-        let _ = self.listener.try_wait(|_| {});
-        Ok(())
+    /// Takes the other side's notifications, and registers `cx`'s waker to be woken when
+    /// it next notifies: whether it had notified since the last call. `Err` if the reactor
+    /// is gone.
+    pub(crate) fn drain(&self, cx: &mut Context<'_>) -> std::io::Result<bool> {
+        let mut notified = false;
+        while let Poll::Ready(ready) = self.socket.poll_read_ready(cx) {
+            // Cleared before the notifications are taken: one that comes after is a new
+            // edge, which wakes the waker again.
+            ready?.clear_ready();
+            let _ = self.listener.try_wait(|_| {});
+            notified = true;
+        }
+        Ok(notified)
     }
 }
 

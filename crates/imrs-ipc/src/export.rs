@@ -1,8 +1,9 @@
-//! The owner's side: a port exported to other processes. The bridge's task, woken by
-//! iceoryx2's request events, takes each request into the real port from the remote
-//! module's own end — a send, or a query its owner's order answers — and, woken again when
-//! the reply comes, sends it back through shared memory. On a TIGHT port the owner's
-//! spinning receive does the same in its turns.
+//! The owner's side: a port exported to other processes. The bridge, woken by iceoryx2's
+//! request events, takes each request into the real port from the remote module's own end
+//! — a send, or a query its owner's order answers — and, woken again when the reply comes,
+//! sends it back through shared memory. It does so where it is woken ([`crate::dispatch`]):
+//! in the reactor's thread as the request comes, in the module's as it answers. On a TIGHT
+//! port the owner's spinning receive does the same in its turns.
 
 use std::collections::HashMap;
 use std::marker::PhantomData;
@@ -18,6 +19,7 @@ use imrs_core::imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, Wire
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Active, Carry, Held, Server, lock};
+use crate::dispatch::{Dispatch, Work};
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TIGHT,
@@ -257,10 +259,22 @@ where
                 detail: format!("another process already owns it ({error:?})"),
             })?;
     let listener = channel.listener(&channel.requested)?;
+    // A bridge thread waits on the listener itself. A task is woken through the reactor,
+    // and on a port that parks its work is done where the wake-up comes: in the reactor's
+    // thread when a user notifies, in the module's when it answers.
+    let (waits, readiness) = if attach_blocks {
+        (Some(listener), None)
+    } else {
+        (None, Some(Readiness::new(listener, &name)?))
+    };
+    let dispatch = Dispatch::new(!tight && !attach_blocks);
     let notifier = Arc::new(Mutex::new(channel.notifier(&channel.replied)?));
     let stop = Arc::new(AtomicBool::new(false));
     let in_flight = Arc::new(InFlight::default());
-    let woken = Arc::new(Woken::default());
+    let woken = Arc::new(Woken {
+        flag: AtomicBool::new(false),
+        dispatch: Arc::clone(&dispatch),
+    });
     let side = Arc::new(Mutex::new(Serving {
         server,
         attach,
@@ -271,38 +285,35 @@ where
         notifier,
         in_flight: Arc::clone(&in_flight),
         waker: Waker::from(Arc::clone(&woken)),
-        woken: Arc::clone(&woken),
+        woken,
+        readiness,
+        dispatch: Waker::from(Arc::clone(&dispatch)),
+        closed: false,
         answered: Vec::new(),
         quiet: Quiet::default(),
         tight,
         _carried: PhantomData,
     }));
+    dispatch.serve(Arc::downgrade(&side) as Weak<Mutex<dyn Work>>);
     let weak = Arc::downgrade(&side) as Weak<Mutex<dyn Turns>>;
-    let serve = |side: &Mutex<Serving<Req, Rep, M, R, E, A>>| {
-        let mut side = lock(side);
-        side.serve(true);
-        side.announce();
-    };
-    if !attach_blocks {
-        // A task in the runtime the owner's module runs on, woken by the users' notify, so
-        // that a request reaches the module with no hand-over between threads; and by the
-        // requests in flight, when their replies come.
-        let readiness = Readiness::new(listener, &name)?;
+    let Some(listener) = waits else {
         let task = runtime.spawn(async move {
             // The channel lives as long as the task: its node keeps the services open.
             let _channel = channel;
-            // Woken by a user's notify; and at each tick all the same, so that a request
-            // whose notify was lost (or a peer that never sent one) waits a tick at most.
+            // Woken where a wake-up could not be served where it came; and at each tick all
+            // the same, so that a request whose notify was lost (or a peer that never sent
+            // one) waits a tick at most.
             let mut tick = tokio::time::interval(TICK);
             loop {
-                serve(&side);
-                tokio::select! {
-                    notified = readiness.notified() => {
-                        if notified.is_err() {
-                            return;
-                        }
+                {
+                    let mut side = lock(&side);
+                    side.work(true);
+                    if side.closed {
+                        return;
                     }
-                    () = woken.notify.notified() => {}
+                }
+                tokio::select! {
+                    () = dispatch.woken() => {}
                     _ = tick.tick() => {}
                 }
             }
@@ -316,7 +327,7 @@ where
             },
             weak,
         ));
-    }
+    };
     let halt = Arc::clone(&stop);
     let thread = std::thread::Builder::new()
         .name(format!("imrs-ipc {name}"))
@@ -328,7 +339,7 @@ where
                 if listener.timed_wait(|_| {}, TICK).is_err() {
                     break;
                 }
-                serve(&side);
+                lock(&side).work(true);
             }
         })
         .map_err(|error| IpcError::Transport {
@@ -354,11 +365,10 @@ type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 /// comes out, so that a large reply is not moved on.
 type Flight<Req, Rep> = Pin<Box<dyn Future<Output = Held<Req, Rep>> + Send>>;
 
-/// Wakes the bridge's task when a reply comes for a request in flight.
-#[derive(Default)]
+/// Wakes the bridge when a reply comes for a request in flight.
 struct Woken {
     flag: AtomicBool,
-    notify: tokio::sync::Notify,
+    dispatch: Arc<Dispatch>,
 }
 
 impl Wake for Woken {
@@ -368,7 +378,7 @@ impl Wake for Woken {
 
     fn wake_by_ref(self: &Arc<Self>) {
         self.flag.store(true, Ordering::Release);
-        self.notify.notify_one();
+        self.dispatch.wake_by_ref();
     }
 }
 
@@ -384,9 +394,15 @@ struct Serving<Req: Wire, Rep: Wire, M, R, E, A> {
     spawn_on: Option<tokio::runtime::Handle>,
     notifier: Arc<Mutex<Notifier<Svc>>>,
     in_flight: Arc<InFlight>,
-    /// The flights' waker, which wakes the task.
+    /// The flights' waker, which wakes the bridge.
     waker: Waker,
     woken: Arc<Woken>,
+    /// The users' notifications, for a bridge that is a task.
+    readiness: Option<Readiness>,
+    /// The waker their notifications wake.
+    dispatch: Waker,
+    /// Whether the reactor is gone, and with it the users' notifications.
+    closed: bool,
     /// Requests answered by a spinning owner's turn, whose users' processes were not woken.
     answered: Vec<Held<Req, Rep>>,
     quiet: Quiet,
@@ -403,12 +419,13 @@ where
     E: Forward<M, R>,
     A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
 {
-    /// Takes the requests that came, and answers those whose replies came; wakes the users'
-    /// processes, or, from a spinning owner's turn (`wake` false), holds the wake-ups back.
-    fn serve(&mut self, wake: bool) {
+    /// Takes the requests that came (if `take`), and answers those whose replies came;
+    /// wakes the users' processes, or, from a spinning owner's turn (`wake` false), holds
+    /// the wake-ups back.
+    fn serve(&mut self, wake: bool, take: bool) {
         let mut came = false;
         // An error is a connection iceoryx2 could not make yet: the next wake-up retries.
-        while let Ok(Some(active)) = self.server.receive() {
+        while take && let Ok(Some(active)) = self.server.receive() {
             let Some(flight) = self.take(active) else {
                 continue;
             };
@@ -494,6 +511,31 @@ where
     }
 }
 
+impl<Req, Rep, M, R, E, A> Work for Serving<Req, Rep, M, R, E, A>
+where
+    Req: Wire,
+    Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
+    E: Forward<M, R>,
+    A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
+{
+    fn work(&mut self, everything: bool) {
+        let notified = match &self.readiness {
+            Some(readiness) => readiness
+                .drain(&mut Context::from_waker(&self.dispatch))
+                .unwrap_or_else(|_| {
+                    self.closed = true;
+                    false
+                }),
+            None => false,
+        };
+        // A wake-up of the flights alone (a module answered) has no request to take.
+        self.serve(true, everything || notified);
+        self.announce();
+    }
+}
+
 impl<Req, Rep, M, R, E, A> Turns for Serving<Req, Rep, M, R, E, A>
 where
     Req: Wire,
@@ -504,7 +546,7 @@ where
     A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
 {
     fn turn(&mut self) {
-        self.serve(false);
+        self.serve(false, true);
         // A user's process that took its reply has let its request go: it was not parked,
         // and needs no wake-up.
         let in_flight = &self.in_flight;

@@ -1,11 +1,12 @@
 //! A user's side: a port of another process, imported. Locally it is a port of the same
-//! name and types whose owner is a bridge: a tokio task takes each local send into shared
-//! memory and, woken by iceoryx2's reply events, hands each reply back. On a TIGHT port the
-//! user's spinning send does the same in its turns.
+//! name and types whose owner is a bridge: it takes each local send into shared memory and,
+//! woken by iceoryx2's reply events, hands each reply back. It does so where it is woken
+//! ([`crate::dispatch`]): in the module's thread as it sends, in the reactor's as the reply
+//! comes. On a TIGHT port the user's spinning send does the same in its turns.
 
 use std::marker::PhantomData;
-use std::sync::{Arc, Mutex};
-use std::task::{Context, Poll};
+use std::sync::{Arc, Mutex, Weak};
+use std::task::{Context, Poll, Waker};
 use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
@@ -19,6 +20,7 @@ use imrs_core::imrs_ports::{
 use crate::Exported;
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Asker, Carry, Pending, lend, lock};
+use crate::dispatch::{Dispatch, Work};
 use crate::export::InFlight;
 use crate::sweep::sweep_dead;
 use crate::turn::{Quiet, Turn, Turns};
@@ -337,6 +339,12 @@ pub(crate) struct Relaying<Req: Wire, Rep: Wire, M, R, T> {
     waiting: Vec<Waiting<Req, Rep, R>>,
     module: String,
     wake_owner: Notifier<Svc>,
+    /// The owner's notifications that replies came.
+    readiness: Readiness,
+    /// The waker of the bridge: the module's sends and the owner's notifications wake it.
+    dispatch: Waker,
+    /// Whether the bridge is done: the local port closed, or the reactor is gone.
+    closed: bool,
     /// Requests sent by a spinning module's turn, whose owner was not woken.
     quiet: Quiet,
     _carried: PhantomData<fn(M)>,
@@ -369,6 +377,39 @@ impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>
     fn announce_now(&mut self) {
         self.quiet.take();
         let _ = self.wake_owner.notify();
+    }
+}
+
+impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>> Work
+    for Relaying<Req, Rep, M, R, T>
+{
+    /// Forwards each request the importing module sent, and hands each reply that came
+    /// back to its sender.
+    fn work(&mut self, everything: bool) {
+        let dispatch = self.dispatch.clone();
+        let mut cx = Context::from_waker(&dispatch);
+        let notified = self.readiness.drain(&mut cx).unwrap_or_else(|_| {
+            self.closed = true;
+            false
+        });
+        // Forwarded where it is taken: a large message is not moved on.
+        loop {
+            match self.taken.poll_next(&mut cx) {
+                Poll::Ready(Some((request, reply))) => self.forward(request, reply, true),
+                Poll::Ready(None) => {
+                    self.closed = true;
+                    break;
+                }
+                Poll::Pending => break,
+            }
+        }
+        // Wake-ups a spinning module's turns held back go now: the bridge works here when
+        // the module no longer spins.
+        self.announce();
+        // A reply comes with the owner's notification: a wake-up of a send alone has none.
+        if everything || notified {
+            look(&mut self.waiting);
+        }
     }
 }
 
@@ -420,28 +461,33 @@ where
         client,
         listener,
         wake_owner,
-        tight: _,
+        tight,
     } = connection;
     taken.park();
-    // A task in the runtime the importing module runs on, woken by the owner's notify
-    // through tokio's reactor, and by the module's sends: a request reaches shared memory,
-    // and a reply its sender, with no hand-over between threads.
-    let readiness = Readiness::new(listener, name)?;
+    // Woken by the owner's notify through tokio's reactor, and by the module's sends. On a
+    // port that parks the work is done where the wake-up comes, so that a request reaches
+    // shared memory, and a reply its sender, with no task switch between; otherwise, and
+    // at each sweep, by a task in the runtime the importing module runs on.
+    let dispatch = Dispatch::new(!tight);
     let side = Arc::new(Mutex::new(Relaying {
         taken,
         client: Arc::new(Mutex::new(client)),
         waiting: Vec::new(),
         module: module.to_owned(),
         wake_owner,
+        readiness: Readiness::new(listener, name)?,
+        dispatch: Waker::from(Arc::clone(&dispatch)),
+        closed: false,
         quiet: Quiet::default(),
         _carried: PhantomData,
     }));
+    dispatch.serve(Arc::downgrade(&side) as Weak<Mutex<dyn Work>>);
     let task = runtime.spawn({
         let side = Arc::clone(&side);
         async move {
             // The channel lives as long as the task: its node keeps the services open.
             let _channel = channel;
-            relay_requests(&side, &readiness).await;
+            relay_requests(&side, &dispatch).await;
         }
     });
     Ok((Relay { task }, side))
@@ -534,55 +580,35 @@ fn handshake<Req: Wire, Rep: Wire>(
     Err(IpcError::NoOwner { port: port.clone() })
 }
 
-/// The bridge's task: forwards each request the importing module sends, and hands each
-/// reply back to its sender; woken by the module's send, by the owner's notify, and every
-/// half second, to see whether the owner died while requests wait (their senders then fail
-/// at once). A spinning module's turns do the same between its wake-ups.
+/// The bridge's task: does the bridge's work where a wake-up could not be served where it
+/// came, and every half second, to see whether the owner died while requests wait (their
+/// senders then fail at once). A spinning module's turns do the same between its wake-ups.
 async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>>(
     side: &Mutex<Relaying<Req, Rep, M, R, T>>,
-    readiness: &Readiness,
+    dispatch: &Dispatch,
 ) {
-    let locked = || lock(side);
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     sweep.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
-        tokio::select! {
-            // Forwarded where it is taken: a large message is not moved through the select.
-            open = std::future::poll_fn(|cx| {
-                let mut side = locked();
-                side.taken.poll_next(cx).map(|taken| match taken {
-                    Some((request, reply)) => {
-                        side.forward(request, reply, true);
-                        true
-                    }
-                    None => false,
-                })
-            }) => if !open {
+        {
+            let mut side = lock(side);
+            side.work(true);
+            if side.closed {
                 return;
-            },
-            notified = readiness.notified() => {
-                if notified.is_err() {
-                    return;
-                }
             }
+        }
+        tokio::select! {
+            () = dispatch.woken() => {}
             // Ticking even with nothing waiting: a spinning module's turn may forward a
-            // request while this select waits, and the task would never learn that a
+            // request while this task waits, and the task would never learn that a
             // request waits on an owner who then dies.
             _ = sweep.tick() => {
-                let waiting = !locked().waiting.is_empty();
+                let waiting = !lock(side).waiting.is_empty();
                 if waiting {
                     sweep_dead().await;
                 }
             }
         }
-        let mut side = locked();
-        while let Some((request, reply)) = side.taken.try_next() {
-            side.forward(request, reply, true);
-        }
-        // Wake-ups a spinning module's turns held back go now: the task runs when the
-        // module no longer spins.
-        side.announce();
-        look(&mut side.waiting);
     }
 }
 

@@ -132,6 +132,7 @@
 
 mod bridge;
 mod carry;
+mod dispatch;
 mod error;
 mod export;
 mod import;

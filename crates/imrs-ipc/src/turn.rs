@@ -9,7 +9,9 @@
 //! shared memory itself and sends the reply. The wake-up of the other process is held back
 //! while it may be spinning too, and sent as soon as it may not be: when the message has
 //! waited [`QUIET_TURNS`] turns, when the spinning wait parks, or when the bridge's task
-//! runs. The tasks stay, for every wait that parks.
+//! runs. The tasks stay, woken for every wait that parks: on a TIGHT port the wake-ups
+//! are the tasks' to serve, not the waking thread's ([`crate::dispatch`]), since that
+//! thread is a spinning module's, whose own turns move the messages.
 
 use std::sync::{Mutex, Weak};
 
@@ -34,7 +36,7 @@ pub(crate) trait Turns: Send + 'static {
     fn announce(&mut self);
 }
 
-/// The pump of a bridge side: a turn, skipped while the bridge's task is at work. The port
+/// The pump of a bridge side: a turn, skipped while the bridge is at work elsewhere. The port
 /// holds its pump, and the bridge holds the port's ends: the pump holds the bridge weakly,
 /// so that the bridge still goes when its task ends.
 pub(crate) struct Turn<S: ?Sized>(pub(crate) Weak<Mutex<S>>);

@@ -7,8 +7,10 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_core::imrs_ports::{End, ProcessType, SendError, Shared, WireError, usage};
-use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, import, import_shared};
+use imrs_core::imrs_ports::{
+    AnyUser, End, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError, usage,
+};
+use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, export, import, import_shared};
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -224,6 +226,94 @@ async fn two_user_processes_are_served_at_once() {
             (1..=100).map(|v| 2 * v).collect::<Vec<_>>()
         );
     }
+}
+
+/// The bridge answers a request where the owner's reply is given, when it can: here in a
+/// thread of the test's own, outside the runtime, while requests from four processes keep
+/// coming, so that the bridge also takes new requests into the port from that thread. None
+/// of that may need the runtime, and every reply must cross.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn replies_given_outside_the_runtime_cross_while_requests_keep_coming() {
+    let cell = cell("outside");
+    let remote = Remote::new(&cell).unwrap();
+    let modules = ["ASKER", "ASKER_2", "ASKER_3", "ASKER_4"];
+    let port: Port<Number, Number, usage::Receive, AnyUser, 4> =
+        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").user_list(modules));
+    let _exported = export(&remote, &port).unwrap();
+    let mut owner = port.owner().unwrap();
+    let (handles, replier) = std::sync::mpsc::channel::<(Number, ReplyHandle<Number>)>();
+    let replier = std::thread::spawn(move || {
+        let mut replied = 0;
+        for (number, reply) in replier {
+            reply.reply(Number {
+                value: 2 * number.value,
+            });
+            replied += 1;
+        }
+        replied
+    });
+    let serving = tokio::spawn(async move {
+        for _ in 0..800 {
+            let taken = owner.receive().await.unwrap();
+            handles.send(taken).unwrap();
+        }
+    });
+    let users: Vec<Peer> = modules
+        .iter()
+        .map(|module| user(&cell, module, "200"))
+        .collect();
+    for user in users {
+        assert_eq!(
+            answers(user).await,
+            (1..=200).map(|v| 2 * v).collect::<Vec<_>>()
+        );
+    }
+    within(5, serving).await.unwrap();
+    assert_eq!(
+        replier.join().expect("the replying thread did not panic"),
+        800
+    );
+}
+
+/// Runs `future` to its end in this thread, with no runtime: parks until woken.
+fn block_on<F: Future>(future: F) -> F::Output {
+    struct Unpark(std::thread::Thread);
+    impl std::task::Wake for Unpark {
+        fn wake(self: std::sync::Arc<Self>) {
+            self.0.unpark();
+        }
+    }
+    let waker = std::task::Waker::from(std::sync::Arc::new(Unpark(std::thread::current())));
+    let mut context = std::task::Context::from_waker(&waker);
+    let mut future = std::pin::pin!(future);
+    loop {
+        if let std::task::Poll::Ready(output) = future.as_mut().poll(&mut context) {
+            return output;
+        }
+        std::thread::park();
+    }
+}
+
+/// A module's send carries its request into shared memory in the thread it is polled in,
+/// and the reply wakes that thread: here one outside the runtime, which only parks. The
+/// bridge must need nothing of the runtime there, and the reply must still come.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_send_polled_outside_the_runtime_crosses_and_its_reply_wakes_it() {
+    let cell = cell("outside-send");
+    let _owner = owner(&cell, "DOUBLE");
+    let remote = Remote::new(&cell).unwrap();
+    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    let sender = std::thread::spawn(move || {
+        (1..=200)
+            .map(|value| block_on(asker.send(Number { value })).unwrap().value)
+            .collect::<Vec<_>>()
+    });
+    let replies = within(10, tokio::task::spawn_blocking(move || sender.join()))
+        .await
+        .unwrap()
+        .expect("the sending thread did not panic");
+    assert_eq!(replies, (1..=200).map(|v| 2 * v).collect::<Vec<_>>());
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
