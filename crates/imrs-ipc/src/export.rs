@@ -116,8 +116,9 @@ impl Exported {
     }
 
     /// Waits until every request taken from another process has been answered there. A
-    /// reply crosses in a task of the runtime, after the module gave it: a process that ends
-    /// cleanly awaits this first, so that the replies its modules gave reach their senders.
+    /// reply usually crosses as part of the module's `reply`, but where the bridge is busy
+    /// in another thread it is left to a task of the runtime: a process that ends cleanly
+    /// awaits this first, so that the replies its modules gave reach their senders.
     pub async fn settled(&self) {
         self.in_flight.settled().await;
     }

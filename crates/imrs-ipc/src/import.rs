@@ -87,8 +87,8 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
 
     /// For a port whose owner starts each rendezvous (`SENDALL`, `CALLALL`, `QUERY`): waits
     /// until every broadcast or query this process took from the owner has been answered
-    /// back to it. The answer crosses in a task of the runtime, after the module gave it: a
-    /// process that ends cleanly awaits this first, so that its modules' last answers
+    /// back to it. An answer may be left to a task of the runtime, after the module gave it:
+    /// a process that ends cleanly awaits this first, so that its modules' last answers
     /// arrive. For other ports there is nothing to wait for.
     pub async fn settled(&self) {
         if let Some(in_flight) = &self.in_flight {

@@ -35,12 +35,16 @@
 //! handlers of modules in other processes, each run when its module's order says; and
 //! `QUERY` ports, whose owner queries its users, with [`export_query`] and [`import_query`].
 //!
-//! The bridges are tokio tasks in the runtime the cell runs on, woken by iceoryx2's events
-//! through tokio's reactor (the listener's socket, as an `AsyncFd`): a remote request
-//! reaches the owner's module, and its reply the sender, with no hand-over between threads.
-//! They poll no message; an exported port's task also looks at each 50 ms tick, so that a
-//! request whose notify was lost waits a tick at most. Call the functions from within a
-//! runtime whose I/O driver is enabled (`enable_all`).
+//! The bridges are woken by iceoryx2's events through tokio's reactor (the listener's
+//! socket, as an `AsyncFd`), and do their work where they are woken: a remote request goes
+//! into the owner's port in the reactor's thread, which wakes the module; the module's
+//! reply goes into shared memory as part of its `reply`; a user's send goes there as part
+//! of the send, and its reply to the sender in the reactor's thread. A round trip switches
+//! to no task but the modules'. Each bridge also has a task in the runtime the cell runs
+//! on, which does the work where the waking thread cannot (the bridge busy in another
+//! thread, or a TIGHT port). They poll no message; an exported port's task also looks at
+//! each 50 ms tick, so that a request whose notify was lost waits a tick at most. Call the
+//! functions from within a runtime whose I/O driver is enabled (`enable_all`).
 //!
 //! A TIGHT port's modules spin on both sides, and the bridges' work is done in their turns
 //! ([`Pump`](imrs_core::imrs_ports::Pump)): the user's spinning send puts its request into
@@ -64,7 +68,8 @@
 //! [`SendError::NoReply`](imrs_core::imrs_ports::SendError::NoReply), and a new copy of
 //! the owner that exports the port again is served. A process that answers requests from
 //! others awaits [`Exported::settled`] (or [`Imported::settled`]) before it ends cleanly, so
-//! that its modules' last answers, which cross in tasks of the runtime, are not cut off.
+//! that its modules' last answers, which may be left to tasks of the runtime, are not cut
+//! off.
 //!
 //! Service names are derived from the cell's name and the port's, so two cells on one
 //! host never meet; no iceoryx2 configuration file is needed. The owner's process creates a
@@ -76,7 +81,7 @@
 //! ([`RealClock::from_epoch`](imrs_core::imrs_ports::RealClock::from_epoch)).
 //!
 //! A port of values copies each message into shared memory and moves it by value through
-//! the bridges' tasks: cheap for small messages, and costly for large ones (tens of KiB),
+//! the bridges: cheap for small messages, and costly for large ones (tens of KiB),
 //! which in a debug build can also overflow tokio's default 2 MiB worker stack. A port of
 //! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses with [`export_shared`] and
 //! [`import_shared`] instead: the sender loans a sample of shared memory from its end,
