@@ -124,6 +124,17 @@ async fn answers(mut peer: Peer) -> Vec<u64> {
     text.lines().map(|line| line.parse().unwrap()).collect()
 }
 
+/// Waits for each user process (started by [`user`] to ask the doubles of 1..=`n`) to end,
+/// and checks that it got them all, in order.
+async fn each_doubled(users: Vec<Peer>, n: u64) {
+    for user in users {
+        assert_eq!(
+            answers(user).await,
+            (1..=n).map(|v| 2 * v).collect::<Vec<_>>()
+        );
+    }
+}
+
 /// Waits (10 s at most) until `n` users are attached to `end`'s port.
 async fn until_users<Req, Rep, U>(end: &imrs_core::imrs_ports::End<Req, Rep, U>, n: usize)
 where
@@ -220,12 +231,7 @@ async fn two_user_processes_are_served_at_once() {
         .iter()
         .map(|module| user(&cell, module, "100"))
         .collect();
-    for user in users {
-        assert_eq!(
-            answers(user).await,
-            (1..=100).map(|v| 2 * v).collect::<Vec<_>>()
-        );
-    }
+    each_doubled(users, 100).await;
 }
 
 /// The bridge answers a request where the owner's reply is given, when it can: here in a
@@ -262,12 +268,7 @@ async fn replies_given_outside_the_runtime_cross_while_requests_keep_coming() {
         .iter()
         .map(|module| user(&cell, module, "200"))
         .collect();
-    for user in users {
-        assert_eq!(
-            answers(user).await,
-            (1..=200).map(|v| 2 * v).collect::<Vec<_>>()
-        );
-    }
+    each_doubled(users, 200).await;
     within(5, serving).await.unwrap();
     assert_eq!(
         replier.join().expect("the replying thread did not panic"),
