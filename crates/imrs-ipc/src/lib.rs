@@ -129,7 +129,10 @@
 //!
 //! `RESPONSE` ports of `Shared` messages cross the same way, with [`export_response_shared`]
 //! and [`import_response_shared`]: a query loaned and built in place, read in place by the
-//! owner's response handler, whose answer is built in a reply loan.
+//! owner's response handler, whose answer is built in a reply loan. So do `QUERY` ports,
+//! with [`export_query_shared`] and [`import_query_shared`]: the user's response handler
+//! reads the owner's query in place and builds its answer in a reply loan, read in place by
+//! the owner; the owner's query, loaned from the heap, is copied once into a sample.
 //!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
 //! the port allows at once (16). A `Shared` message that does not lie in one of the port's
@@ -150,7 +153,8 @@ pub use error::IpcError;
 pub use export::{Exported, export, export_response, export_response_shared, export_shared};
 pub use import::{Imported, import, import_response, import_response_shared, import_shared};
 pub use send_all::{
-    export_call_all, export_query, export_send_all, import_call_all, import_query, import_send_all,
+    export_call_all, export_query, export_query_shared, export_send_all, import_call_all,
+    import_query, import_query_shared, import_send_all,
 };
 pub use wire::{Remote, Wire};
 

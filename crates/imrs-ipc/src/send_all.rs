@@ -4,10 +4,13 @@
 //! owner's process relays to it whatever that module's end of the real port receives — a
 //! message to reply to, or a query its response handler would answer.
 
-use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, UserList, WireError, usage};
+use imrs_core::imrs_ports::{
+    AnyUser, End, Name, Port, PortSpec, Shared, UserList, WireError, usage,
+};
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
+use crate::carry::Carry;
 use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
@@ -57,7 +60,9 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed(remote, port, |port, module| port.user_named(module))
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
+        port.user_named(module)
+    })
 }
 
 /// Exports `port`, a `CALLALL` port, to the other processes of `remote`'s cell: its owner's
@@ -70,7 +75,7 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     // The handler never runs: the relay takes each query and answers it with the other
     // process's reply.
-    export_relayed(remote, port, |port, module| {
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
         port.responder_named(module, |_: &(), _: Req| Rep::default())
     })
 }
@@ -89,24 +94,43 @@ pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     // The handler never runs: the relay takes each query and answers it with the other
     // process's reply.
-    export_relayed(remote, port, |port, module| {
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
         port.responder_named(module, |_: &(), _: Req| Rep::default())
     })
 }
 
-/// Exports a port whose owner starts each rendezvous: each remote module attached gets
-/// `user_end` of the real port, whose every message or query is relayed to its process.
-fn export_relayed<Req, Rep, U, L, T, const N: usize>(
+/// Exports `port`, a `QUERY` port of messages built in place ([`Shared`]), as
+/// [`export_query`] does a port of values. The owner's query is copied once into a sample
+/// of shared memory (its loans come from the heap: the port may have users in several
+/// processes, and a sample is one process's); the user module's response handler, in its
+/// own process, reads it there and builds its answer in place
+/// ([`Shared::loan_reply`]), which the owner reads where it lies.
+pub fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
-    port: &Port<Req, Rep, U, L, N>,
-    user_end: UserEnd<Req, Rep, U, L, T, N>,
+    port: &Port<Shared<Req>, Shared<Rep>, usage::Query, L, N>,
+) -> Result<Exported, IpcError> {
+    // The handler never runs, as for `export_query`.
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
+        port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
+    })
+}
+
+/// Exports a port whose owner starts each rendezvous: each remote module attached gets
+/// `user_end` of the real port, whose every message or query (of wire type `Req`, carried
+/// in the port as `M`) is relayed to its process.
+fn export_relayed<Req, Rep, M, R, U, L, T, const N: usize>(
+    remote: &Remote,
+    port: &Port<M, R, U, L, N>,
+    user_end: UserEnd<M, R, U, L, T, N>,
 ) -> Result<Exported, IpcError>
 where
     Req: Wire,
     Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
     U: Usage,
     L: UserList,
-    T: Take<Req, Rep>,
+    T: Take<M, R>,
 {
     let name = Name::from(port);
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
@@ -125,7 +149,7 @@ where
             // The module's own end of the real port: what it receives goes to its process.
             let end = user_end(&port, module)?;
             let _entered = runtime.enter();
-            relay::<Req, Rep, Req, Rep, T>(&cell, &to_module(&served, module), owner.as_str(), end)
+            relay::<Req, Rep, M, R, T>(&cell, &to_module(&served, module), owner.as_str(), end)
                 .map(|relay| Relayed { _relay: relay })
                 .map_err(|_| Refusal::Failed)
         })?;
@@ -142,7 +166,7 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::SendAll>, IpcError> {
-    import_relayed(remote, port, owner, module)
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
 }
 
 /// Imports a `CALLALL` port of another process for module `module` of this one: a port of
@@ -156,7 +180,7 @@ pub fn import_call_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::CallAll>, IpcError> {
-    import_relayed(remote, port, owner, module)
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
 }
 
 /// Imports a `QUERY` port of another process for module `module` of this one, which
@@ -169,29 +193,46 @@ pub fn import_query<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::Query>, IpcError> {
-    import_relayed(remote, port, owner, module)
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
 }
 
-fn import_relayed<Req, Rep, U>(
+/// Imports a `QUERY` port of messages built in place ([`Shared`]), exported with
+/// [`export_query_shared`], as [`import_query`] does a port of values: `module`'s response
+/// handler reads each query where it lies in shared memory, and builds its answer in place
+/// ([`Shared::loan_reply`]), which crosses back with nothing copied.
+pub fn import_query_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
     module: &str,
-) -> Result<Imported<Req, Rep, U>, IpcError>
+) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::Query>, IpcError> {
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+}
+
+/// Imports a port whose owner starts each rendezvous, for `module`: what crosses is of wire
+/// types `Req` and `Rep`, carried in the local port as `M` and `R`.
+fn import_relayed<Req, Rep, M, R, U>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<M, R, U>, IpcError>
 where
     Req: Wire,
     Rep: Wire,
+    M: Carry<Req>,
+    R: Carry<Rep>,
     U: Usage + Plain,
-    End<Req, Rep, U>: Forward<Req, Rep>,
+    End<M, R, U>: Forward<M, R>,
 {
     let name = Name::from(port);
-    let local: Port<Req, Rep, U, AnyUser, 1> =
+    let local: Port<M, R, U, AnyUser, 1> =
         Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
     // First the service the owner's process will relay to, so that it is there when the
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
     // Its one user is the owner's relay.
-    let (server, _) = bridge::<Req, Rep, Req, Rep, _, _>(
+    let (server, _) = bridge::<Req, Rep, M, R, _, _>(
         remote,
         to_module(&name, module),
         1,

@@ -1141,6 +1141,44 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
     }
 }
 
+/// The owner of a `QUERY` port of frames queries its user in another process: the user's
+/// response handler reads each query where it lies in shared memory and builds its answer
+/// in a reply loan, which the owner reads in place.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_process() {
+    let cell = cell("shared-owner-query");
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::Query, AnyUser, 1> =
+        Port::declare(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
+    let _exported = imrs_ipc::export_query_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut parent = port.owner().unwrap();
+    let child = peer(&["frame-child", &cell, "ASK_FRAME", "CHILD", "10"]);
+    until_users(&parent, 1).await;
+    for seed in 1..=10u64 {
+        let mut frame = parent.loan().unwrap();
+        for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
+            *out = word(seed, at);
+        }
+        let mut answer = within(10, parent.query(frame)).await.unwrap();
+        assert_eq!(
+            answer.words[0], 1,
+            "the user's handler read query {seed} in a copy"
+        );
+        assert_eq!(
+            answer.words[3], 1,
+            "the user's handler built answer {seed} on the heap"
+        );
+        assert!(
+            !answer.is_writable(),
+            "answer {seed} was copied out of its sample"
+        );
+        for at in [4, 5, 4096, 8191] {
+            assert_eq!(answer.words[at], word(seed, at).wrapping_mul(7));
+        }
+    }
+    let text = finished(child).await;
+    assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() {
     let cell = cell("loan-kill");

@@ -14,6 +14,10 @@
 //! - `ipc_peer child CELL PORT MODULE N`: imports the `QUERY` port PORT (owner PARENT) for
 //!   MODULE, whose response handler answers N queries with five times their number, printing
 //!   each; then exits.
+//! - `ipc_peer frame-child CELL PORT MODULE N`: imports the `QUERY` port PORT of frames
+//!   built in place (owner PARENT) for MODULE, whose response handler answers N queries as
+//!   `inspector` below does, with every further word seven times the frame's, printing
+//!   `answered` after each; then exits.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -36,7 +40,7 @@ use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_response, export_response_shared,
-    export_shared, import, import_call_all, import_query, import_send_all,
+    export_shared, import, import_call_all, import_query, import_query_shared, import_send_all,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["child", cell, port, module, n] => child(cell, port, module, n).await,
+            ["frame-child", cell, port, module, n] => frame_child(cell, port, module, n).await,
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
                 "usage: ipc_peer owner|tight-owner|responder CELL PORT | user|listener|answerer|child CELL PORT MODULE N"
@@ -154,18 +159,36 @@ async fn inspector(cell: &str, port: &str) -> Result<(), Error> {
     let _exported = export_response_shared(&Remote::new(cell)?, &port)?;
     println!("ready");
     let factor = 5;
-    let mut inspector = port.owner_responder(|factor: &u64, mut frame: Shared<Frame>| {
-        let mut answer: Shared<Frame> = frame.loan_reply();
-        answer.words[0] = u64::from(!frame.is_writable());
-        answer.words[3] = u64::from(!answer.buffer().is::<Box<Frame>>());
-        for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(4) {
-            *out = word.wrapping_mul(*factor);
-        }
-        answer
-    })?;
+    let mut inspector = port.owner_responder(inspect)?;
     loop {
         inspector.serve(&factor).await?;
     }
+}
+
+/// Answers `frame` with one built in a loan made for it: word 0 is 1 if the frame was read
+/// in place (not a copy of its own), word 3 is 1 if the answer lies in a loan, and every
+/// further word is `factor` times the frame's.
+fn inspect(factor: &u64, mut frame: Shared<Frame>) -> Shared<Frame> {
+    let mut answer: Shared<Frame> = frame.loan_reply();
+    answer.words[0] = u64::from(!frame.is_writable());
+    answer.words[3] = u64::from(!answer.buffer().is::<Box<Frame>>());
+    for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(4) {
+        *out = word.wrapping_mul(*factor);
+    }
+    answer
+}
+
+async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
+    let imported =
+        import_query_shared::<Frame, Frame>(&Remote::new(cell)?, port, "PARENT", module)?;
+    let factor = 7;
+    let mut answering = imported.port().responder_named(module, inspect)?;
+    for _ in 0..n.parse::<u64>()? {
+        answering.serve(&factor).await?;
+        println!("answered");
+    }
+    imported.settled().await;
+    Ok(())
 }
 
 async fn responder(cell: &str, port: &str) -> Result<(), Error> {
