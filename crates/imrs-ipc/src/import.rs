@@ -30,7 +30,7 @@ use crate::wire::{
 use crate::{IpcError, Remote, Wire};
 
 /// A port's client, shared by its forwarder and its lender.
-type SharedAsker<Req, Rep> = Arc<Mutex<Asker<Req, Rep>>>;
+pub(crate) type SharedAsker<Req, Rep> = Arc<Mutex<Asker<Req, Rep>>>;
 
 /// A request sent, and the local sender's right to its reply (taken when answered), which
 /// the port carries as `R`.
@@ -313,12 +313,13 @@ impl<Req: Wire, Rep: Wire> Lent<Req, Rep> for Shared<Req> {
 
 /// Relays what `taken` takes to port `name`'s owner in another process, as module
 /// `module`, and hands each reply back; connects first. Call it within a tokio runtime.
+/// Also gives the relay's client, whose samples a message may be built in.
 pub(crate) fn relay<Req, Rep, M, R, T>(
     remote: &Remote,
     name: &Name,
     module: &str,
     taken: T,
-) -> Result<Relay, IpcError>
+) -> Result<(Relay, SharedAsker<Req, Rep>), IpcError>
 where
     Req: Wire,
     Rep: Wire,
@@ -327,7 +328,9 @@ where
     T: Take<M, R>,
 {
     let connection = connect::<Req, Rep>(remote, name, module)?;
-    Ok(relay_connected::<Req, Rep, M, R, T>(connection, name, module, taken)?.0)
+    let (relay, side) = relay_connected::<Req, Rep, M, R, T>(connection, name, module, taken)?;
+    let client = Arc::clone(&lock(&side).client);
+    Ok((relay, client))
 }
 
 /// One port's bridge in a user's process: the local owner's end through which the

@@ -130,9 +130,9 @@
 //! `RESPONSE` ports of `Shared` messages cross the same way, with [`export_response_shared`]
 //! and [`import_response_shared`]: a query loaned and built in place, read in place by the
 //! owner's response handler, whose answer is built in a reply loan. So do `QUERY` ports,
-//! with [`export_query_shared`] and [`import_query_shared`]: the user's response handler
-//! reads the owner's query in place and builds its answer in a reply loan, read in place by
-//! the owner; the owner's query, loaned from the heap, is copied once into a sample.
+//! with [`export_query_shared`] and [`import_query_shared`]: the owner's query, loaned from
+//! the user's process, is read in place by the user's response handler, which builds its
+//! answer in a reply loan, read in place by the owner.
 //!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
 //! the port allows at once (16). A `Shared` message that does not lie in one of the port's

@@ -10,9 +10,11 @@ use imrs_core::imrs_ports::{
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
 
-use crate::carry::Carry;
+use std::sync::{Arc, Mutex};
+
+use crate::carry::{Carry, lend, lock};
 use crate::export::{Forward, Refusal, bridge};
-use crate::import::{Relay, Take, connect, relay};
+use crate::import::{Relay, SharedAsker, Take, connect, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
 /// The service a remote user module is served on.
@@ -60,9 +62,12 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
-        port.user_named(module)
-    })
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| port.user_named(module),
+        None,
+    )
 }
 
 /// Exports `port`, a `CALLALL` port, to the other processes of `remote`'s cell: its owner's
@@ -75,10 +80,17 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     // The handler never runs: the relay takes each query and answers it with the other
     // process's reply.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
-        port.responder_named(module, |_: &(), _: Req| Rep::default())
-    })
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| port.responder_named(module, |_: &(), _: Req| Rep::default()),
+        None,
+    )
 }
+
+/// The client of the relay to the remote user module attached last: where an owner's loans
+/// on a port of [`Shared`] messages come from.
+type Lending<Req, Rep> = Arc<Mutex<Option<SharedAsker<Req, Rep>>>>;
 
 /// How a remote module's end of the real port is attached.
 type UserEnd<Req, Rep, U, L, T, const N: usize> =
@@ -94,25 +106,43 @@ pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 ) -> Result<Exported, IpcError> {
     // The handler never runs: the relay takes each query and answers it with the other
     // process's reply.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
-        port.responder_named(module, |_: &(), _: Req| Rep::default())
-    })
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| port.responder_named(module, |_: &(), _: Req| Rep::default()),
+        None,
+    )
 }
 
 /// Exports `port`, a `QUERY` port of messages built in place ([`Shared`]), as
-/// [`export_query`] does a port of values. The owner's query is copied once into a sample
-/// of shared memory (its loans come from the heap: the port may have users in several
-/// processes, and a sample is one process's); the user module's response handler, in its
-/// own process, reads it there and builds its answer in place
+/// [`export_query`] does a port of values. The owner's loans ([`End::loan`]) are samples
+/// of shared memory, of the user process attached last (on the heap until one is): a
+/// query built there to that user crosses with nothing copied, and one to a user in
+/// another process is copied once. The user module's response handler, in its own
+/// process, reads the query where it lies and builds its answer in place
 /// ([`Shared::loan_reply`]), which the owner reads where it lies.
 pub fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Query, L, N>,
 ) -> Result<Exported, IpcError> {
+    let lending = Lending::<Req, Rep>::default();
+    let (from, name) = (Arc::clone(&lending), Name::from(port));
+    let _lends = port.clone().lend_with(move || {
+        let client = lock(&from).clone();
+        match client {
+            Some(client) => lend(&client, &name),
+            None => Ok(Shared::default()),
+        }
+    });
     // The handler never runs, as for `export_query`.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, |port, module| {
-        port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
-    })
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| {
+            port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
+        },
+        Some(lending),
+    )
 }
 
 /// Exports a port whose owner starts each rendezvous: each remote module attached gets
@@ -122,6 +152,7 @@ fn export_relayed<Req, Rep, M, R, U, L, T, const N: usize>(
     remote: &Remote,
     port: &Port<M, R, U, L, N>,
     user_end: UserEnd<M, R, U, L, T, N>,
+    lending: Option<Lending<Req, Rep>>,
 ) -> Result<Exported, IpcError>
 where
     Req: Wire,
@@ -149,9 +180,13 @@ where
             // The module's own end of the real port: what it receives goes to its process.
             let end = user_end(&port, module)?;
             let _entered = runtime.enter();
-            relay::<Req, Rep, M, R, T>(&cell, &to_module(&served, module), owner.as_str(), end)
-                .map(|relay| Relayed { _relay: relay })
-                .map_err(|_| Refusal::Failed)
+            let (relay, client) =
+                relay::<Req, Rep, M, R, T>(&cell, &to_module(&served, module), owner.as_str(), end)
+                    .map_err(|_| Refusal::Failed)?;
+            if let Some(lending) = &lending {
+                *lock(lending) = Some(client);
+            }
+            Ok(Relayed { _relay: relay })
         })?;
     Ok(exported)
 }

@@ -1141,9 +1141,10 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
     }
 }
 
-/// The owner of a `QUERY` port of frames queries its user in another process: the user's
-/// response handler reads each query where it lies in shared memory and builds its answer
-/// in a reply loan, which the owner reads in place.
+/// The owner of a `QUERY` port of frames queries its user in another process. Its loans
+/// are samples of that user's process, where its queries are built and sent as they lie;
+/// the user's response handler reads each where it lies and builds its answer in a reply
+/// loan, which the owner reads in place.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_process() {
     let cell = cell("shared-owner-query");
@@ -1151,10 +1152,19 @@ async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_p
         Port::declare(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
     let _exported = imrs_ipc::export_query_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
-    let child = peer(&["frame-child", &cell, "ASK_FRAME", "CHILD", "10"]);
+    let child = peer(&["frame-child", &cell, "ASK_FRAME", "CHILD", "11"]);
     until_users(&parent, 1).await;
-    for seed in 1..=10u64 {
-        let mut frame = parent.loan().unwrap();
+    // The user is attached a moment before its process's relay is connected: until then a
+    // loan is on the heap.
+    within(5, async {
+        while parent.loan().unwrap().buffer().is::<Box<Frame>>() {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    let ask = async |parent: &mut End<Shared<Frame>, Shared<Frame>, usage::Query>,
+                     mut frame: Shared<Frame>,
+                     seed: u64| {
         for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
             *out = word(seed, at);
         }
@@ -1174,9 +1184,31 @@ async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_p
         for at in [4, 5, 4096, 8191] {
             assert_eq!(answer.words[at], word(seed, at).wrapping_mul(7));
         }
+    };
+    for seed in 1..=10u64 {
+        let frame = parent.loan().unwrap();
+        assert!(
+            !frame.buffer().is::<Box<Frame>>(),
+            "loan {seed} is on the heap"
+        );
+        ask(&mut parent, frame, seed).await;
     }
+    // With every loan out, a query built in the last still crosses: it goes as it lies,
+    // where a copy would find no room.
+    let mut held = Vec::new();
+    let refused = loop {
+        match parent.loan() {
+            Ok(loan) => held.push(loan),
+            Err(error) => break error,
+        }
+        assert!(held.len() <= 64, "loans without end");
+    };
+    assert_eq!(refused.port.as_str(), "ASK_FRAME");
+    let last = held.pop().unwrap();
+    ask(&mut parent, last, 11).await;
+    drop(held);
     let text = finished(child).await;
-    assert_eq!(text.lines().filter(|line| *line == "answered").count(), 10);
+    assert_eq!(text.lines().filter(|line| *line == "answered").count(), 11);
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
