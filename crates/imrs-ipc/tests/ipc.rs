@@ -55,6 +55,34 @@ fn word(seed: u64, at: usize) -> u64 {
     seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ at as u64
 }
 
+/// Writes frame `seed`'s words, from word 4 on.
+fn write_frame(frame: &mut Frame, seed: u64) {
+    for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
+        *out = word(seed, at);
+    }
+}
+
+/// Checks the answer to frame `seed` of a handler that inspects frames (the peer's
+/// `inspect`) with `factor`: the handler read the frame in place, built its answer in a
+/// loan, and that answer is read here in place.
+fn assert_inspected(mut answer: Shared<Frame>, seed: u64, factor: u64) {
+    assert_eq!(
+        answer.words[0], 1,
+        "the handler read query {seed} in a copy"
+    );
+    assert_eq!(
+        answer.words[3], 1,
+        "the handler built answer {seed} on the heap"
+    );
+    assert!(
+        !answer.is_writable(),
+        "answer {seed} was copied out of its sample"
+    );
+    for at in [4, 5, 4096, 8191] {
+        assert_eq!(answer.words[at], word(seed, at).wrapping_mul(factor));
+    }
+}
+
 fn cell(test: &str) -> String {
     let nanos = SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -1119,25 +1147,9 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
     for seed in 1..=10u64 {
         let mut frame = asker.loan().unwrap();
         assert!(!frame.buffer().is::<Box<Frame>>());
-        for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
-            *out = word(seed, at);
-        }
-        let mut answer = within(10, asker.query(frame)).await.unwrap();
-        assert_eq!(
-            answer.words[0], 1,
-            "the handler read query {seed} in a copy"
-        );
-        assert_eq!(
-            answer.words[3], 1,
-            "the handler built answer {seed} on the heap"
-        );
-        assert!(
-            !answer.is_writable(),
-            "answer {seed} was copied out of its sample"
-        );
-        for at in [4, 5, 4096, 8191] {
-            assert_eq!(answer.words[at], word(seed, at).wrapping_mul(5));
-        }
+        write_frame(&mut frame, seed);
+        let answer = within(10, asker.query(frame)).await.unwrap();
+        assert_inspected(answer, seed, 5);
     }
 }
 
@@ -1165,25 +1177,9 @@ async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_p
     let ask = async |parent: &mut End<Shared<Frame>, Shared<Frame>, usage::Query>,
                      mut frame: Shared<Frame>,
                      seed: u64| {
-        for (at, out) in frame.words.iter_mut().enumerate().skip(4) {
-            *out = word(seed, at);
-        }
-        let mut answer = within(10, parent.query(frame)).await.unwrap();
-        assert_eq!(
-            answer.words[0], 1,
-            "the user's handler read query {seed} in a copy"
-        );
-        assert_eq!(
-            answer.words[3], 1,
-            "the user's handler built answer {seed} on the heap"
-        );
-        assert!(
-            !answer.is_writable(),
-            "answer {seed} was copied out of its sample"
-        );
-        for at in [4, 5, 4096, 8191] {
-            assert_eq!(answer.words[at], word(seed, at).wrapping_mul(7));
-        }
+        write_frame(&mut frame, seed);
+        let answer = within(10, parent.query(frame)).await.unwrap();
+        assert_inspected(answer, seed, 7);
     };
     for seed in 1..=10u64 {
         let frame = parent.loan().unwrap();
