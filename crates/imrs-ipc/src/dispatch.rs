@@ -17,8 +17,9 @@ pub(crate) trait Work: Send + 'static {
     /// Moves what has arrived, either way, and registers the dispatch to be woken when more
     /// does. Must not block. `everything`: looks at all there may be, whatever woke it, so
     /// that a message whose notification was lost waits one tick at most; otherwise only
-    /// at what the wake-ups said is there.
-    fn work(&mut self, everything: bool);
+    /// at what the wake-ups said is there. Whether the bridge is still open: `false` once
+    /// its port or its reactor is gone, for good.
+    fn work(&mut self, everything: bool) -> bool;
 }
 
 /// The waker of a bridge: does the bridge's work where it is woken, or wakes its task.
@@ -67,7 +68,8 @@ impl Dispatch {
             Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
             Err(TryLockError::WouldBlock) => return false,
         };
-        side.work(false);
+        // A bridge found closed here is ended by its task, at its next turn.
+        let _open = side.work(false);
         true
     }
 }

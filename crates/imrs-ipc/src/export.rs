@@ -306,12 +306,8 @@ where
             // one) waits a tick at most.
             let mut tick = tokio::time::interval(TICK);
             loop {
-                {
-                    let mut side = lock(&side);
-                    side.work(true);
-                    if side.closed {
-                        return;
-                    }
+                if !lock(&side).work(true) {
+                    return;
                 }
                 tokio::select! {
                     () = dispatch.woken() => {}
@@ -340,7 +336,7 @@ where
                 if listener.timed_wait(|_| {}, TICK).is_err() {
                     break;
                 }
-                lock(&side).work(true);
+                let _open = lock(&side).work(true);
             }
         })
         .map_err(|error| IpcError::Transport {
@@ -521,7 +517,7 @@ where
     E: Forward<M, R>,
     A: FnMut(&str) -> Result<E, Refusal> + Send + 'static,
 {
-    fn work(&mut self, everything: bool) {
+    fn work(&mut self, everything: bool) -> bool {
         let notified = match &self.readiness {
             Some(readiness) => readiness
                 .drain(&mut Context::from_waker(&self.dispatch))
@@ -534,6 +530,7 @@ where
         // A wake-up of the flights alone (a module answered) has no request to take.
         self.serve(true, everything || notified);
         self.announce();
+        !self.closed
     }
 }
 

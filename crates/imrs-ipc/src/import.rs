@@ -388,7 +388,7 @@ impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>> Work
 {
     /// Forwards each request the importing module sent, and hands each reply that came
     /// back to its sender.
-    fn work(&mut self, everything: bool) {
+    fn work(&mut self, everything: bool) -> bool {
         let dispatch = self.dispatch.clone();
         let mut cx = Context::from_waker(&dispatch);
         let notified = self.readiness.drain(&mut cx).unwrap_or_else(|_| {
@@ -413,6 +413,7 @@ impl<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: Take<M, R>> Work
         if everything || notified {
             look(&mut self.waiting);
         }
+        !self.closed
     }
 }
 
@@ -593,12 +594,8 @@ async fn relay_requests<Req: Wire, Rep: Wire, M: Carry<Req>, R: Carry<Rep>, T: T
     let mut sweep = tokio::time::interval(SWEEP_PERIOD);
     sweep.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
-        {
-            let mut side = lock(side);
-            side.work(true);
-            if side.closed {
-                return;
-            }
+        if !lock(side).work(true) {
+            return;
         }
         tokio::select! {
             () = dispatch.woken() => {}
