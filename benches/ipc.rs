@@ -23,9 +23,11 @@
 //! each end, and are left out of a run that has one.
 //!
 //! Each IMRS case runs where a module runs, in a task on the runtime's workers; each raw
-//! case in a thread of its own. Where the processes run weighs on the raw round trip that
-//! blocks its thread more than on any other: started under `taskset -c 0`, the bench and
-//! its peers share one processor, and a wake-up never has to reach another.
+//! case in a thread of its own. Where the processes run, and how many threads each has,
+//! weighs on every case that waits, in ways the port does not decide: started under
+//! `taskset -c 0`, the bench and its peers share one processor, and a wake-up never has to
+//! reach another; `IMRS_IPC_BENCH_WORKERS=1` gives each process's runtime one worker
+//! rather than two.
 //!
 //! `cargo bench --bench ipc` measures 20 000 round trips a case; `cargo test` runs 200, so
 //! that the benchmark cannot rot. The peers are this same binary, started again with
@@ -70,6 +72,8 @@ const ONE_ID: &str = "-one-id";
 const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
 /// The raw part served by a task of the peer's runtime.
 const TASK_PART: &str = "task-one-id";
+/// How many workers each process's runtime has, if not two.
+const WORKERS: &str = "IMRS_IPC_BENCH_WORKERS";
 
 fn main() {
     if let Ok(cell) = std::env::var(PEER) {
@@ -82,8 +86,8 @@ fn main() {
         200
     };
     let cell = format!("bench-{}", std::process::id());
-    let mut child = start_peer(&cell, Peer::Parked);
     let runtime = runtime();
+    let mut child = start_peer(&cell, Peer::Parked);
     let raw_small = raw_round_trips::<Small>(&cell, "small", rounds, Wait::Events);
     let raw_large = raw_round_trips::<Large>(&cell, "large", rounds, Wait::Events);
     let raw_small_one_id =
@@ -244,12 +248,22 @@ enum Wait {
     Spin,
 }
 
-/// Each process's runtime: two workers, with stacks large enough for 64 KiB messages, which
-/// the bridges' futures copy by value — more than tokio's 2 MiB default holds in a debug
-/// build.
+/// Each process's runtime: two workers (or as many as `IMRS_IPC_BENCH_WORKERS` says, which
+/// the peers inherit), with stacks large enough for 64 KiB messages, which the bridges'
+/// futures copy by value — more than tokio's 2 MiB default holds in a debug build.
 fn runtime() -> tokio::runtime::Runtime {
+    let workers = match std::env::var(WORKERS) {
+        Err(_) => 2,
+        Ok(workers) => match workers.parse::<usize>() {
+            Ok(workers) if workers > 0 => workers,
+            _ => {
+                eprintln!("{WORKERS}={workers:?}: give a number of workers, 1 or more");
+                std::process::exit(2);
+            }
+        },
+    };
     tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
+        .worker_threads(workers)
         .thread_stack_size(32 << 20)
         .enable_all()
         .build()
