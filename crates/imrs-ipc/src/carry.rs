@@ -199,6 +199,14 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Received<Req, Rep> {
         None
     }
 
+    /// No one writes the request: a clone reads it where it lies, and keeps its sample.
+    fn share(&self) -> Option<Box<dyn Buffer<Req> + Send>> {
+        Some(Box::new(Received {
+            payload: self.payload,
+            request: Arc::clone(&self.request),
+        }))
+    }
+
     fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
         let mut loan: ReplyUninit<Rep> = lock(&self.request).loan_uninit().ok()?;
         // SAFETY: `Rep: FromBytes` (a bound of `Wire`), so all zeros are one of its values;

@@ -132,6 +132,12 @@
 //! owner's response handler, whose answer is built in a reply loan. So do `QUERY` ports,
 //! with [`export_query_shared`] and [`import_query_shared`]: the owner's query, loaned from
 //! the user's process, is read in place by the user's response handler, which builds its
+//! answer in a reply loan, read in place by the owner. And `SENDALL` and `CALLALL` ports,
+//! with [`export_send_all_shared`] and [`import_send_all_shared`], [`export_call_all_shared`]
+//! and [`import_call_all_shared`]: a broadcast hands each user a message of its own, so the
+//! owner's message is copied for each user, and once more into that user's sample; in the
+//! user's process the module reads it in place (its local broadcast shares it rather than
+//! copying it, as `Shared`'s `Clone` does for a message no one writes), and builds its
 //! answer in a reply loan, read in place by the owner.
 //!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
@@ -153,8 +159,9 @@ pub use error::IpcError;
 pub use export::{Exported, export, export_response, export_response_shared, export_shared};
 pub use import::{Imported, import, import_response, import_response_shared, import_shared};
 pub use send_all::{
-    export_call_all, export_query, export_query_shared, export_send_all, import_call_all,
-    import_query, import_query_shared, import_send_all,
+    export_call_all, export_call_all_shared, export_query, export_query_shared, export_send_all,
+    export_send_all_shared, import_call_all, import_call_all_shared, import_query,
+    import_query_shared, import_send_all, import_send_all_shared,
 };
 pub use wire::{Remote, Wire};
 

@@ -36,22 +36,29 @@ impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for Relayed {
 }
 
 /// On a user's side, the local port's owner end: each broadcast from the other process is
-/// sent to the one local user, whose reply goes back.
-impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::SendAll> {
-    async fn forward(&mut self, request: Req) -> Option<Rep> {
+/// sent to the one local user, whose reply goes back. A message read in place is shared
+/// with that user, not copied ([`Shared`]'s `Clone`).
+impl<M: Clone + Send + 'static, R: Default + Send + 'static> Forward<M, R>
+    for End<M, R, usage::SendAll>
+{
+    async fn forward(&mut self, request: M) -> Option<R> {
         self.peer_attached().await;
-        let broadcast = self.send_all(request).await.ok()?;
-        Some(broadcast.first)
+        let mut broadcast = self.send_all(request).await.ok()?;
+        // Taken, not moved: the broadcast lets the other users' requests go when dropped.
+        Some(std::mem::take(&mut broadcast.first))
     }
 }
 
 /// On a user's side, the local port's owner end: each query from the other process goes
 /// to the one local user's response handler, which answers when that module's order says.
-impl<Req: Wire, Rep: Wire> Forward<Req, Rep> for End<Req, Rep, usage::CallAll> {
-    async fn forward(&mut self, request: Req) -> Option<Rep> {
+impl<M: Clone + Send + 'static, R: Default + Send + 'static> Forward<M, R>
+    for End<M, R, usage::CallAll>
+{
+    async fn forward(&mut self, request: M) -> Option<R> {
         self.peer_attached().await;
-        let broadcast = self.call_all(request).await.ok()?;
-        Some(broadcast.first)
+        let mut broadcast = self.call_all(request).await.ok()?;
+        // Taken, not moved: the broadcast lets the other users' requests go when dropped.
+        Some(std::mem::take(&mut broadcast.first))
     }
 }
 
@@ -84,6 +91,43 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
         remote,
         port,
         |port, module| port.responder_named(module, |_: &(), _: Req| Rep::default()),
+        None,
+    )
+}
+
+/// Exports `port`, a `SENDALL` port of messages built in place ([`Shared`]), as
+/// [`export_send_all`] does a port of values. A broadcast hands every user a message of
+/// its own: the owner's is copied for each remote user, and once more into that user's
+/// sample. There the user module reads it in place, and builds its reply in place
+/// ([`Shared::loan_reply`]), which the owner reads where it lies. The owner's loans are on
+/// the heap: a sample would be copied all the same.
+pub fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Shared<Req>, Shared<Rep>, usage::SendAll, L, N>,
+) -> Result<Exported, IpcError> {
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| port.user_named(module),
+        None,
+    )
+}
+
+/// Exports `port`, a `CALLALL` port of messages built in place ([`Shared`]), as
+/// [`export_call_all`] does a port of values, and as [`export_send_all_shared`] carries
+/// them: copied for each remote user and into its sample, read in place there by its
+/// response handler, whose answer, built in place, the owner reads where it lies.
+pub fn export_call_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+    remote: &Remote,
+    port: &Port<Shared<Req>, Shared<Rep>, usage::CallAll, L, N>,
+) -> Result<Exported, IpcError> {
+    // The handler never runs, as for `export_call_all`.
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+        remote,
+        port,
+        |port, module| {
+            port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
+        },
         None,
     )
 }
@@ -215,6 +259,31 @@ pub fn import_call_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::CallAll>, IpcError> {
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+}
+
+/// Imports a `SENDALL` port of messages built in place ([`Shared`]), exported with
+/// [`export_send_all_shared`], as [`import_send_all`] does a port of values: `module`
+/// receives each broadcast where it lies in shared memory, and builds its reply in place
+/// ([`Shared::loan_reply`]), which crosses back with nothing copied.
+pub fn import_send_all_shared<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::SendAll>, IpcError> {
+    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+}
+
+/// Imports a `CALLALL` port of messages built in place ([`Shared`]), exported with
+/// [`export_call_all_shared`], as [`import_call_all`] does a port of values: `module`'s
+/// response handler reads each query where it lies, and builds its answer in place.
+pub fn import_call_all_shared<Req: Wire, Rep: Wire>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::CallAll>, IpcError> {
     import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
 }
 

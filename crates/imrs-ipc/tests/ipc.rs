@@ -1291,3 +1291,83 @@ async fn a_process_killed_while_nobody_waited_on_it_is_swept_by_the_next_to_star
         "the killed process's node is left"
     );
 }
+
+/// The factor each user process answers with, by module.
+fn factor_of(module: &str) -> u64 {
+    match module {
+        "LEFT" => 3,
+        "RIGHT" => 5,
+        other => panic!("an answer from {other}, not a user"),
+    }
+}
+
+/// Checks the answers to broadcast `seed`, first and later, one from each of LEFT and
+/// RIGHT: each read the frame in place, and built its answer in place, read here in place.
+async fn assert_each_inspected<Req>(
+    mut broadcast: imrs_core::imrs_ports::Broadcast<'_, Req, Shared<Frame>>,
+    seed: u64,
+) {
+    let first = std::mem::take(&mut broadcast.first);
+    let mut from = vec![broadcast.from.to_string()];
+    assert_inspected(first, seed, factor_of(&from[0]));
+    let (second, answer) = within(10, broadcast.next_reply()).await.unwrap();
+    assert_inspected(answer, seed, factor_of(second.as_str()));
+    from.push(second.to_string());
+    from.sort();
+    assert_eq!(from, ["LEFT", "RIGHT"], "each user answers once");
+    assert!(within(10, broadcast.next_reply()).await.is_none());
+}
+
+/// The user processes LEFT and RIGHT of port `port`, each in `role`, answering six frames.
+fn frame_users(role: &str, cell: &str, port: &str) -> Vec<Peer> {
+    [("LEFT", "3"), ("RIGHT", "5")]
+        .iter()
+        .map(|(module, factor)| peer(&[role, cell, port, module, "6", factor]))
+        .collect()
+}
+
+/// Waits for each of `users` to end, having answered six frames.
+async fn answered_six(users: Vec<Peer>) {
+    for user in users {
+        let text = finished(user).await;
+        assert_eq!(text.lines().filter(|line| *line == "answered").count(), 6);
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes() {
+    let cell = cell("shared-send-all");
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut camera = port.owner().unwrap();
+    let users = frame_users("frame-listener", &cell, "FRAMES");
+    until_users(&camera, 2).await;
+    for seed in 1..=6u64 {
+        // Built in a loan, as a module would: on the heap here, copied once into each user's
+        // sample.
+        let mut frame = camera.loan().unwrap();
+        write_frame(&mut frame, seed);
+        let broadcast = within(10, camera.send_all(frame)).await.unwrap();
+        assert_each_inspected(broadcast, seed).await;
+    }
+    answered_six(users).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_processes() {
+    let cell = cell("shared-call-all");
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::CallAll, AnyUser, 2> =
+        Port::declare(PortSpec::new("LOOK", "CAMERA").user_list(["LEFT", "RIGHT"]));
+    let _exported = imrs_ipc::export_call_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut camera = port.owner().unwrap();
+    let users = frame_users("frame-answerer", &cell, "LOOK");
+    until_users(&camera, 2).await;
+    for seed in 1..=6u64 {
+        let mut frame = Shared::new(Frame::default());
+        write_frame(&mut frame, seed);
+        let poll = within(10, camera.call_all(frame)).await.unwrap();
+        assert_each_inspected(poll, seed).await;
+    }
+    answered_six(users).await;
+}

@@ -50,7 +50,9 @@
 //! The receiver builds its reply the same way, in memory its message's transport lends for
 //! it ([`Shared::loan_reply`]). A message received from another process lies where its
 //! sender wrote it, and is read-only there: changing it ([`DerefMut`]) first copies it to
-//! the heap, once.
+//! the heap, once. Cloning it (as a `SENDALL` or `CALLALL` port does, once for each user)
+//! copies nothing: the clone reads the same memory. A message that may still be written is
+//! cloned by copying it to the heap.
 
 use std::any::Any;
 use std::fmt;
@@ -70,6 +72,15 @@ pub trait Buffer<T>: Any + Send {
     /// [`Shared`] of the reply's type, boxed as `Any`. `None` (the default) where the
     /// transport lends none, and the reply is built on the heap.
     fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
+        None
+    }
+
+    /// Another handle to this same message, read-only where it lies, for a copy of the
+    /// message that needs none ([`Shared`]'s `Clone`): a buffer no one writes (a message
+    /// received from another process) can give one, and the memory is let go when the last
+    /// handle is dropped. `None` (the default) where the message may be written, and its
+    /// clone is a copy.
+    fn share(&self) -> Option<Box<dyn Buffer<T> + Send>> {
         None
     }
 }
@@ -154,6 +165,20 @@ impl<T: Clone + Send + 'static> DerefMut for Shared<T> {
         self.buffer
             .get_mut()
             .expect("a message just copied to the heap is writable")
+    }
+}
+
+/// A message that lies where no one writes it (one received from another process) is
+/// shared: the clone reads the same memory, as a `SENDALL` or `CALLALL` port needs to hand
+/// one message to every user without copying it. A message that may be written (on the
+/// heap, or in a loan still being built) is copied to the heap, so that neither handle sees
+/// the other's changes.
+impl<T: Clone + Send + 'static> Clone for Shared<T> {
+    fn clone(&self) -> Self {
+        match self.buffer.share() {
+            Some(buffer) => Self { buffer },
+            None => Self::new(self.buffer.get().clone()),
+        }
     }
 }
 

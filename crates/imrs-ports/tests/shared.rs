@@ -139,3 +139,97 @@ fn a_reply_is_loaned_where_the_transport_lends_it_and_on_the_heap_otherwise() {
     assert!(reply.buffer().is::<Box<u64>>());
     assert_eq!(*reply, 0);
 }
+
+/// A transport's memory that no one writes, which it can share: what a message received
+/// from another process lies in.
+struct Received(Arc<Image>);
+
+impl Buffer<Image> for Received {
+    fn get(&self) -> &Image {
+        &self.0
+    }
+
+    fn get_mut(&mut self) -> Option<&mut Image> {
+        None
+    }
+
+    fn share(&self) -> Option<Box<dyn Buffer<Image> + Send>> {
+        Some(Box::new(Received(Arc::clone(&self.0))))
+    }
+}
+
+#[test]
+fn a_clone_of_a_message_no_one_writes_reads_the_same_memory_and_a_writable_ones_is_a_copy() {
+    let mut image = Image::default();
+    image.pixels[0] = 5;
+    let memory = Arc::new(image);
+    let received = Shared::in_buffer(Received(Arc::clone(&memory)));
+    let clone = received.clone();
+    assert_eq!(clone.pixels.as_ptr(), memory.pixels.as_ptr(), "copied");
+    assert_eq!(Arc::strong_count(&memory), 3);
+    // The memory is let go when the last handle is.
+    drop(received);
+    assert_eq!(Arc::strong_count(&memory), 2);
+    // Changing the clone copies it, once, and leaves the memory as it was.
+    let mut changed = clone.clone();
+    changed.pixels[0] = 6;
+    assert_eq!(
+        (changed.pixels[0], clone.pixels[0], memory.pixels[0]),
+        (6, 5, 5)
+    );
+    drop((clone, changed));
+    assert_eq!(Arc::strong_count(&memory), 1);
+
+    // Writable, on the heap: the clone is a copy, and neither sees the other's changes.
+    let mut original = Shared::new(Image::default());
+    let mut copy = original.clone();
+    assert_ne!(copy.pixels.as_ptr(), original.pixels.as_ptr());
+    original.pixels[0] = 1;
+    copy.pixels[0] = 2;
+    assert_eq!((original.pixels[0], copy.pixels[0]), (1, 2));
+    // Read-only, but not shareable: copied to the heap.
+    let unshared = Shared::in_buffer(ReadOnly(Arc::clone(&memory)));
+    let copy = unshared.clone();
+    assert!(copy.buffer().is::<Box<Image>>());
+    assert_eq!(copy.pixels[0], 5);
+}
+
+#[tokio::test]
+async fn a_broadcast_of_a_message_no_one_writes_reaches_every_user_where_it_lies() {
+    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::declare(
+        PortSpec::new("FRAME", "CAMERA"),
+    );
+    let mut camera = port.owner().unwrap();
+    let mut users: Vec<_> = ["VISION", "GRIPPER", "LOGGER"]
+        .into_iter()
+        .map(|module| port.user_named(module).unwrap())
+        .collect();
+    let mut frame = Image::default();
+    frame.pixels[..3].fill(1);
+    let memory = Arc::new(frame);
+    let reading = users
+        .drain(..)
+        .map(|mut user| {
+            tokio::spawn(async move {
+                let (frame, reply) = user.receive().await.unwrap();
+                let read_at = frame.pixels.as_ptr() as usize;
+                reply.reply(Shared::new(
+                    frame.pixels.iter().map(|&p| u64::from(p)).sum(),
+                ));
+                read_at
+            })
+        })
+        .collect::<Vec<_>>();
+    let broadcast = camera
+        .send_all(Shared::in_buffer(Received(Arc::clone(&memory))))
+        .await
+        .unwrap();
+    assert_eq!(*broadcast.first, 3);
+    for user in reading {
+        assert_eq!(
+            user.await.unwrap(),
+            memory.pixels.as_ptr() as usize,
+            "a user's frame was copied"
+        );
+    }
+}

@@ -18,6 +18,12 @@
 //!   built in place (owner PARENT) for MODULE, whose response handler answers N queries as
 //!   `inspector` below does, with every further word seven times the frame's, printing
 //!   `answered` after each; then exits.
+//! - `ipc_peer frame-listener CELL PORT MODULE N FACTOR`: imports the `SENDALL` port PORT
+//!   of frames built in place (owner CAMERA) for MODULE, which answers N broadcasts as
+//!   `inspector` below does, with every further word FACTOR times the frame's, printing
+//!   `answered` after each; then exits.
+//! - `ipc_peer frame-answerer CELL PORT MODULE N FACTOR`: the same for the `CALLALL` port
+//!   PORT (owner CAMERA), answered by MODULE's response handler.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -40,7 +46,8 @@ use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_response, export_response_shared,
-    export_shared, import, import_call_all, import_query, import_query_shared, import_send_all,
+    export_shared, import, import_call_all, import_call_all_shared, import_query,
+    import_query_shared, import_send_all, import_send_all_shared,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -83,9 +90,17 @@ fn main() -> ExitCode {
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
             ["child", cell, port, module, n] => child(cell, port, module, n).await,
             ["frame-child", cell, port, module, n] => frame_child(cell, port, module, n).await,
+            ["frame-listener", cell, port, module, n, factor] => {
+                frame_listener(cell, port, module, n, factor).await
+            }
+            ["frame-answerer", cell, port, module, n, factor] => {
+                frame_answerer(cell, port, module, n, factor).await
+            }
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
-                "usage: ipc_peer owner|tight-owner|responder CELL PORT | user|listener|answerer|child CELL PORT MODULE N"
+                "usage: ipc_peer owner|tight-owner|responder|vision|inspector CELL PORT \
+                 | user|listener|answerer|child|frame-child CELL PORT MODULE N \
+                 | frame-listener|frame-answerer CELL PORT MODULE N FACTOR"
                     .into(),
             ),
         }
@@ -182,6 +197,45 @@ async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<()
     let imported =
         import_query_shared::<Frame, Frame>(&Remote::new(cell)?, port, "PARENT", module)?;
     let factor = 7;
+    let mut answering = imported.port().responder_named(module, inspect)?;
+    for _ in 0..n.parse::<u64>()? {
+        answering.serve(&factor).await?;
+        println!("answered");
+    }
+    imported.settled().await;
+    Ok(())
+}
+
+async fn frame_listener(
+    cell: &str,
+    port: &str,
+    module: &str,
+    n: &str,
+    factor: &str,
+) -> Result<(), Error> {
+    let imported =
+        import_send_all_shared::<Frame, Frame>(&Remote::new(cell)?, port, "CAMERA", module)?;
+    let factor = factor.parse::<u64>()?;
+    let mut listening = imported.port().user_named(module)?;
+    for _ in 0..n.parse::<u64>()? {
+        let (frame, reply) = listening.receive().await?;
+        reply.reply(inspect(&factor, frame));
+        println!("answered");
+    }
+    imported.settled().await;
+    Ok(())
+}
+
+async fn frame_answerer(
+    cell: &str,
+    port: &str,
+    module: &str,
+    n: &str,
+    factor: &str,
+) -> Result<(), Error> {
+    let imported =
+        import_call_all_shared::<Frame, Frame>(&Remote::new(cell)?, port, "CAMERA", module)?;
+    let factor = factor.parse::<u64>()?;
     let mut answering = imported.port().responder_named(module, inspect)?;
     for _ in 0..n.parse::<u64>()? {
         answering.serve(&factor).await?;
