@@ -5,7 +5,7 @@
 //! message to reply to, or a query its response handler would answer.
 
 use imrs_core::imrs_ports::{
-    AnyUser, End, Name, Port, PortSpec, Shared, UserList, WireError, usage,
+    AnyUser, End, Name, Port, PortSpec, ResponseEnd, Shared, UserList, WireError, usage,
 };
 
 use imrs_core::imrs_ports::usage::{Plain, Usage};
@@ -85,14 +85,7 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    // The handler never runs: the relay takes each query and answers it with the other
-    // process's reply.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
-        remote,
-        port,
-        |port, module| port.responder_named(module, |_: &(), _: Req| Rep::default()),
-        None,
-    )
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
 }
 
 /// Exports `port`, a `SENDALL` port of messages built in place ([`Shared`]), as
@@ -121,20 +114,27 @@ pub fn export_call_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    // The handler never runs, as for `export_call_all`.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
-        remote,
-        port,
-        |port, module| {
-            port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
-        },
-        None,
-    )
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
 }
 
 /// The client of the relay to the remote user module attached last: where an owner's loans
 /// on a port of [`Shared`] messages come from.
 type Lending<Req, Rep> = Arc<Mutex<Option<SharedAsker<Req, Rep>>>>;
+
+/// A remote module's end of a `QUERY` or `CALLALL` port. Its handler never runs: the relay
+/// takes each query and answers it with the other process's reply.
+fn relayed_responder<M, R, U, L, const N: usize>(
+    port: &Port<M, R, U, L, N>,
+    module: &str,
+) -> Result<ResponseEnd<M, R, ()>, WireError>
+where
+    M: Send + 'static,
+    R: Default + Send + 'static,
+    U: Usage<Complement = usage::Response>,
+    L: UserList,
+{
+    port.responder_named(module, |_: &(), _: M| R::default())
+}
 
 /// How a remote module's end of the real port is attached.
 type UserEnd<Req, Rep, U, L, T, const N: usize> =
@@ -148,14 +148,7 @@ pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Query, L, N>,
 ) -> Result<Exported, IpcError> {
-    // The handler never runs: the relay takes each query and answers it with the other
-    // process's reply.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
-        remote,
-        port,
-        |port, module| port.responder_named(module, |_: &(), _: Req| Rep::default()),
-        None,
-    )
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
 }
 
 /// Exports `port`, a `QUERY` port of messages built in place ([`Shared`]), as
@@ -178,15 +171,7 @@ pub fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
             None => Ok(Shared::default()),
         }
     });
-    // The handler never runs, as for `export_query`.
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
-        remote,
-        port,
-        |port, module| {
-            port.responder_named(module, |_: &(), _: Shared<Req>| Shared::<Rep>::default())
-        },
-        Some(lending),
-    )
+    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, Some(lending))
 }
 
 /// Exports a port whose owner starts each rendezvous: each remote module attached gets
