@@ -1371,3 +1371,31 @@ async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_proce
     }
     answered_six(users).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_answers() {
+    let cell = cell("shared-send-all-kill");
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut camera = port.owner().unwrap();
+    let mut users = frame_users("frame-listener", &cell, "FRAMES");
+    until_users(&camera, 2).await;
+    let mut frame = camera.loan().unwrap();
+    write_frame(&mut frame, 1);
+    let broadcast = within(10, camera.send_all(frame)).await.unwrap();
+    assert_each_inspected(broadcast, 1).await;
+    // kill -9 RIGHT's process: the next broadcast is answered by LEFT, and ends without
+    // RIGHT's answer rather than waiting for it.
+    let mut right = users.pop().unwrap();
+    right.0.kill().unwrap();
+    right.0.wait().unwrap();
+    for seed in 2..=3u64 {
+        let mut frame = camera.loan().unwrap();
+        write_frame(&mut frame, seed);
+        let mut broadcast = within(10, camera.send_all(frame)).await.unwrap();
+        assert_eq!(broadcast.from, "LEFT");
+        assert_inspected(std::mem::take(&mut broadcast.first), seed, 3);
+        assert!(within(10, broadcast.next_reply()).await.is_none());
+    }
+}
