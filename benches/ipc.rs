@@ -10,12 +10,16 @@
 //! each message in a sample of shared memory loaned from its port, the owner reads it
 //! there, and its reply is copied once into the sample that carries it back.
 //!
-//! Then the 8 B round trips again, taking turns one round trip at a time in one task, so
-//! that whatever else the shared machine does meanwhile weighs on all alike: raw iceoryx2
-//! with its client blocking its thread on the reply event, raw iceoryx2 with both ends
-//! waiting in tokio tasks through the reactor (as the IMRS bridges wait), and the IMRS port.
-//! Run one case after the other, a case's figures move by a fifth from run to run with the
-//! machine's load; taking turns, their ratios move far less.
+//! Then the round trips again, taking turns one round trip at a time in one task, so that
+//! whatever else the shared machine does meanwhile weighs on all alike: raw iceoryx2 with
+//! its client blocking its thread on the reply event, raw iceoryx2 with both ends waiting
+//! in tokio tasks through the reactor (as the IMRS bridges wait), the IMRS port, and the
+//! IMRS port loaned, 8 B and 64 KiB. Run one case after the other, a case's figures move by
+//! a fifth from run to run with the machine's load, and on a quiet machine jump between
+//! where the scheduler happens to wake threads; taking turns, their ratios move far less.
+//!
+//! Then `SENDALL` broadcasts from this process to one user in a peer started for them, 8 B
+//! and 64 KiB, by value and built in place, each timed to its first reply.
 //!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
@@ -40,7 +44,10 @@ use std::time::{Duration, Instant};
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
-use imrs_ipc::{FromBytes, Remote, Wire, export, export_shared, import, import_shared};
+use imrs_ipc::{
+    FromBytes, Remote, Wire, export, export_send_all, export_send_all_shared, export_shared,
+    import, import_send_all, import_send_all_shared, import_shared,
+};
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 
@@ -72,6 +79,8 @@ const ONE_ID: &str = "-one-id";
 const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
 /// The raw part served by a task of the peer's runtime.
 const TASK_PART: &str = "task-one-id";
+/// Set for the peer that listens to the `SENDALL` ports.
+const LISTEN: &str = "IMRS_IPC_BENCH_LISTEN";
 /// How many workers each process's runtime has, if not two.
 const WORKERS: &str = "IMRS_IPC_BENCH_WORKERS";
 
@@ -102,7 +111,13 @@ fn main() {
         &runtime,
         loaned_round_trips::<Large>(&cell, "LARGE_LOANED", rounds),
     );
-    let [raw_alternating, raw_task_alternating, imrs_alternating] = runtime
+    let [
+        raw_alternating,
+        raw_task_alternating,
+        imrs_alternating,
+        loaned_small_alternating,
+        loaned_large_alternating,
+    ] = runtime
         .block_on(runtime.spawn(alternating(cell.clone(), rounds)))
         .expect("the round trips ran");
     let _ = child.kill();
@@ -127,6 +142,9 @@ fn main() {
         (raw_spin, imrs_tight)
     });
 
+    let [news_small, news_large, news_loaned_small, news_loaned_large] =
+        broadcasts(&runtime, &cell, rounds);
+
     println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
     for (name, times) in [
         ("raw iceoryx2, events, 8 B", &raw_small),
@@ -149,11 +167,23 @@ fn main() {
             println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
         }
     }
-    println!("the same 8 B round trips, taking turns one round trip at a time:");
+    println!("SENDALL to one user in another process, each broadcast to its first reply:");
+    for (name, times) in [
+        ("IMRS SENDALL, 8 B", &news_small),
+        ("IMRS SENDALL, 64 KiB", &news_large),
+        ("IMRS SENDALL, loaned, 8 B", &news_loaned_small),
+        ("IMRS SENDALL, loaned, 64 KiB", &news_loaned_large),
+    ] {
+        let [p50, p99, p999] = percentiles(times);
+        println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
+    }
+    println!("the round trips again, taking turns one round trip at a time (8 B unless said):");
     for (name, times) in [
         ("raw iceoryx2, events of one id", &raw_alternating),
         ("raw iceoryx2, waited on in a task", &raw_task_alternating),
         ("IMRS port over iceoryx2", &imrs_alternating),
+        ("IMRS port, loaned", &loaned_small_alternating),
+        ("IMRS port, loaned, 64 KiB", &loaned_large_alternating),
     ] {
         let [p50, p99, p999] = percentiles(times);
         println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
@@ -188,12 +218,24 @@ fn main() {
         show(ratio(&loaned_large, &loaned_small).collect())
     );
     println!(
+        "  IMRS 64 KiB loaned vs IMRS 8 B loaned, taking turns (target: 1.5)  {}",
+        show(ratio(&loaned_large_alternating, &loaned_small_alternating).collect())
+    );
+    println!(
         "  IMRS 64 KiB loaned vs IMRS 8 B by value                            {}",
         show(ratio(&loaned_large, &imrs_small).collect())
     );
     println!(
         "  IMRS 8 B loaned vs raw 8 B                                         {}",
         show(ratio(&loaned_small, &raw_small).collect())
+    );
+    println!(
+        "  SENDALL 64 KiB vs 8 B, by value                                    {}",
+        show(ratio(&news_large, &news_small).collect())
+    );
+    println!(
+        "  SENDALL 64 KiB vs 8 B, loaned                                      {}",
+        show(ratio(&news_loaned_large, &news_loaned_small).collect())
     );
     match &spinning {
         Some((raw_spin, imrs_tight)) => println!(
@@ -215,6 +257,8 @@ enum Peer {
     RawSpinning,
     /// One IMRS port declared TIGHT.
     Tight,
+    /// The one user of four `SENDALL` ports, echoing each broadcast.
+    Listener,
 }
 
 /// Starts a peer for `cell` serving `what`, and waits until it serves.
@@ -228,6 +272,9 @@ fn start_peer(cell: &str, what: Peer) -> std::process::Child {
         }
         Peer::Tight => {
             command.env(TIGHT, "imrs");
+        }
+        Peer::Listener => {
+            command.env(LISTEN, "1");
         }
     }
     let mut child = command.spawn().expect("the peer starts");
@@ -283,12 +330,13 @@ fn peer(cell: &str) {
     let what = match std::env::var(TIGHT).as_deref() {
         Ok("raw") => Peer::RawSpinning,
         Ok(_) => Peer::Tight,
+        Err(_) if std::env::var_os(LISTEN).is_some() => Peer::Listener,
         Err(_) => Peer::Parked,
     };
     let raw: &[&str] = match what {
         Peer::Parked => &["small", "large", "small-one-id"],
         Peer::RawSpinning => &["small"],
-        Peer::Tight => &[],
+        Peer::Tight | Peer::Listener => &[],
     };
     let wait = if what == Peer::RawSpinning {
         Wait::Spin
@@ -317,6 +365,12 @@ fn peer(cell: &str) {
             ],
             Peer::RawSpinning => Vec::new(),
             Peer::Tight => vec![echo::<Small>(&remote, "SMALL", ProcessType::Tight)],
+            Peer::Listener => vec![
+                listen::<Small>(&remote, "NEWS_SMALL"),
+                listen::<Large>(&remote, "NEWS_LARGE"),
+                loaned_listen::<Small>(&remote, "NEWS_SMALL_LOANED"),
+                loaned_listen::<Large>(&remote, "NEWS_LARGE_LOANED"),
+            ],
         };
         // Give the raw servers a moment to open their services.
         tokio::time::sleep(Duration::from_millis(200)).await;
@@ -338,6 +392,39 @@ fn echo<T: Wire>(
     tokio::spawn(async move {
         let _exported = exported;
         while let Ok((message, reply)) = owner.receive().await {
+            reply.reply(message);
+        }
+    })
+}
+
+/// The one user of `SENDALL` port `name` (owner CAMERA), answering each broadcast with
+/// itself.
+fn listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
+    let imported = import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER").expect("imported");
+    let mut listener = imported
+        .port()
+        .user_named("LISTENER")
+        .expect("the user's end");
+    tokio::spawn(async move {
+        let _imported = imported;
+        while let Ok((message, reply)) = listener.receive().await {
+            reply.reply(message);
+        }
+    })
+}
+
+/// The same, for a port of messages built in place: each read where it lies, and answered
+/// with itself, copied once into the reply's sample.
+fn loaned_listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
+    let imported =
+        import_send_all_shared::<T, T>(remote, name, "CAMERA", "LISTENER").expect("imported");
+    let mut listener = imported
+        .port()
+        .user_named("LISTENER")
+        .expect("the user's end");
+    tokio::spawn(async move {
+        let _imported = imported;
+        while let Ok((message, reply)) = listener.receive().await {
             reply.reply(message);
         }
     })
@@ -383,6 +470,85 @@ fn in_task(
 ) -> Vec<Duration> {
     runtime
         .block_on(runtime.spawn(round_trips))
+        .expect("the round trips ran")
+}
+
+/// Broadcasts on four `SENDALL` ports of this process to their one user, a peer started for
+/// them: 8 B and 64 KiB, by value and built in place; each timed to its first reply.
+fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [Vec<Duration>; 4] {
+    let cell = format!("{cell}-news");
+    let remote = Remote::new(&cell).expect("a cell name");
+    let _entered = runtime.enter();
+    let small = Port::<Small, Small, usage::SendAll, AnyUser, 1>::declare(PortSpec::new(
+        "NEWS_SMALL",
+        "CAMERA",
+    ));
+    let large = Port::<Large, Large, usage::SendAll, AnyUser, 1>::declare(PortSpec::new(
+        "NEWS_LARGE",
+        "CAMERA",
+    ));
+    let loaned_small = Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 1>::declare(
+        PortSpec::new("NEWS_SMALL_LOANED", "CAMERA"),
+    );
+    let loaned_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 1>::declare(
+        PortSpec::new("NEWS_LARGE_LOANED", "CAMERA"),
+    );
+    let _exported = [
+        export_send_all(&remote, &small),
+        export_send_all(&remote, &large),
+        export_send_all_shared(&remote, &loaned_small),
+        export_send_all_shared(&remote, &loaned_large),
+    ]
+    .map(|exported| exported.expect("exported"));
+    let mut child = start_peer(&cell, Peer::Listener);
+    let times = runtime.block_on(async {
+        let (mut small, mut large) = (small.owner().unwrap(), large.owner().unwrap());
+        let (mut loaned_small, mut loaned_large) =
+            (loaned_small.owner().unwrap(), loaned_large.owner().unwrap());
+        [
+            spawned(async move {
+                timed!(rounds, {
+                    let mut news = small.send_all(Small::default()).await.expect("an answer");
+                    std::hint::black_box(std::mem::take(&mut news.first));
+                })
+            })
+            .await,
+            spawned(async move {
+                timed!(rounds, {
+                    let mut news = large.send_all(Large::default()).await.expect("an answer");
+                    std::hint::black_box(std::mem::take(&mut news.first));
+                })
+            })
+            .await,
+            spawned(async move {
+                timed!(rounds, {
+                    let message = loaned_small.loan().expect("a loan");
+                    let mut news = loaned_small.send_all(message).await.expect("an answer");
+                    std::hint::black_box(&*std::mem::take(&mut news.first));
+                })
+            })
+            .await,
+            spawned(async move {
+                timed!(rounds, {
+                    let message = loaned_large.loan().expect("a loan");
+                    let mut news = loaned_large.send_all(message).await.expect("an answer");
+                    std::hint::black_box(&*std::mem::take(&mut news.first));
+                })
+            })
+            .await,
+        ]
+    });
+    let _ = child.kill();
+    let _ = child.wait();
+    times
+}
+
+/// Runs `round_trips` in a task of its own, where a module runs.
+async fn spawned(
+    round_trips: impl Future<Output = Vec<Duration>> + Send + 'static,
+) -> Vec<Duration> {
+    tokio::spawn(round_trips)
+        .await
         .expect("the round trips ran")
 }
 
@@ -572,7 +738,7 @@ async fn raw_task_server(cell: String) {
 /// its thread on the reply event (events of one id, as the IMRS bridges size theirs); a raw
 /// round trip whose client and server wait in tasks, through tokio's reactor; and an IMRS
 /// port's.
-async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 3] {
+async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 5] {
     struct Raw {
         _node: Node<Svc>,
         client: iceoryx2::port::client::Client<Svc, Small, (), Small, ()>,
@@ -593,7 +759,19 @@ async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 3] {
     let remote = Remote::new(&cell).expect("a cell name");
     let imported = import::<Small, Small>(&remote, "SMALL", "ECHO", "ASKER").expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
-    let mut times: [Vec<Duration>; 3] = Default::default();
+    let loaned_small =
+        import_shared::<Small, Small>(&remote, "SMALL_LOANED", "ECHO", "ASKER").expect("imported");
+    let mut small_asker = loaned_small
+        .port()
+        .user_named("ASKER")
+        .expect("the user's end");
+    let loaned_large =
+        import_shared::<Large, Large>(&remote, "LARGE_LOANED", "ECHO", "ASKER").expect("imported");
+    let mut large_asker = loaned_large
+        .port()
+        .user_named("ASKER")
+        .expect("the user's end");
+    let mut times: [Vec<Duration>; 5] = Default::default();
     for round in 0..rounds + rounds / 10 {
         let start = Instant::now();
         let pending = blocking.client.send_copy(Small::default()).expect("sent");
@@ -616,9 +794,20 @@ async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 3] {
         let start = Instant::now();
         std::hint::black_box(asker.send(Small::default()).await.expect("a round trip"));
         let imrs = start.elapsed();
+
+        let start = Instant::now();
+        let message = small_asker.loan().expect("a loan");
+        std::hint::black_box(&*small_asker.send(message).await.expect("a round trip"));
+        let loaned_small = start.elapsed();
+
+        let start = Instant::now();
+        let message = large_asker.loan().expect("a loan");
+        std::hint::black_box(&*large_asker.send(message).await.expect("a round trip"));
+        let loaned_large = start.elapsed();
         // The first tenth warms up.
         if round >= rounds / 10 {
-            for (times, time) in times.iter_mut().zip([raw_blocking, raw_in_task, imrs]) {
+            let round = [raw_blocking, raw_in_task, imrs, loaned_small, loaned_large];
+            for (times, time) in times.iter_mut().zip(round) {
                 times.push(time);
             }
         }
