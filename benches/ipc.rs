@@ -45,8 +45,8 @@ use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
-    FromBytes, Remote, Wire, export, export_send_all, export_send_all_shared, export_shared,
-    import, import_send_all, import_send_all_shared, import_shared,
+    FromBytes, Imported, IpcError, Remote, Wire, export, export_send_all, export_send_all_shared,
+    export_shared, import, import_send_all, import_send_all_shared, import_shared,
 };
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
@@ -400,24 +400,22 @@ fn echo<T: Wire>(
 /// The one user of `SENDALL` port `name` (owner CAMERA), answering each broadcast with
 /// itself.
 fn listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
-    let imported = import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER").expect("imported");
-    let mut listener = imported
-        .port()
-        .user_named("LISTENER")
-        .expect("the user's end");
-    tokio::spawn(async move {
-        let _imported = imported;
-        while let Ok((message, reply)) = listener.receive().await {
-            reply.reply(message);
-        }
-    })
+    echo_broadcasts(import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER"))
 }
 
 /// The same, for a port of messages built in place: each read where it lies, and answered
 /// with itself, copied once into the reply's sample.
 fn loaned_listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
-    let imported =
-        import_send_all_shared::<T, T>(remote, name, "CAMERA", "LISTENER").expect("imported");
+    echo_broadcasts(import_send_all_shared::<T, T>(
+        remote, name, "CAMERA", "LISTENER",
+    ))
+}
+
+/// Answers each broadcast on `imported` with itself, as its user LISTENER.
+fn echo_broadcasts<M: Send + 'static>(
+    imported: Result<Imported<M, M, usage::SendAll>, IpcError>,
+) -> tokio::task::JoinHandle<()> {
+    let imported = imported.expect("imported");
     let mut listener = imported
         .port()
         .user_named("LISTENER")
