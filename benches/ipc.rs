@@ -43,7 +43,7 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
+use imrs_core::imrs_ports::{AnyUser, End, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Imported, IpcError, Remote, Wire, export, export_send_all, export_send_all_shared,
     export_shared, import, import_send_all, import_send_all_shared, import_shared,
@@ -499,55 +499,44 @@ fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [
     ]
     .map(|exported| exported.expect("exported"));
     let mut child = start_peer(&cell, Peer::Listener);
-    let times = runtime.block_on(async {
-        let (mut small, mut large) = (small.owner().unwrap(), large.owner().unwrap());
-        let (mut loaned_small, mut loaned_large) =
-            (loaned_small.owner().unwrap(), loaned_large.owner().unwrap());
-        [
-            spawned(async move {
-                timed!(rounds, {
-                    let mut news = small.send_all(Small::default()).await.expect("an answer");
-                    std::hint::black_box(std::mem::take(&mut news.first));
-                })
-            })
-            .await,
-            spawned(async move {
-                timed!(rounds, {
-                    let mut news = large.send_all(Large::default()).await.expect("an answer");
-                    std::hint::black_box(std::mem::take(&mut news.first));
-                })
-            })
-            .await,
-            spawned(async move {
-                timed!(rounds, {
-                    let message = loaned_small.loan().expect("a loan");
-                    let mut news = loaned_small.send_all(message).await.expect("an answer");
-                    std::hint::black_box(&*std::mem::take(&mut news.first));
-                })
-            })
-            .await,
-            spawned(async move {
-                timed!(rounds, {
-                    let message = loaned_large.loan().expect("a loan");
-                    let mut news = loaned_large.send_all(message).await.expect("an answer");
-                    std::hint::black_box(&*std::mem::take(&mut news.first));
-                })
-            })
-            .await,
-        ]
-    });
+    let times = [
+        in_task(runtime, broadcast_times(small.owner().unwrap(), rounds)),
+        in_task(runtime, broadcast_times(large.owner().unwrap(), rounds)),
+        in_task(
+            runtime,
+            loaned_broadcast_times(loaned_small.owner().unwrap(), rounds),
+        ),
+        in_task(
+            runtime,
+            loaned_broadcast_times(loaned_large.owner().unwrap(), rounds),
+        ),
+    ];
     let _ = child.kill();
     let _ = child.wait();
     times
 }
 
-/// Runs `round_trips` in a task of its own, where a module runs.
-async fn spawned(
-    round_trips: impl Future<Output = Vec<Duration>> + Send + 'static,
+/// `rounds` broadcasts of `T::default()` to the port's users, each timed to its first reply.
+async fn broadcast_times<T: Wire>(
+    mut owner: End<T, T, usage::SendAll>,
+    rounds: usize,
 ) -> Vec<Duration> {
-    tokio::spawn(round_trips)
-        .await
-        .expect("the round trips ran")
+    timed!(rounds, {
+        let mut news = owner.send_all(T::default()).await.expect("an answer");
+        std::hint::black_box(std::mem::take(&mut news.first));
+    })
+}
+
+/// The same, each message built in a loan of the port.
+async fn loaned_broadcast_times<T: Wire>(
+    mut owner: End<Shared<T>, Shared<T>, usage::SendAll>,
+    rounds: usize,
+) -> Vec<Duration> {
+    timed!(rounds, {
+        let message = owner.loan().expect("a loan");
+        let mut news = owner.send_all(message).await.expect("an answer");
+        std::hint::black_box(&*std::mem::take(&mut news.first));
+    })
 }
 
 /// Round trips of messages built in place: each loaned from the port (zeroed, in shared

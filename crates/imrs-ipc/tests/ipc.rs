@@ -1318,19 +1318,26 @@ async fn assert_each_inspected<Req>(
     assert!(within(10, broadcast.next_reply()).await.is_none());
 }
 
-/// The user processes LEFT and RIGHT of port `port`, each in `role`, answering six frames.
+/// How many frames each broadcast test sends: more than a port's samples (16), so that a
+/// sample kept past its last handle would leave a later broadcast without one.
+const BROADCAST_FRAMES: u64 = 40;
+
+/// The user processes LEFT and RIGHT of port `port`, each in `role`, answering
+/// [`BROADCAST_FRAMES`] frames.
 fn frame_users(role: &str, cell: &str, port: &str) -> Vec<Peer> {
+    let frames = BROADCAST_FRAMES.to_string();
     [("LEFT", "3"), ("RIGHT", "5")]
         .iter()
-        .map(|(module, factor)| peer(&[role, cell, port, module, "6", factor]))
+        .map(|(module, factor)| peer(&[role, cell, port, module, &frames, factor]))
         .collect()
 }
 
-/// Waits for each of `users` to end, having answered six frames.
-async fn answered_six(users: Vec<Peer>) {
+/// Waits for each of `users` to end, having answered every frame.
+async fn answered_every_frame(users: Vec<Peer>) {
     for user in users {
         let text = finished(user).await;
-        assert_eq!(text.lines().filter(|line| *line == "answered").count(), 6);
+        let answered = text.lines().filter(|line| *line == "answered").count();
+        assert_eq!(answered as u64, BROADCAST_FRAMES);
     }
 }
 
@@ -1343,7 +1350,7 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-listener", &cell, "FRAMES");
     until_users(&camera, 2).await;
-    for seed in 1..=6u64 {
+    for seed in 1..=BROADCAST_FRAMES {
         // Built in a loan, as a module would: on the heap here, copied once into each user's
         // sample.
         let mut frame = camera.loan().unwrap();
@@ -1351,7 +1358,7 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
         let broadcast = within(10, camera.send_all(frame)).await.unwrap();
         assert_each_inspected(broadcast, seed).await;
     }
-    answered_six(users).await;
+    answered_every_frame(users).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -1363,13 +1370,13 @@ async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_proce
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-answerer", &cell, "LOOK");
     until_users(&camera, 2).await;
-    for seed in 1..=6u64 {
+    for seed in 1..=BROADCAST_FRAMES {
         let mut frame = Shared::new(Frame::default());
         write_frame(&mut frame, seed);
         let poll = within(10, camera.call_all(frame)).await.unwrap();
         assert_each_inspected(poll, seed).await;
     }
-    answered_six(users).await;
+    answered_every_frame(users).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -196,12 +196,7 @@ fn inspect(factor: &u64, mut frame: Shared<Frame>) -> Shared<Frame> {
 async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported =
         import_query_shared::<Frame, Frame>(&Remote::new(cell)?, port, "PARENT", module)?;
-    let factor = 7;
-    let mut answering = imported.port().responder_named(module, inspect)?;
-    for _ in 0..n.parse::<u64>()? {
-        answering.serve(&factor).await?;
-        println!("answered");
-    }
+    answer(imported.port(), module, inspect, 7, n).await?;
     imported.settled().await;
     Ok(())
 }
@@ -235,12 +230,7 @@ async fn frame_answerer(
 ) -> Result<(), Error> {
     let imported =
         import_call_all_shared::<Frame, Frame>(&Remote::new(cell)?, port, "CAMERA", module)?;
-    let factor = factor.parse::<u64>()?;
-    let mut answering = imported.port().responder_named(module, inspect)?;
-    for _ in 0..n.parse::<u64>()? {
-        answering.serve(&factor).await?;
-        println!("answered");
-    }
+    answer(imported.port(), module, inspect, factor.parse()?, n).await?;
     imported.settled().await;
     Ok(())
 }
@@ -252,9 +242,7 @@ async fn responder(cell: &str, port: &str) -> Result<(), Error> {
     println!("ready");
     // The module's state: the factor its handler answers with.
     let factor = 3;
-    let mut responder = port.owner_responder(|factor: &u64, number: Number| Number {
-        value: factor * number.value,
-    })?;
+    let mut responder = port.owner_responder(multiply)?;
     loop {
         responder.serve(&factor).await?;
     }
@@ -278,32 +266,39 @@ async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
 
 async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_call_all::<Number, Number>(&Remote::new(cell)?, port, "CALLER", module)?;
-    answer(imported.port(), module, 4, n).await?;
+    answer(imported.port(), module, multiply, 4, n).await?;
     imported.settled().await;
     Ok(())
 }
 
 async fn child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
     let imported = import_query::<Number, Number>(&Remote::new(cell)?, port, "PARENT", module)?;
-    answer(imported.port(), module, 5, n).await?;
+    answer(imported.port(), module, multiply, 5, n).await?;
     imported.settled().await;
     Ok(())
 }
 
-/// Answers `n` queries on `port` as `module`, each with `factor` times its number, from a
+/// A response handler's answer: `factor` times the number.
+fn multiply(factor: &u64, number: Number) -> Number {
+    Number {
+        value: factor * number.value,
+    }
+}
+
+/// Answers `n` queries on `port` as `module`, each as `handler` does with `factor`, from a
 /// response handler; prints `answered` after each.
-async fn answer<U>(
-    port: &Port<Number, Number, U, AnyUser, 1>,
+async fn answer<M, U>(
+    port: &Port<M, M, U, AnyUser, 1>,
     module: &str,
+    handler: fn(&u64, M) -> M,
     factor: u64,
     n: &str,
 ) -> Result<(), Error>
 where
+    M: Send + 'static,
     U: Usage<Complement = usage::Response>,
 {
-    let mut answering = port.responder_named(module, |factor: &u64, number: Number| Number {
-        value: factor * number.value,
-    })?;
+    let mut answering = port.responder_named(module, handler)?;
     for _ in 0..n.parse::<u64>()? {
         answering.serve(&factor).await?;
         println!("answered");
