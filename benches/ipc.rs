@@ -19,7 +19,8 @@
 //! where the scheduler happens to wake threads; taking turns, their ratios move far less.
 //!
 //! Then `SENDALL` broadcasts from this process to one user in a peer started for them, 8 B
-//! and 64 KiB, by value and built in place, each timed to its first reply.
+//! and 64 KiB, by value and built in place, each timed to its first reply; and broadcasts
+//! built in place to two users, each in a peer of its own, timed to the last reply.
 //!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
@@ -79,7 +80,7 @@ const ONE_ID: &str = "-one-id";
 const TIGHT: &str = "IMRS_IPC_BENCH_TIGHT";
 /// The raw part served by a task of the peer's runtime.
 const TASK_PART: &str = "task-one-id";
-/// Set for the peer that listens to the `SENDALL` ports.
+/// Set, to the module's name, for a peer that listens to the `SENDALL` ports.
 const LISTEN: &str = "IMRS_IPC_BENCH_LISTEN";
 /// How many workers each process's runtime has, if not two.
 const WORKERS: &str = "IMRS_IPC_BENCH_WORKERS";
@@ -142,8 +143,14 @@ fn main() {
         (raw_spin, imrs_tight)
     });
 
-    let [news_small, news_large, news_loaned_small, news_loaned_large] =
-        broadcasts(&runtime, &cell, rounds);
+    let [
+        news_small,
+        news_large,
+        news_loaned_small,
+        news_loaned_large,
+        pair_small,
+        pair_large,
+    ] = broadcasts(&runtime, &cell, rounds);
 
     println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
     for (name, times) in [
@@ -173,6 +180,14 @@ fn main() {
         ("IMRS SENDALL, 64 KiB", &news_large),
         ("IMRS SENDALL, loaned, 8 B", &news_loaned_small),
         ("IMRS SENDALL, loaned, 64 KiB", &news_loaned_large),
+    ] {
+        let [p50, p99, p999] = percentiles(times);
+        println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
+    }
+    println!("SENDALL to two users in two other processes, each broadcast to its last reply:");
+    for (name, times) in [
+        ("IMRS SENDALL, loaned, 8 B", &pair_small),
+        ("IMRS SENDALL, loaned, 64 KiB", &pair_large),
     ] {
         let [p50, p99, p999] = percentiles(times);
         println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
@@ -237,6 +252,10 @@ fn main() {
         "  SENDALL 64 KiB vs 8 B, loaned                                      {}",
         show(ratio(&news_loaned_large, &news_loaned_small).collect())
     );
+    println!(
+        "  SENDALL to two users, 64 KiB vs 8 B, loaned                        {}",
+        show(ratio(&pair_large, &pair_small).collect())
+    );
     match &spinning {
         Some((raw_spin, imrs_tight)) => println!(
             "  IMRS TIGHT 8 B vs raw spinning 8 B (target: within 1.2)            {}",
@@ -257,8 +276,9 @@ enum Peer {
     RawSpinning,
     /// One IMRS port declared TIGHT.
     Tight,
-    /// The one user of four `SENDALL` ports, echoing each broadcast.
-    Listener,
+    /// A user of `SENDALL` ports, echoing each broadcast: LISTENER, the one user of four
+    /// and one of the two users of two more; or LISTENER_2, the other of those two.
+    Listener(&'static str),
 }
 
 /// Starts a peer for `cell` serving `what`, and waits until it serves.
@@ -273,8 +293,8 @@ fn start_peer(cell: &str, what: Peer) -> std::process::Child {
         Peer::Tight => {
             command.env(TIGHT, "imrs");
         }
-        Peer::Listener => {
-            command.env(LISTEN, "1");
+        Peer::Listener(module) => {
+            command.env(LISTEN, module);
         }
     }
     let mut child = command.spawn().expect("the peer starts");
@@ -330,13 +350,16 @@ fn peer(cell: &str) {
     let what = match std::env::var(TIGHT).as_deref() {
         Ok("raw") => Peer::RawSpinning,
         Ok(_) => Peer::Tight,
-        Err(_) if std::env::var_os(LISTEN).is_some() => Peer::Listener,
-        Err(_) => Peer::Parked,
+        Err(_) => match std::env::var(LISTEN).as_deref() {
+            Ok("LISTENER") => Peer::Listener("LISTENER"),
+            Ok(_) => Peer::Listener("LISTENER_2"),
+            Err(_) => Peer::Parked,
+        },
     };
     let raw: &[&str] = match what {
         Peer::Parked => &["small", "large", "small-one-id"],
         Peer::RawSpinning => &["small"],
-        Peer::Tight | Peer::Listener => &[],
+        Peer::Tight | Peer::Listener(_) => &[],
     };
     let wait = if what == Peer::RawSpinning {
         Wait::Spin
@@ -365,11 +388,17 @@ fn peer(cell: &str) {
             ],
             Peer::RawSpinning => Vec::new(),
             Peer::Tight => vec![echo::<Small>(&remote, "SMALL", ProcessType::Tight)],
-            Peer::Listener => vec![
+            Peer::Listener("LISTENER") => vec![
                 listen::<Small>(&remote, "NEWS_SMALL"),
                 listen::<Large>(&remote, "NEWS_LARGE"),
-                loaned_listen::<Small>(&remote, "NEWS_SMALL_LOANED"),
-                loaned_listen::<Large>(&remote, "NEWS_LARGE_LOANED"),
+                loaned_listen::<Small>(&remote, "NEWS_SMALL_LOANED", "LISTENER"),
+                loaned_listen::<Large>(&remote, "NEWS_LARGE_LOANED", "LISTENER"),
+                loaned_listen::<Small>(&remote, "PAIR_SMALL", "LISTENER"),
+                loaned_listen::<Large>(&remote, "PAIR_LARGE", "LISTENER"),
+            ],
+            Peer::Listener(module) => vec![
+                loaned_listen::<Small>(&remote, "PAIR_SMALL", module),
+                loaned_listen::<Large>(&remote, "PAIR_LARGE", module),
             ],
         };
         // Give the raw servers a moment to open their services.
@@ -397,29 +426,35 @@ fn echo<T: Wire>(
     })
 }
 
-/// The one user of `SENDALL` port `name` (owner CAMERA), answering each broadcast with
-/// itself.
+/// The one user of `SENDALL` port `name` (owner CAMERA), LISTENER, answering each
+/// broadcast with itself.
 fn listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
-    echo_broadcasts(import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER"))
+    echo_broadcasts(
+        import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER"),
+        "LISTENER",
+    )
 }
 
-/// The same, for a port of messages built in place: each read where it lies, and answered
-/// with itself, copied once into the reply's sample.
-fn loaned_listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
-    echo_broadcasts(import_send_all_shared::<T, T>(
-        remote, name, "CAMERA", "LISTENER",
-    ))
+/// The same for `module`, a user of a port of messages built in place: each read where it
+/// lies, and answered with itself, copied once into the reply's sample.
+fn loaned_listen<T: Wire>(
+    remote: &Remote,
+    name: &str,
+    module: &str,
+) -> tokio::task::JoinHandle<()> {
+    echo_broadcasts(
+        import_send_all_shared::<T, T>(remote, name, "CAMERA", module),
+        module,
+    )
 }
 
-/// Answers each broadcast on `imported` with itself, as its user LISTENER.
+/// Answers each broadcast on `imported` with itself, as its user `module`.
 fn echo_broadcasts<M: Send + 'static>(
     imported: Result<Imported<M, M, usage::SendAll>, IpcError>,
+    module: &str,
 ) -> tokio::task::JoinHandle<()> {
     let imported = imported.expect("imported");
-    let mut listener = imported
-        .port()
-        .user_named("LISTENER")
-        .expect("the user's end");
+    let mut listener = imported.port().user_named(module).expect("the user's end");
     tokio::spawn(async move {
         let _imported = imported;
         while let Ok((message, reply)) = listener.receive().await {
@@ -472,8 +507,10 @@ fn in_task(
 }
 
 /// Broadcasts on four `SENDALL` ports of this process to their one user, a peer started for
-/// them: 8 B and 64 KiB, by value and built in place; each timed to its first reply.
-fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [Vec<Duration>; 4] {
+/// them: 8 B and 64 KiB, by value and built in place; each timed to its first reply. Then
+/// on two more, built in place, to two users, each in a peer of its own; each timed to its
+/// last reply.
+fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [Vec<Duration>; 6] {
     let cell = format!("{cell}-news");
     let remote = Remote::new(&cell).expect("a cell name");
     let _entered = runtime.enter();
@@ -491,28 +528,48 @@ fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [
     let loaned_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 1>::declare(
         PortSpec::new("NEWS_LARGE_LOANED", "CAMERA"),
     );
+    let pair = |name: &str| PortSpec::new(name, "CAMERA").user_list(["LISTENER", "LISTENER_2"]);
+    let pair_small = Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 2>::declare(
+        pair("PAIR_SMALL"),
+    );
+    let pair_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 2>::declare(
+        pair("PAIR_LARGE"),
+    );
     let _exported = [
         export_send_all(&remote, &small),
         export_send_all(&remote, &large),
         export_send_all_shared(&remote, &loaned_small),
         export_send_all_shared(&remote, &loaned_large),
+        export_send_all_shared(&remote, &pair_small),
+        export_send_all_shared(&remote, &pair_large),
     ]
     .map(|exported| exported.expect("exported"));
-    let mut child = start_peer(&cell, Peer::Listener);
+    let mut child = start_peer(&cell, Peer::Listener("LISTENER"));
+    let mut second = start_peer(&cell, Peer::Listener("LISTENER_2"));
     let times = [
         in_task(runtime, broadcast_times(small.owner().unwrap(), rounds)),
         in_task(runtime, broadcast_times(large.owner().unwrap(), rounds)),
         in_task(
             runtime,
-            loaned_broadcast_times(loaned_small.owner().unwrap(), rounds),
+            loaned_broadcast_times(loaned_small.owner().unwrap(), 1, rounds),
         ),
         in_task(
             runtime,
-            loaned_broadcast_times(loaned_large.owner().unwrap(), rounds),
+            loaned_broadcast_times(loaned_large.owner().unwrap(), 1, rounds),
+        ),
+        in_task(
+            runtime,
+            loaned_broadcast_times(pair_small.owner().unwrap(), 2, rounds),
+        ),
+        in_task(
+            runtime,
+            loaned_broadcast_times(pair_large.owner().unwrap(), 2, rounds),
         ),
     ];
-    let _ = child.kill();
-    let _ = child.wait();
+    for child in [&mut child, &mut second] {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
     times
 }
 
@@ -527,15 +584,21 @@ async fn broadcast_times<T: Wire>(
     })
 }
 
-/// The same, each message built in a loan of the port.
+/// `rounds` broadcasts, each built in a loan of the port, and timed to the last of the
+/// replies of its `users` users.
 async fn loaned_broadcast_times<T: Wire>(
     mut owner: End<Shared<T>, Shared<T>, usage::SendAll>,
+    users: usize,
     rounds: usize,
 ) -> Vec<Duration> {
     timed!(rounds, {
         let message = owner.loan().expect("a loan");
         let mut news = owner.send_all(message).await.expect("an answer");
         std::hint::black_box(&*std::mem::take(&mut news.first));
+        for _ in 1..users {
+            let (_, reply) = news.next_reply().await.expect("every user answers");
+            std::hint::black_box(&*reply);
+        }
     })
 }
 

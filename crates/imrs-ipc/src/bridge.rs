@@ -115,10 +115,39 @@ pub(crate) struct Channel<Req: Wire, Rep: Wire> {
     pub(crate) replied: event::PortFactory<Svc>,
 }
 
-fn transport(port: &Name, what: &str, error: impl std::fmt::Debug) -> IpcError {
+pub(crate) fn transport(port: &Name, what: &str, error: impl std::fmt::Debug) -> IpcError {
     IpcError::Transport {
         port: port.clone(),
         detail: format!("{what}: {error:?}"),
+    }
+}
+
+/// A node of this process for port `port`'s services.
+pub(crate) fn node(port: &Name) -> Result<Node<Svc>, IpcError> {
+    // Defaults need no configuration file; iceoryx2 says so at every start unless told to
+    // keep its warnings for what matters (`IOX2_LOG_LEVEL` still overrides).
+    static QUIET: std::sync::Once = std::sync::Once::new();
+    QUIET.call_once(|| set_log_level_from_env_or(LogLevel::Error));
+    // The framework's own processes decide when to stop: no signal handlers.
+    NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<Svc>()
+        .map_err(|error| transport(port, "creating the node", error))
+}
+
+/// Why a user's process could not open port `port`'s service: no owner created it, the
+/// two processes disagree on its types, or iceoryx2 failed.
+pub(crate) fn refusal(port: &Name, error: &dyn std::fmt::Debug) -> IpcError {
+    let detail = format!("{error:?}");
+    if detail.contains("DoesNotExist") {
+        IpcError::NoOwner { port: port.clone() }
+    } else if detail.contains("Incompatible") || detail.contains("TypeDefinition") {
+        IpcError::TypeMismatch {
+            port: port.clone(),
+            detail,
+        }
+    } else {
+        transport(port, "opening its service", detail)
     }
 }
 
@@ -127,28 +156,8 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
     /// from the port's restrictions rather than iceoryx2's defaults; a user opens them, and
     /// is told there is no owner if they are not there.
     pub(crate) fn open(remote: &Remote, port: &Name, side: Side) -> Result<Self, IpcError> {
-        // Defaults need no configuration file; iceoryx2 says so at every start unless told
-        // to keep its warnings for what matters (`IOX2_LOG_LEVEL` still overrides).
-        static QUIET: std::sync::Once = std::sync::Once::new();
-        QUIET.call_once(|| set_log_level_from_env_or(LogLevel::Error));
-        // The framework's own processes decide when to stop: no signal handlers.
-        let node = NodeBuilder::new()
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<Svc>()
-            .map_err(|error| transport(port, "creating the node", error))?;
-        let refusal = |error: &dyn std::fmt::Debug| {
-            let detail = format!("{error:?}");
-            if detail.contains("DoesNotExist") {
-                IpcError::NoOwner { port: port.clone() }
-            } else if detail.contains("Incompatible") || detail.contains("TypeDefinition") {
-                IpcError::TypeMismatch {
-                    port: port.clone(),
-                    detail,
-                }
-            } else {
-                transport(port, "opening its service", detail)
-            }
-        };
+        let node = node(port)?;
+        let refused = |error: &dyn std::fmt::Debug| refusal(port, error);
         let messages = node
             .service_builder(&remote.service(port.as_str(), "messages")?)
             .request_response::<Req, Rep>()
@@ -165,8 +174,8 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
                 .max_loaned_requests(MAX_PENDING)
                 .max_response_buffer_size(2)
                 .open_or_create()
-                .map_err(|error| refusal(&error))?,
-            Side::User => messages.open().map_err(|error| refusal(&error))?,
+                .map_err(|error| refused(&error))?,
+            Side::User => messages.open().map_err(|error| refused(&error))?,
         };
         let event = |part: &str| {
             let events = node
@@ -183,7 +192,7 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
                     .max_nodes(users + 2)
                     .open_or_create()
                     .map_err(|error| transport(port, "opening its events", error)),
-                Side::User => events.open().map_err(|error| refusal(&error)),
+                Side::User => events.open().map_err(|error| refused(&error)),
             }
         };
         let (requested, replied) = (event("requested")?, event("replied")?);

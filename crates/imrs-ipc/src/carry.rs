@@ -208,19 +208,27 @@ impl<Req: Wire, Rep: Wire> Buffer<Req> for Received<Req, Rep> {
     }
 
     fn lend_reply(&self) -> Option<Box<dyn Any + Send>> {
-        let mut loan: ReplyUninit<Rep> = lock(&self.request).loan_uninit().ok()?;
-        // SAFETY: `Rep: FromBytes` (a bound of `Wire`), so all zeros are one of its values;
-        // the whole payload is written before it is assumed initialised.
-        let reply = unsafe {
-            loan.payload_mut().as_mut_ptr().write_bytes(0, 1);
-            loan.assume_init()
-        };
-        let replying = Replying {
-            reply,
-            request: Arc::clone(&self.request),
-        };
-        Some(Box::new(Shared::in_buffer(replying)))
+        lend_reply(&self.request)
     }
+}
+
+/// A loan for the reply to `request`, in which it crosses back as it lies: a [`Shared`] of
+/// the reply's type, all zeros, boxed as `Any` (as [`Buffer::lend_reply`] gives it).
+pub(crate) fn lend_reply<Req: Wire, Rep: Wire>(
+    request: &Held<Req, Rep>,
+) -> Option<Box<dyn Any + Send>> {
+    let mut loan: ReplyUninit<Rep> = lock(request).loan_uninit().ok()?;
+    // SAFETY: `Rep: FromBytes` (a bound of `Wire`), so all zeros are one of its values; the
+    // whole payload is written before it is assumed initialised.
+    let reply = unsafe {
+        loan.payload_mut().as_mut_ptr().write_bytes(0, 1);
+        loan.assume_init()
+    };
+    let replying = Replying {
+        reply,
+        request: Arc::clone(request),
+    };
+    Some(Box::new(Shared::in_buffer(replying)))
 }
 
 /// A reply being built by the owner's module, in a loan made for the request it answers.

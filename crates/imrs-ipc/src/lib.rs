@@ -134,17 +134,20 @@
 //! the user's process, is read in place by the user's response handler, which builds its
 //! answer in a reply loan, read in place by the owner. And `SENDALL` and `CALLALL` ports,
 //! with [`export_send_all_shared`] and [`import_send_all_shared`], [`export_call_all_shared`]
-//! and [`import_call_all_shared`]: a broadcast hands each user a message of its own, so the
-//! owner's message is copied for each user, and once more into that user's sample; in the
-//! user's process the module reads it in place (its local broadcast shares it rather than
-//! copying it, as `Shared`'s `Clone` does for a message no one writes), and builds its
-//! answer in a reply loan, read in place by the owner.
+//! and [`import_call_all_shared`]: the owner's loans are samples of a publish-subscribe
+//! service of the port's own, and a broadcast built in one goes out once, when the port
+//! hands it to its users (`Shared`'s `Clone`, which shares a message no one writes rather
+//! than copying it). Every user, in any process, reads that one sample where the owner
+//! built it, and it is let go when the last handle is dropped; a broadcast built on the
+//! heap is copied into a sample for each user. The user module builds its answer in a
+//! reply loan, read in place by the owner.
 //!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
 //! the port allows at once (16). A `Shared` message that does not lie in one of the port's
 //! own loans — a heap value, or another port's loan — is copied into one when sent.
 
 mod bridge;
+mod broadcast;
 mod carry;
 mod dispatch;
 mod error;

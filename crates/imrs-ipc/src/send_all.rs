@@ -12,6 +12,7 @@ use imrs_core::imrs_ports::usage::{Plain, Usage};
 
 use std::sync::{Arc, Mutex};
 
+use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
 use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, SharedAsker, Take, connect, relay};
@@ -69,7 +70,7 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
+    export_relayed::<Req, Rep, Req, _, _, _, _, _, _, N>(
         remote,
         port,
         |port, module| port.user_named(module),
@@ -85,36 +86,72 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
+    export_relayed::<Req, Rep, Req, _, _, _, _, _, _, N>(remote, port, relayed_responder, None)
 }
 
 /// Exports `port`, a `SENDALL` port of messages built in place ([`Shared`]), as
-/// [`export_send_all`] does a port of values. A broadcast hands every user a message of
-/// its own: the owner's is copied for each remote user, and once more into that user's
-/// sample. There the user module reads it in place, and builds its reply in place
-/// ([`Shared::loan_reply`]), which the owner reads where it lies. The owner's loans are on
-/// the heap: a sample would be copied all the same.
+/// [`export_send_all`] does a port of values, sending each broadcast once for every user
+/// to read in place. The owner's loans ([`End::loan`]) are samples of shared memory: a
+/// broadcast built in one crosses with nothing copied, and every user process reads that
+/// one sample where it lies (one built on the heap is copied into a sample for each user).
+/// The user module builds its reply in place ([`Shared::loan_reply`]), which the owner
+/// reads where it lies. The sample is let go when every process has dropped its handles.
 pub fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(
-        remote,
-        port,
-        |port, module| port.user_named(module),
-        None,
-    )
+    export_broadcast::<Req, Rep, _, _, _, N>(remote, port, |port, module| port.user_named(module))
 }
 
 /// Exports `port`, a `CALLALL` port of messages built in place ([`Shared`]), as
 /// [`export_call_all`] does a port of values, and as [`export_send_all_shared`] carries
-/// them: copied for each remote user and into its sample, read in place there by its
-/// response handler, whose answer, built in place, the owner reads where it lies.
+/// them: each query sent once, read in place by every remote user's response handler,
+/// whose answer, built in place, the owner reads where it lies.
 pub fn export_call_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
+    export_broadcast::<Req, Rep, _, _, _, N>(remote, port, relayed_responder)
+}
+
+/// How a remote module's end of the real port is attached.
+type UserEnd<M, R, U, L, T, const N: usize> =
+    fn(&Port<M, R, U, L, N>, &str) -> Result<T, WireError>;
+
+/// Exports a `SENDALL` or `CALLALL` port of [`Shared`] messages: the owner's loans are
+/// samples of the port's publisher, each broadcast is sent once, and a remote module's end
+/// (`user_end`) is relayed the broadcast's ticket.
+fn export_broadcast<Req, Rep, U, L, T, const N: usize>(
+    remote: &Remote,
+    port: &Port<Shared<Req>, Shared<Rep>, U, L, N>,
+    user_end: UserEnd<Shared<Req>, Shared<Rep>, U, L, T, N>,
+) -> Result<Exported, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    U: Usage,
+    L: UserList,
+    T: Take<Shared<Req>, Shared<Rep>>,
+{
+    let name = Name::from(port);
+    let broadcaster = Broadcaster::<Req>::create(remote, &name, N)?;
+    // The port's lender outlives an export withdrawn; loans from then on are on the heap.
+    let lender = Arc::downgrade(&broadcaster);
+    let _lends = port.clone().lend_with(move || match lender.upgrade() {
+        Some(broadcaster) => broadcaster.loan(),
+        None => Ok(Shared::default()),
+    });
+    export_relayed::<Req, Rep, Ticket, Ticket, _, _, _, _, _, N>(
+        remote,
+        port,
+        move |port, module| {
+            Ok(Ticketing {
+                taken: user_end(port, module)?,
+                broadcaster: Arc::clone(&broadcaster),
+            })
+        },
+        None,
+    )
 }
 
 /// The client of the relay to the remote user module attached last: where an owner's loans
@@ -136,10 +173,6 @@ where
     port.responder_named(module, |_: &(), _: M| R::default())
 }
 
-/// How a remote module's end of the real port is attached.
-type UserEnd<Req, Rep, U, L, T, const N: usize> =
-    fn(&Port<Req, Rep, U, L, N>, &str) -> Result<T, WireError>;
-
 /// Exports `port`, a `QUERY` port (the owner queries its users), to the other processes of
 /// `remote`'s cell: the owner's query to a module there waits for that module's response
 /// handler, which runs when the module's order says. Call it within the tokio runtime the
@@ -148,7 +181,7 @@ pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Query, L, N>,
 ) -> Result<Exported, IpcError> {
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, None)
+    export_relayed::<Req, Rep, Req, _, _, _, _, _, _, N>(remote, port, relayed_responder, None)
 }
 
 /// Exports `port`, a `QUERY` port of messages built in place ([`Shared`]), as
@@ -171,26 +204,34 @@ pub fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
             None => Ok(Shared::default()),
         }
     });
-    export_relayed::<Req, Rep, _, _, _, _, _, N>(remote, port, relayed_responder, Some(lending))
+    export_relayed::<Req, Rep, Req, _, _, _, _, _, _, N>(
+        remote,
+        port,
+        relayed_responder,
+        Some(lending),
+    )
 }
 
 /// Exports a port whose owner starts each rendezvous: each remote module attached gets
-/// `user_end` of the real port, whose every message or query (of wire type `Req`, carried
-/// in the port as `M`) is relayed to its process.
-fn export_relayed<Req, Rep, M, R, U, L, T, const N: usize>(
+/// `user_end` of the real port, whose every message or query (carried in the port as `M`)
+/// is relayed to its process as `X`, of wire type `W`. The port's own types are `Req` and
+/// `Rep` on the wire: what a connecting process is checked against.
+fn export_relayed<Req, Rep, W, X, M, R, U, L, T, const N: usize>(
     remote: &Remote,
     port: &Port<M, R, U, L, N>,
-    user_end: UserEnd<M, R, U, L, T, N>,
-    lending: Option<Lending<Req, Rep>>,
+    mut user_end: impl FnMut(&Port<M, R, U, L, N>, &str) -> Result<T, WireError> + Send + 'static,
+    lending: Option<Lending<W, Rep>>,
 ) -> Result<Exported, IpcError>
 where
     Req: Wire,
     Rep: Wire,
-    M: Carry<Req>,
+    W: Wire,
+    X: Carry<W>,
+    M: Send + 'static,
     R: Carry<Rep>,
     U: Usage,
     L: UserList,
-    T: Take<M, R>,
+    T: Take<X, R>,
 {
     let name = Name::from(port);
     let runtime = tokio::runtime::Handle::try_current().map_err(|_| IpcError::Transport {
@@ -210,7 +251,7 @@ where
             let end = user_end(&port, module)?;
             let _entered = runtime.enter();
             let (relay, client) =
-                relay::<Req, Rep, M, R, T>(&cell, &to_module(&served, module), owner.as_str(), end)
+                relay::<W, Rep, X, R, T>(&cell, &to_module(&served, module), owner.as_str(), end)
                     .map_err(|_| Refusal::Failed)?;
             if let Some(lending) = &lending {
                 *lock(lending) = Some(client);
@@ -230,7 +271,7 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::SendAll>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_relayed::<Req, Rep, Req, _, _, _, _, _>(remote, port, owner, module, |end| end)
 }
 
 /// Imports a `CALLALL` port of another process for module `module` of this one: a port of
@@ -244,7 +285,7 @@ pub fn import_call_all<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::CallAll>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_relayed::<Req, Rep, Req, _, _, _, _, _>(remote, port, owner, module, |end| end)
 }
 
 /// Imports a `SENDALL` port of messages built in place ([`Shared`]), exported with
@@ -257,7 +298,7 @@ pub fn import_send_all_shared<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::SendAll>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_tuned::<Req, Rep, _>(remote, port, owner, module)
 }
 
 /// Imports a `CALLALL` port of messages built in place ([`Shared`]), exported with
@@ -269,7 +310,7 @@ pub fn import_call_all_shared<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::CallAll>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_tuned::<Req, Rep, _>(remote, port, owner, module)
 }
 
 /// Imports a `QUERY` port of another process for module `module` of this one, which
@@ -282,7 +323,7 @@ pub fn import_query<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Req, Rep, usage::Query>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_relayed::<Req, Rep, Req, _, _, _, _, _>(remote, port, owner, module, |end| end)
 }
 
 /// Imports a `QUERY` port of messages built in place ([`Shared`]), exported with
@@ -295,24 +336,29 @@ pub fn import_query_shared<Req: Wire, Rep: Wire>(
     owner: &str,
     module: &str,
 ) -> Result<Imported<Shared<Req>, Shared<Rep>, usage::Query>, IpcError> {
-    import_relayed::<Req, Rep, _, _, _>(remote, port, owner, module)
+    import_relayed::<Req, Rep, Req, _, _, _, _, _>(remote, port, owner, module, |end| end)
 }
 
-/// Imports a port whose owner starts each rendezvous, for `module`: what crosses is of wire
-/// types `Req` and `Rep`, carried in the local port as `M` and `R`.
-fn import_relayed<Req, Rep, M, R, U>(
+/// Imports a port whose owner starts each rendezvous, for `module`: the port's own types
+/// are `Req` and `Rep` on the wire, carried in the local port as `M` and `R`; what its
+/// owner's relay sends is `X`, of wire type `W`, which `serve` takes into the local port
+/// through its owner end.
+fn import_relayed<Req, Rep, W, X, M, R, U, E>(
     remote: &Remote,
     port: &str,
     owner: &str,
     module: &str,
+    mut serve: impl FnMut(End<M, R, U>) -> E + Send + 'static,
 ) -> Result<Imported<M, R, U>, IpcError>
 where
     Req: Wire,
     Rep: Wire,
-    M: Carry<Req>,
+    W: Wire,
+    X: Carry<W>,
+    M: Send + 'static,
     R: Carry<Rep>,
     U: Usage + Plain,
-    End<M, R, U>: Forward<M, R>,
+    E: Forward<X, R>,
 {
     let name = Name::from(port);
     let local: Port<M, R, U, AnyUser, 1> =
@@ -321,7 +367,7 @@ where
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
     // Its one user is the owner's relay.
-    let (server, _) = bridge::<Req, Rep, M, R, _, _>(
+    let (server, _) = bridge::<W, Rep, X, R, _, _>(
         remote,
         to_module(&name, module),
         1,
@@ -334,10 +380,35 @@ where
                     module: relay_module.into(),
                 }));
             }
-            Ok(serving.owner()?)
+            Ok(serve(serving.owner()?))
         },
     )?;
     // Then the connection, which keeps the module attached on the owner's side.
     let connection = connect::<Req, Rep>(remote, &name, module)?;
     Ok(Imported::serving(local, server, connection))
+}
+
+/// Imports a `SENDALL` or `CALLALL` port of [`Shared`] messages for `module`: each
+/// broadcast is read where the owner wrote it, from this process's subscription.
+fn import_tuned<Req, Rep, U>(
+    remote: &Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Shared<Req>, Shared<Rep>, U>, IpcError>
+where
+    Req: Wire,
+    Rep: Wire,
+    U: Usage + Plain,
+    End<Shared<Req>, Shared<Rep>, U>: Forward<Shared<Req>, Shared<Rep>>,
+{
+    // Subscribed before connecting: every broadcast the owner relays to `module` from then
+    // on reaches this subscription first.
+    let inbox = Arc::new(Mutex::new(Inbox::<Req>::open(remote, &Name::from(port))?));
+    import_relayed::<Req, Rep, Ticket, Ticketed, _, _, U, _>(remote, port, owner, module, {
+        move |end| Tuned {
+            end,
+            inbox: Arc::clone(&inbox),
+        }
+    })
 }

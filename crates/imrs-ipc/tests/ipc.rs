@@ -1351,8 +1351,8 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
     let users = frame_users("frame-listener", &cell, "FRAMES");
     until_users(&camera, 2).await;
     for seed in 1..=BROADCAST_FRAMES {
-        // Built in a loan, as a module would: on the heap here, copied once into each user's
-        // sample.
+        // Built in a loan, as a module would: a sample of shared memory, sent once for both
+        // users.
         let mut frame = camera.loan().unwrap();
         write_frame(&mut frame, seed);
         let broadcast = within(10, camera.send_all(frame)).await.unwrap();
@@ -1380,7 +1380,8 @@ async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_proce
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_answers() {
+async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_answers_and_its_restart_is_served()
+ {
     let cell = cell("shared-send-all-kill");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
@@ -1405,4 +1406,128 @@ async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_ans
         assert_inspected(std::mem::take(&mut broadcast.first), seed, 3);
         assert!(within(10, broadcast.next_reply()).await.is_none());
     }
+    // A new copy of RIGHT subscribes again, and every broadcast from then on reaches both.
+    let again = peer(&["frame-listener", &cell, "FRAMES", "RIGHT", "2", "5"]);
+    let mut seed = 4;
+    within(10, async {
+        loop {
+            let mut frame = camera.loan().unwrap();
+            write_frame(&mut frame, seed);
+            let mut broadcast = camera.send_all(frame).await.unwrap();
+            let mut from = vec![broadcast.from.to_string()];
+            assert_inspected(
+                std::mem::take(&mut broadcast.first),
+                seed,
+                factor_of(&from[0]),
+            );
+            if let Some((second, answer)) = broadcast.next_reply().await {
+                assert_inspected(answer, seed, factor_of(second.as_str()));
+                from.push(second.to_string());
+            }
+            from.sort();
+            if from == ["LEFT", "RIGHT"] {
+                break;
+            }
+            assert_eq!(from, ["LEFT"], "only LEFT answers until RIGHT is back");
+            seed += 1;
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    let mut frame = camera.loan().unwrap();
+    write_frame(&mut frame, seed + 1);
+    let broadcast = within(10, camera.send_all(frame)).await.unwrap();
+    assert_each_inspected(broadcast, seed + 1).await;
+    let text = finished(again).await;
+    assert_eq!(text.lines().filter(|line| *line == "answered").count(), 2);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_built_in_a_loan_is_read_in_place_by_a_user_here_and_in_two_other_processes() {
+    let cell = cell("shared-send-all-here");
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
+    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let mut camera = port.owner().unwrap();
+    // HERE, a user in the owner's process, answers as the others do, from the heap.
+    let mut here = port.user_named("HERE").unwrap();
+    let local = tokio::spawn(async move {
+        for _ in 0..BROADCAST_FRAMES {
+            let (mut frame, reply) = here.receive().await.unwrap();
+            let mut answer = Shared::new(Frame::default());
+            answer.words[0] = u64::from(!frame.is_writable());
+            for (out, word) in answer.words.iter_mut().zip(frame.words.iter()).skip(4) {
+                *out = word.wrapping_mul(7);
+            }
+            reply.reply(answer);
+        }
+    });
+    let users = frame_users("frame-listener", &cell, "FRAMES");
+    until_users(&camera, 3).await;
+    for seed in 1..=BROADCAST_FRAMES {
+        // Built in a loan: a sample of shared memory, sent once for all three users.
+        let mut frame = camera.loan().unwrap();
+        write_frame(&mut frame, seed);
+        let mut broadcast = within(10, camera.send_all(frame)).await.unwrap();
+        let mut answers = vec![(
+            broadcast.from.to_string(),
+            std::mem::take(&mut broadcast.first),
+        )];
+        while let Some((from, answer)) = within(10, broadcast.next_reply()).await {
+            answers.push((from.to_string(), answer));
+        }
+        answers.sort_by(|a, b| a.0.cmp(&b.0));
+        let from: Vec<&str> = answers.iter().map(|(from, _)| from.as_str()).collect();
+        assert_eq!(from, ["HERE", "LEFT", "RIGHT"], "each user answers once");
+        for (from, answer) in answers {
+            if from != "HERE" {
+                assert_inspected(answer, seed, factor_of(&from));
+                continue;
+            }
+            // Read where the owner built it, as sent: a copy would be the user's to write.
+            assert_eq!(answer.words[0], 1, "HERE read broadcast {seed} in a copy");
+            for at in [4, 5, 4096, 8191] {
+                assert_eq!(answer.words[at], word(seed, at).wrapping_mul(7));
+            }
+        }
+    }
+    within(10, local).await.unwrap();
+    answered_every_frame(users).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_unlisted_module() {
+    let cell = cell("shared-send-all-refused");
+    let remote = Remote::new(&cell).unwrap();
+    let nobody =
+        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT");
+    assert_eq!(
+        nobody.err(),
+        Some(IpcError::NoOwner {
+            port: "FRAMES".into()
+        })
+    );
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+    let _exported = imrs_ipc::export_send_all_shared(&remote, &port).unwrap();
+    // The broadcasts are of frames, not numbers.
+    let error =
+        imrs_ipc::import_send_all_shared::<Number, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
+            .err()
+            .expect("refused");
+    assert!(
+        matches!(&error, IpcError::TypeMismatch { port, .. } if port == "FRAMES"),
+        "{error:?}"
+    );
+    let error =
+        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "STRANGER")
+            .err()
+            .expect("refused");
+    assert_eq!(
+        error,
+        IpcError::Refused(WireError::NotOnUserList {
+            port: "FRAMES".into(),
+            module: "STRANGER".into(),
+        })
+    );
 }

@@ -78,8 +78,9 @@ pub trait Buffer<T>: Any + Send {
     /// Another handle to this same message, read-only where it lies, for a copy of the
     /// message that needs none ([`Shared`]'s `Clone`): a buffer no one writes (a message
     /// received from another process) can give one, and the memory is let go when the last
-    /// handle is dropped. `None` (the default) where the message may be written, and its
-    /// clone is a copy.
+    /// handle is dropped. So can a buffer that makes its message read-only from then on (a
+    /// broadcast loan, sent to every user when first handed on). `None` (the default)
+    /// where the message may be written, and its clone is a copy.
     fn share(&self) -> Option<Box<dyn Buffer<T> + Send>> {
         None
     }
@@ -168,11 +169,12 @@ impl<T: Clone + Send + 'static> DerefMut for Shared<T> {
     }
 }
 
-/// A message that lies where no one writes it (one received from another process) is
-/// shared: the clone reads the same memory, as a `SENDALL` or `CALLALL` port needs to hand
-/// one message to every user without copying it. A message that may be written (on the
-/// heap, or in a loan still being built) is copied to the heap, so that neither handle sees
-/// the other's changes.
+/// A message that lies where no one writes it (one received from another process, or a
+/// broadcast loan, which its transport sends when first handed on) is shared: the clone
+/// reads the same memory, as a `SENDALL` or `CALLALL` port needs to hand one message to
+/// every user without copying it. A message that may be written (on the heap, or in a loan
+/// still being built) is copied to the heap, so that neither handle sees the other's
+/// changes.
 impl<T: Clone + Send + 'static> Clone for Shared<T> {
     fn clone(&self) -> Self {
         match self.buffer.share() {
