@@ -567,6 +567,25 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
             .value,
         2
     );
+    // And a port whose broadcasts go out on a publish-subscribe service of its own.
+    let frames: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT"]));
+    let _broadcasts = imrs_ipc::export_send_all_shared(&remote, &frames).unwrap();
+    let listening =
+        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
+            .unwrap();
+    let mut left = listening.port().user_named("LEFT").unwrap();
+    let echo = tokio::spawn(async move {
+        let (frame, reply) = left.receive().await.unwrap();
+        reply.reply(frame);
+    });
+    let mut camera = frames.owner().unwrap();
+    until_users(&camera, 1).await;
+    let mut frame = camera.loan().unwrap();
+    write_frame(&mut frame, 1);
+    let broadcast = within(5, camera.send_all(frame)).await.unwrap();
+    assert_eq!(broadcast.first.words[4], word(1, 4));
+    within(5, echo).await.unwrap();
     // Every file iceoryx2 keeps for services and their data, but its one host-wide
     // bookkeeping file, is readable and writable by its owner alone.
     let mut files = Vec::new();
