@@ -70,9 +70,10 @@ fn service<Req: Wire>(
         .user_header::<u64>();
     match users {
         // Each user process, the owner's own subscription, and one more for a user process
-        // restarted before its dead one is swept.
+        // restarted before its dead one is swept; and for the owner's publisher, one more
+        // for an owner exporting the port again while its last broadcast is still held.
         Some(users) => builder
-            .max_publishers(1)
+            .max_publishers(2)
             .max_subscribers(users + 2)
             .max_nodes(users + 3)
             .history_size(0)

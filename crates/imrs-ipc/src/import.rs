@@ -537,6 +537,60 @@ pub(crate) fn connect<Req: Wire, Rep: Wire>(
     })
 }
 
+/// Keeps `module` attached to the port's owner, whoever that is: the owner of a port that
+/// starts each rendezvous itself hears nothing from its users once they connect, so an
+/// owner started again (or exporting the port again) would not know them. Every half
+/// second the module connects again: an owner that knows it answers at once, and a new
+/// one attaches it, relaying to it from then on. A connection unanswered for a whole tick
+/// may have gone to an owner that died, so what dead processes left is swept first, and a
+/// new owner is reached. Call it within a tokio runtime; the task ends when this is
+/// dropped.
+pub(crate) fn keep_attached<Req: Wire, Rep: Wire>(
+    connection: Connection<Req, Rep>,
+    module: &str,
+) -> Relay {
+    let module = module.to_owned();
+    let task = tokio::spawn(async move {
+        let Connection {
+            channel,
+            client,
+            listener,
+            wake_owner,
+            ..
+        } = connection;
+        // The channel lives as long as the task: its node keeps the services open.
+        let _channel = channel;
+        let mut tick = tokio::time::interval(SWEEP_PERIOD);
+        tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+        // The first tick is at once: the module has just connected.
+        tick.tick().await;
+        let mut asked: Option<Pending<Req, Rep>> = None;
+        loop {
+            tick.tick().await;
+            // The owner's wake-ups for these answers are not waited on: let them go.
+            let _ = listener.try_wait(|_| {});
+            if let Some(asked) = asked.take()
+                && !matches!(asked.receive(), Ok(Some(_)))
+            {
+                sweep_dead().await;
+            }
+            asked = ask_connect(&client, &module);
+            let _ = wake_owner.notify();
+        }
+    });
+    Relay { task }
+}
+
+/// Sends `module`'s connection request; its answer is to come.
+fn ask_connect<Req: Wire, Rep: Wire>(
+    client: &Asker<Req, Rep>,
+    module: &str,
+) -> Option<Pending<Req, Rep>> {
+    let mut loan = client.loan_uninit().ok()?;
+    *loan.user_header_mut() = RequestMeta::new(CONNECT, module);
+    loan.write_payload(Req::default()).send().ok()
+}
+
 /// The handshake: the owner attaches `module` to its port, and says how the port waits; or
 /// refuses it by name.
 fn handshake<Req: Wire, Rep: Wire>(
@@ -550,14 +604,8 @@ fn handshake<Req: Wire, Rep: Wire>(
         port: port.clone(),
         detail,
     };
-    let mut loan = client
-        .loan_uninit()
-        .map_err(|error| transport(format!("connecting: {error:?}")))?;
-    *loan.user_header_mut() = RequestMeta::new(CONNECT, module);
-    let pending = loan
-        .write_payload(Req::default())
-        .send()
-        .map_err(|error| transport(format!("connecting: {error:?}")))?;
+    let pending = ask_connect(client, module)
+        .ok_or_else(|| transport("connecting: no room to send the request".into()))?;
     let _ = wake_owner.notify();
     let deadline = Instant::now() + CONNECT_TIMEOUT;
     while Instant::now() < deadline {

@@ -66,7 +66,9 @@
 //! [`WireError`](imrs_core::imrs_ports::WireError). A process that dies does not hang its
 //! peers: a user's pending sends to a dead owner fail with
 //! [`SendError::NoReply`](imrs_core::imrs_ports::SendError::NoReply), and a new copy of
-//! the owner that exports the port again is served. A process that answers requests from
+//! the owner that exports the port again is served. The owner of a `SENDALL`, `CALLALL`
+//! or `QUERY` port hears nothing from its users once they connect, so their processes
+//! connect again every half second, and a new copy of the owner reaches them from then on. A process that answers requests from
 //! others awaits [`Exported::settled`] (or [`Imported::settled`]) before it ends cleanly, so
 //! that its modules' last answers, which may be left to tasks of the runtime, are not cut
 //! off.

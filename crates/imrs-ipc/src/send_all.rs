@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
 use crate::export::{Forward, Refusal, bridge};
-use crate::import::{Relay, SharedAsker, Take, connect, relay};
+use crate::import::{Relay, SharedAsker, Take, connect, keep_attached, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
 /// The service a remote user module is served on.
@@ -383,9 +383,14 @@ where
             Ok(serve(serving.owner()?))
         },
     )?;
-    // Then the connection, which keeps the module attached on the owner's side.
+    // Then the connection, which keeps the module attached on the owner's side, and on
+    // the side of an owner started again.
     let connection = connect::<Req, Rep>(remote, &name, module)?;
-    Ok(Imported::serving(local, server, connection))
+    Ok(Imported::serving(
+        local,
+        server,
+        keep_attached(connection, module),
+    ))
 }
 
 /// Imports a `SENDALL` or `CALLALL` port of [`Shared`] messages for `module`: each

@@ -117,7 +117,12 @@ fn owner(cell: &str, port: &str) -> Peer {
 
 /// Starts an owner of the role `role` (`owner`, `tight-owner`), ready once exported.
 fn started_owner(role: &str, cell: &str, port: &str) -> Peer {
-    let mut owner = peer(&[role, cell, port]);
+    started(&[role, cell, port])
+}
+
+/// Starts an owner with `args`, ready once exported.
+fn started(args: &[&str]) -> Peer {
+    let mut owner = peer(args);
     let stdout = owner.0.stdout.take().expect("piped");
     let mut line = String::new();
     BufReader::new(stdout)
@@ -1549,4 +1554,82 @@ async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_
             module: "STRANGER".into(),
         })
     );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_processes() {
+    let cell = cell("shared-send-all-again");
+    let remote = Remote::new(&cell).unwrap();
+    let declare = || -> Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> {
+        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]))
+    };
+    let half = BROADCAST_FRAMES / 2;
+    let mut seeds = 1..=BROADCAST_FRAMES;
+    let mut users = Vec::new();
+    for export in 0..2 {
+        // The port, declared and exported anew: nothing of the first export is left here.
+        let port = declare();
+        let exported = imrs_ipc::export_send_all_shared(&remote, &port).unwrap();
+        if export == 0 {
+            users = frame_users("frame-listener", &cell, "FRAMES");
+        }
+        let mut camera = port.owner().unwrap();
+        // The second time, the user processes connected to the first export only.
+        eprintln!("DBG {export} peers at once {:?}", camera.peers());
+        until_users(&camera, 2).await;
+        for seed in seeds.by_ref().take(half as usize) {
+            let mut frame = camera.loan().unwrap();
+            write_frame(&mut frame, seed);
+            let broadcast = within(10, camera.send_all(frame)).await.unwrap();
+            assert_each_inspected(broadcast, seed).await;
+        }
+        drop(camera);
+        drop(exported);
+    }
+    answered_every_frame(users).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_of_broadcasts_killed_mid_run_and_started_again_reaches_its_user_again() {
+    let cell = cell("shared-send-all-owner-killed");
+    let mut first = started(&["camera", &cell, "FRAMES", "1000000"]);
+    let remote = Remote::new(&cell).unwrap();
+    let imported =
+        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
+            .unwrap();
+    let mut left = imported.port().user_named("LEFT").unwrap();
+    // LEFT answers as the camera checks: read in place, three times word 4.
+    let (seen, mut heard) = tokio::sync::mpsc::unbounded_channel();
+    tokio::spawn(async move {
+        while let Ok((mut frame, reply)) = left.receive().await {
+            let mut answer: Shared<Frame> = frame.loan_reply();
+            answer.words[0] = u64::from(!frame.is_writable());
+            answer.words[4] = 3 * frame.words[4];
+            reply.reply(answer);
+            let _ = seen.send(frame.words[4]);
+        }
+    });
+    for seed in 1..=3 {
+        assert_eq!(within(10, heard.recv()).await, Some(seed));
+    }
+    // kill -9 the camera mid-run; what it broadcast before is left to drain.
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    while heard.try_recv().is_ok() {}
+    // A new copy of the camera numbers from 1 again, and LEFT hears each of its frames.
+    let mut second = started(&["camera", &cell, "FRAMES", "3"]);
+    for seed in 1..=3 {
+        assert_eq!(within(10, heard.recv()).await, Some(seed));
+    }
+    // It found every answer as it checks them, read in place.
+    let status = within(10, async {
+        loop {
+            if let Some(status) = second.0.try_wait().unwrap() {
+                return status;
+            }
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    assert!(status.success());
 }

@@ -24,6 +24,11 @@
 //!   `answered` after each; then exits.
 //! - `ipc_peer frame-answerer CELL PORT MODULE N FACTOR`: the same for the `CALLALL` port
 //!   PORT (owner CAMERA), answered by MODULE's response handler.
+//! - `ipc_peer camera CELL PORT N`: exports PORT, a `SENDALL` port of frames built in
+//!   place (user LEFT), prints `ready`, and once LEFT is attached broadcasts N frames, each
+//!   built in a loan with word 4 its number (from 1). Each answer must say that LEFT read
+//!   the frame in place (word 0 is 1), and hold three times the number in word 4; it
+//!   exits with 2 at the first that does not.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -46,8 +51,8 @@ use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_response, export_response_shared,
-    export_shared, import, import_call_all, import_call_all_shared, import_query,
-    import_query_shared, import_send_all, import_send_all_shared,
+    export_send_all_shared, export_shared, import, import_call_all, import_call_all_shared,
+    import_query, import_query_shared, import_send_all, import_send_all_shared,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -85,6 +90,7 @@ fn main() -> ExitCode {
             ["tight-owner", cell, port] => owner(cell, port, ProcessType::Tight).await,
             ["responder", cell, port] => responder(cell, port).await,
             ["vision", cell, port] => vision(cell, port).await,
+            ["camera", cell, port, n] => camera(cell, port, n).await,
             ["inspector", cell, port] => inspector(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
@@ -99,6 +105,7 @@ fn main() -> ExitCode {
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
                 "usage: ipc_peer owner|tight-owner|responder|vision|inspector CELL PORT \
+                 | camera CELL PORT N \
                  | user|listener|answerer|child|frame-child CELL PORT MODULE N \
                  | frame-listener|frame-answerer CELL PORT MODULE N FACTOR"
                     .into(),
@@ -198,6 +205,25 @@ async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<()
         import_query_shared::<Frame, Frame>(&Remote::new(cell)?, port, "PARENT", module)?;
     answer(imported.port(), module, inspect, 7, n).await?;
     imported.settled().await;
+    Ok(())
+}
+
+async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
+    let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "CAMERA").user_list(["LEFT"]));
+    let _exported = export_send_all_shared(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut camera = port.owner()?;
+    camera.peer_attached().await;
+    for seed in 1..=n.parse::<u64>()? {
+        let mut frame = camera.loan()?;
+        frame.words[4] = seed;
+        let broadcast = camera.send_all(frame).await?;
+        let (in_place, word) = (broadcast.first.words[0], broadcast.first.words[4]);
+        if in_place != 1 || word != 3 * seed {
+            return Err(format!("frame {seed}: answered {word}, read in place: {in_place}").into());
+        }
+    }
     Ok(())
 }
 
