@@ -1622,14 +1622,57 @@ async fn an_owner_of_broadcasts_killed_mid_run_and_started_again_reaches_its_use
         assert_eq!(within(10, heard.recv()).await, Some(seed));
     }
     // It found every answer as it checks them, read in place.
-    let status = within(10, async {
+    assert!(exit_status(&mut second).await.success());
+}
+
+/// How `peer` ended, once it has (10 s at most).
+async fn exit_status(peer: &mut Peer) -> std::process::ExitStatus {
+    within(10, async {
         loop {
-            if let Some(status) = second.0.try_wait().unwrap() {
+            if let Some(status) = peer.0.try_wait().unwrap() {
                 return status;
             }
             tokio::time::sleep(Duration::from_millis(20)).await;
         }
     })
-    .await;
-    assert!(status.success());
+    .await
+}
+
+/// A response handler's answer: five times the question.
+fn five_times(_: &(), number: Number) -> Number {
+    Number {
+        value: 5 * number.value,
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_again() {
+    let cell = cell("query-owner-killed");
+    let mut first = started(&["parent", &cell, "ASK_STATUS", "1000000"]);
+    let remote = Remote::new(&cell).unwrap();
+    let imported =
+        imrs_ipc::import_query::<Number, Number>(&remote, "ASK_STATUS", "PARENT", "CHILD").unwrap();
+    let mut child = imported
+        .port()
+        .responder_named("CHILD", five_times)
+        .unwrap();
+    let (answered, mut heard) = tokio::sync::mpsc::unbounded_channel();
+    tokio::spawn(async move {
+        while child.serve(&()).await.is_ok() {
+            let _ = answered.send(());
+        }
+    });
+    for _ in 0..3 {
+        within(10, heard.recv()).await.unwrap();
+    }
+    // kill -9 the parent mid-run; a new copy asks three questions, each answered by CHILD.
+    first.0.kill().unwrap();
+    first.0.wait().unwrap();
+    while heard.try_recv().is_ok() {}
+    let mut second = started(&["parent", &cell, "ASK_STATUS", "3"]);
+    for _ in 0..3 {
+        within(10, heard.recv()).await.unwrap();
+    }
+    // The new parent found every answer five times its question.
+    assert!(exit_status(&mut second).await.success());
 }

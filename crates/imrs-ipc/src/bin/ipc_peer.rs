@@ -29,6 +29,9 @@
 //!   built in a loan with word 4 its number (from 1). Each answer must say that LEFT read
 //!   the frame in place (word 0 is 1), and hold three times the number in word 4; it
 //!   exits with 2 at the first that does not.
+//! - `ipc_peer parent CELL PORT N`: exports PORT, a `QUERY` port of numbers (owner PARENT,
+//!   user CHILD), prints `ready`, and once CHILD is attached asks it 1..=N; each answer
+//!   must be five times the question, or it exits with 2.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -50,7 +53,7 @@ use std::time::Duration;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
-    FromBytes, Remote, ZeroCopySend, export, export_response, export_response_shared,
+    FromBytes, Remote, ZeroCopySend, export, export_query, export_response, export_response_shared,
     export_send_all_shared, export_shared, import, import_call_all, import_call_all_shared,
     import_query, import_query_shared, import_send_all, import_send_all_shared,
 };
@@ -91,6 +94,7 @@ fn main() -> ExitCode {
             ["responder", cell, port] => responder(cell, port).await,
             ["vision", cell, port] => vision(cell, port).await,
             ["camera", cell, port, n] => camera(cell, port, n).await,
+            ["parent", cell, port, n] => parent(cell, port, n).await,
             ["inspector", cell, port] => inspector(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
@@ -105,7 +109,7 @@ fn main() -> ExitCode {
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
                 "usage: ipc_peer owner|tight-owner|responder|vision|inspector CELL PORT \
-                 | camera CELL PORT N \
+                 | camera|parent CELL PORT N \
                  | user|listener|answerer|child|frame-child CELL PORT MODULE N \
                  | frame-listener|frame-answerer CELL PORT MODULE N FACTOR"
                     .into(),
@@ -222,6 +226,22 @@ async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
         let (in_place, word) = (broadcast.first.words[0], broadcast.first.words[4]);
         if in_place != 1 || word != 3 * seed {
             return Err(format!("frame {seed}: answered {word}, read in place: {in_place}").into());
+        }
+    }
+    Ok(())
+}
+
+async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::Query, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "PARENT").user_list(["CHILD"]));
+    let _exported = export_query(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut parent = port.owner()?;
+    parent.peer_attached().await;
+    for value in 1..=n.parse::<u64>()? {
+        let status = parent.query(Number { value }).await?;
+        if status.value != 5 * value {
+            return Err(format!("asked {value}, answered {}", status.value).into());
         }
     }
     Ok(())
