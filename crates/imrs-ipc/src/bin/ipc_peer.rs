@@ -32,6 +32,8 @@
 //! - `ipc_peer parent CELL PORT N`: exports PORT, a `QUERY` port of numbers (owner PARENT,
 //!   user CHILD), prints `ready`, and once CHILD is attached asks it 1..=N; each answer
 //!   must be five times the question, or it exits with 2.
+//! - `ipc_peer caller CELL PORT N`: the same for PORT, a `CALLALL` port of numbers (owner
+//!   CALLER, user ANSWERER): each question goes to ANSWERER's response handler.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -53,9 +55,10 @@ use std::time::Duration;
 use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
-    FromBytes, Remote, ZeroCopySend, export, export_query, export_response, export_response_shared,
-    export_send_all_shared, export_shared, import, import_call_all, import_call_all_shared,
-    import_query, import_query_shared, import_send_all, import_send_all_shared,
+    FromBytes, Remote, ZeroCopySend, export, export_call_all, export_query, export_response,
+    export_response_shared, export_send_all_shared, export_shared, import, import_call_all,
+    import_call_all_shared, import_query, import_query_shared, import_send_all,
+    import_send_all_shared,
 };
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
@@ -95,6 +98,7 @@ fn main() -> ExitCode {
             ["vision", cell, port] => vision(cell, port).await,
             ["camera", cell, port, n] => camera(cell, port, n).await,
             ["parent", cell, port, n] => parent(cell, port, n).await,
+            ["caller", cell, port, n] => caller(cell, port, n).await,
             ["inspector", cell, port] => inspector(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
@@ -109,7 +113,7 @@ fn main() -> ExitCode {
             ["user", cell, port, module, n] => user(cell, port, module, n).await,
             _ => Err(
                 "usage: ipc_peer owner|tight-owner|responder|vision|inspector CELL PORT \
-                 | camera|parent CELL PORT N \
+                 | camera|parent|caller CELL PORT N \
                  | user|listener|answerer|child|frame-child CELL PORT MODULE N \
                  | frame-listener|frame-answerer CELL PORT MODULE N FACTOR"
                     .into(),
@@ -242,6 +246,22 @@ async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
         let status = parent.query(Number { value }).await?;
         if status.value != 5 * value {
             return Err(format!("asked {value}, answered {}", status.value).into());
+        }
+    }
+    Ok(())
+}
+
+async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::CallAll, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "CALLER").user_list(["ANSWERER"]));
+    let _exported = export_call_all(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut caller = port.owner()?;
+    caller.peer_attached().await;
+    for value in 1..=n.parse::<u64>()? {
+        let answer = caller.call_all(Number { value }).await?.first;
+        if answer.value != 5 * value {
+            return Err(format!("asked {value}, answered {}", answer.value).into());
         }
     }
     Ok(())
