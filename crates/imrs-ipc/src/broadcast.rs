@@ -9,7 +9,9 @@
 //! with nothing copied. Its send is when the port first hands it on (`Shared`'s `Clone`,
 //! which a broadcast makes for each user): the owner's own subscription then holds the
 //! sample, so the owner's handles read it where it lies too. A message built anywhere else
-//! (the heap) is copied into a sample for each user it goes to.
+//! (the heap) is copied into a sample once, when the port hands the broadcast over
+//! ([`Port::broadcast_with`](imrs_core::imrs_ports::Port::broadcast_with)), and goes out
+//! as one built in a loan does.
 
 use std::any::Any;
 use std::cmp::Ordering;
@@ -154,28 +156,49 @@ impl<Req: Wire> Broadcaster<Req> {
         })?;
         // SAFETY: `Req: FromBytes` (a bound of `Wire`), so all zeros are one of its values;
         // the whole payload is written before it is assumed initialised.
-        let mut sample = unsafe {
+        let sample = unsafe {
             loan.payload_mut().as_mut_ptr().write_bytes(0, 1);
             loan.assume_init()
         };
-        let payload = NonNull::from(sample.payload_mut());
-        Ok(Shared::in_buffer(Publication {
-            broadcaster: Arc::clone(self),
-            payload,
-            state: Mutex::new(State::Building(sample)),
-        }))
+        drop(station);
+        Ok(self.building(sample))
+    }
+
+    /// `message`, ready to be sent once for every user: in a sample of the publisher,
+    /// copied there if it lies anywhere else (the heap). Left where it is if no sample can
+    /// be had; it is then copied for each user it goes to.
+    pub(crate) fn adopt(self: &Arc<Self>, message: Shared<Req>) -> Shared<Req> {
+        if self.published(&message).is_some() {
+            return message;
+        }
+        let copied = self.copied(&message);
+        copied.map_or(message, |sample| self.building(sample))
     }
 
     /// The ticket for `message`, sent to one user: the broadcast it belongs to, sent now if
     /// it has not been. A message not in one of this publisher's samples is copied into
     /// one. `None` if it could not be sent.
     pub(crate) fn ticket(self: &Arc<Self>, message: Shared<Req>) -> Option<Ticket> {
-        if let Some(publication) = message.buffer().downcast_ref::<Publication<Req>>()
-            && Arc::ptr_eq(&publication.broadcaster, self)
-        {
+        if let Some(publication) = self.published(&message) {
             return publication.sent().map(|(seq, _)| Ticket { seq });
         }
-        let mut station = lock(&self.station);
+        let sample = self.copied(&message)?;
+        lock(&self.station)
+            .publish(sample)
+            .map(|(seq, _)| Ticket { seq })
+    }
+
+    /// `message`'s sample, if it lies in one of this publisher's.
+    fn published<'m>(self: &Arc<Self>, message: &'m Shared<Req>) -> Option<&'m Publication<Req>> {
+        message
+            .buffer()
+            .downcast_ref::<Publication<Req>>()
+            .filter(|publication| Arc::ptr_eq(&publication.broadcaster, self))
+    }
+
+    /// A sample of the publisher holding a copy of `message`; `None` if none can be had.
+    fn copied(&self, message: &Req) -> Option<Building<Req>> {
+        let station = lock(&self.station);
         if station.failed {
             return None;
         }
@@ -183,13 +206,22 @@ impl<Req: Wire> Broadcaster<Req> {
         // SAFETY: `message` is a valid `Req`, and the loan is a sample of its own in shared
         // memory, so the two do not overlap; the copy writes the whole payload before it is
         // assumed initialised.
-        let sample = unsafe {
+        Some(unsafe {
             loan.payload_mut()
                 .as_mut_ptr()
-                .copy_from_nonoverlapping(&*message, 1);
+                .copy_from_nonoverlapping(message, 1);
             loan.assume_init()
-        };
-        station.publish(sample).map(|(seq, _)| Ticket { seq })
+        })
+    }
+
+    /// The owner's message in `sample`, still to be built or sent.
+    fn building(self: &Arc<Self>, mut sample: Building<Req>) -> Shared<Req> {
+        let payload = NonNull::from(sample.payload_mut());
+        Shared::in_buffer(Publication {
+            broadcaster: Arc::clone(self),
+            payload,
+            state: Mutex::new(State::Building(sample)),
+        })
     }
 }
 
@@ -537,7 +569,41 @@ mod tests {
     }
 
     #[test]
-    fn a_message_on_the_heap_is_copied_into_a_sample_for_each_user() {
+    fn a_broadcast_on_the_heap_is_copied_into_one_sample_which_every_users_clone_reads() {
+        let remote = remote("adopted");
+        let port = Name::from("FRAMES");
+        let broadcaster = Broadcaster::<[u64; 32]>::create(&remote, &port, 3).unwrap();
+        let mut inbox = Inbox::<[u64; 32]>::open(&remote, &port).unwrap();
+        // More broadcasts than the publisher has samples to lend at once: each is let go.
+        for round in 0..(3 * MAX_PENDING as u64) {
+            let mut message = Shared::new([0u64; 32]);
+            message[7] = round;
+            let adopted = broadcaster.adopt(message);
+            assert!(
+                adopted.buffer().is::<Publication<[u64; 32]>>(),
+                "left on the heap"
+            );
+            // Adopting it again changes nothing.
+            let at = std::ptr::from_ref(&*adopted);
+            let adopted = broadcaster.adopt(adopted);
+            assert!(std::ptr::eq(&*adopted, at), "copied again");
+            let clones: Vec<Shared<[u64; 32]>> = (0..3).map(|_| adopted.clone()).collect();
+            for clone in &clones {
+                assert!(std::ptr::eq(&**clone, at), "a clone is a copy");
+            }
+            let tickets: Vec<u64> = clones
+                .into_iter()
+                .map(|clone| broadcaster.ticket(clone).unwrap().seq)
+                .collect();
+            assert!(tickets.iter().all(|&seq| seq == tickets[0]));
+            let sample = inbox.take(tickets[0]).unwrap();
+            assert_eq!(sample.payload()[7], round);
+            assert!(inbox.subscriber.receive().unwrap().is_none());
+        }
+    }
+
+    #[test]
+    fn a_message_still_on_the_heap_at_a_users_relay_is_copied_into_a_sample_for_it() {
         let remote = remote("heap");
         let port = Name::from("FRAMES");
         let broadcaster = Broadcaster::<[u64; 32]>::create(&remote, &port, 2).unwrap();

@@ -140,9 +140,11 @@
 //! service of the port's own, and a broadcast built in one goes out once, when the port
 //! hands it to its users (`Shared`'s `Clone`, which shares a message no one writes rather
 //! than copying it). Every user, in any process, reads that one sample where the owner
-//! built it, and it is let go when the last handle is dropped; a broadcast built on the
-//! heap is copied into a sample for each user. The user module builds its answer in a
-//! reply loan, read in place by the owner.
+//! built it, and it is let go when the last handle is dropped. A broadcast built on the
+//! heap is copied into a sample once, as the port hands it over
+//! ([`Port::broadcast_with`](imrs_core::imrs_ports::Port::broadcast_with)), and goes out
+//! the same way. The user module builds its answer in a reply loan, read in place by the
+//! owner.
 //!
 //! A loan is refused, naming the port, while the module holds as many loans and requests as
 //! the port allows at once (16). A `Shared` message that does not lie in one of the port's

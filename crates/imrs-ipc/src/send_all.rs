@@ -93,7 +93,7 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// [`export_send_all`] does a port of values, sending each broadcast once for every user
 /// to read in place. The owner's loans ([`End::loan`]) are samples of shared memory: a
 /// broadcast built in one crosses with nothing copied, and every user process reads that
-/// one sample where it lies (one built on the heap is copied into a sample for each user).
+/// one sample where it lies (one built on the heap is copied into a sample once).
 /// The user module builds its reply in place ([`Shared::loan_reply`]), which the owner
 /// reads where it lies. The sample is let go when every process has dropped its handles.
 pub fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
@@ -136,11 +136,18 @@ where
     let name = Name::from(port);
     let broadcaster = Broadcaster::<Req>::create(remote, &name, N)?;
     // The port's lender outlives an export withdrawn; loans from then on are on the heap.
-    let lender = Arc::downgrade(&broadcaster);
-    let _lends = port.clone().lend_with(move || match lender.upgrade() {
-        Some(broadcaster) => broadcaster.loan(),
-        None => Ok(Shared::default()),
-    });
+    let (lender, handing) = (Arc::downgrade(&broadcaster), Arc::downgrade(&broadcaster));
+    let _lends = port
+        .clone()
+        .lend_with(move || match lender.upgrade() {
+            Some(broadcaster) => broadcaster.loan(),
+            None => Ok(Shared::default()),
+        })
+        // A broadcast built on the heap is copied into a sample once, for every user.
+        .broadcast_with(move |message| match handing.upgrade() {
+            Some(broadcaster) => broadcaster.adopt(message),
+            None => message,
+        });
     export_relayed::<Req, Rep, Ticket, Ticket, _, _, _, _, _, N>(
         remote,
         port,

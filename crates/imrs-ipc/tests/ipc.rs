@@ -1468,7 +1468,33 @@ async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_ans
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_broadcast_built_in_a_loan_is_read_in_place_by_a_user_here_and_in_two_other_processes() {
-    let cell = cell("shared-send-all-here");
+    // Built in a loan: a sample of shared memory, sent once for all three users.
+    read_in_place_here_and_in_two_other_processes("shared-send-all-here", |camera| {
+        camera.loan().unwrap()
+    })
+    .await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_broadcast_built_on_the_heap_is_copied_once_and_read_there_by_a_user_here_and_in_two_other_processes()
+ {
+    // Built on the heap: copied into one sample, sent once for all three users.
+    read_in_place_here_and_in_two_other_processes("shared-send-all-heap", |_| {
+        Shared::new(Frame::default())
+    })
+    .await;
+}
+
+/// Broadcasts [`BROADCAST_FRAMES`] frames, each made by `build`, to HERE, a user in this
+/// process, and to LEFT and RIGHT, each in a process of its own: each reads every frame
+/// where it lies in shared memory, read-only, and answers.
+async fn read_in_place_here_and_in_two_other_processes(
+    test: &str,
+    build: impl Fn(
+        &mut imrs_core::imrs_ports::End<Shared<Frame>, Shared<Frame>, usage::SendAll>,
+    ) -> Shared<Frame>,
+) {
+    let cell = cell(test);
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
     let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1489,8 +1515,7 @@ async fn a_broadcast_built_in_a_loan_is_read_in_place_by_a_user_here_and_in_two_
     let users = frame_users("frame-listener", &cell, "FRAMES");
     until_users(&camera, 3).await;
     for seed in 1..=BROADCAST_FRAMES {
-        // Built in a loan: a sample of shared memory, sent once for all three users.
-        let mut frame = camera.loan().unwrap();
+        let mut frame = build(&mut camera);
         write_frame(&mut frame, seed);
         let mut broadcast = within(10, camera.send_all(frame)).await.unwrap();
         let mut answers = vec![(

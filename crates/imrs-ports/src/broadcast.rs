@@ -55,6 +55,10 @@ impl<'a, Req, Rep> Broadcasting<'a, Req, Rep> {
     }
 }
 
+/// How a port's transport takes a broadcast before it is cloned for each user
+/// ([`Port::broadcast_with`](crate::Port::broadcast_with)).
+pub(crate) type Handing<Req> = Box<dyn Fn(Req) -> Req + Send + Sync>;
+
 /// The first answer to a broadcast, and the way to read the later ones.
 ///
 /// While it lives the owner end stays borrowed, so no new broadcast can overwrite answers
@@ -103,6 +107,10 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
                     return Poll::Ready(Err(BroadcastError::Timeout { port, message }));
                 }
                 return Poll::Pending;
+            }
+            if let Some(hand) = core.handing.get() {
+                let message = this.message.take().expect("the message waits to be posted");
+                *this.message = Some(hand(message));
             }
             let message = this
                 .message

@@ -7,6 +7,7 @@
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 use std::task::Waker;
 
+use crate::broadcast::Handing;
 use crate::clock::SharedClock;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
@@ -120,6 +121,9 @@ pub(crate) struct Core<Req, Rep> {
     /// Where a sender's messages are built, if a transport lends memory of its own
     /// ([`Port::lend_with`](crate::Port::lend_with)).
     pub(crate) lender: OnceLock<Lender<Req>>,
+    /// Where a broadcast is moved before it is cloned for each user, if a transport says
+    /// ([`Port::broadcast_with`](crate::Port::broadcast_with)).
+    pub(crate) handing: OnceLock<Handing<Req>>,
     /// Whether waits park at once, whatever the process type says
     /// ([`Port::park_waits`](crate::Port::park_waits)).
     pub(crate) parked: AtomicBool,
@@ -144,6 +148,7 @@ impl<Req, Rep> Core<Req, Rep> {
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
             shown: OnceLock::new(),
             lender: OnceLock::new(),
+            handing: OnceLock::new(),
             parked: AtomicBool::new(false),
             pump: OnceLock::new(),
         }

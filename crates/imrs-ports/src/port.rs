@@ -181,6 +181,17 @@ where
         self
     }
 
+    /// Hands each broadcast of the port (`SENDALL` or `CALLALL`) to its transport before
+    /// the port clones it for each user: the port clones what `hand` returns. For a
+    /// transport whose users all read one copy where it lies (shared memory, across
+    /// processes): a broadcast built elsewhere, such as the heap, is moved there once, and
+    /// every user's clone reads that one copy, rather than each being copied on its way.
+    /// The first set holds, for every handle of the port.
+    pub fn broadcast_with(self, hand: impl Fn(Req) -> Req + Send + Sync + 'static) -> Self {
+        let _first_holds = self.core.handing.set(Box::new(hand));
+        self
+    }
+
     /// Makes every wait on the port park at once, whatever its process type says: for a
     /// transport whose side of the rendezvous is a task on the same runtime as the module's,
     /// which a TIGHT port's spin would keep off its worker until the spin ends. Holds for

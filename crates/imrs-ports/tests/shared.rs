@@ -233,3 +233,64 @@ async fn a_broadcast_of_a_message_no_one_writes_reaches_every_user_where_it_lies
         );
     }
 }
+
+#[tokio::test]
+async fn a_broadcast_is_handed_to_the_transport_once_and_every_user_reads_what_it_made() {
+    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::declare(
+        PortSpec::new("FRAME", "CAMERA"),
+    );
+    // The transport moves each broadcast into memory of its own, which it shares.
+    let handed = Arc::new(std::sync::Mutex::new(Vec::<Arc<Image>>::new()));
+    let into_memory = Arc::clone(&handed);
+    let port = port.broadcast_with(move |frame: Shared<Image>| {
+        let memory = Arc::new((*frame).clone());
+        into_memory.lock().unwrap().push(Arc::clone(&memory));
+        Shared::in_buffer(Received(memory))
+    });
+    let mut camera = port.owner().unwrap();
+
+    // Refused before it is posted: the sender gets its own message back, not handed on.
+    let mut frame = Image::default();
+    frame.pixels[0] = 7;
+    let refused = camera.send_all(Shared::new(frame)).await.unwrap_err();
+    let imrs_ports::BroadcastError::NoUsers { message, .. } = refused else {
+        panic!("a broadcast to nobody was not refused for it: {refused:?}");
+    };
+    assert!(message.buffer().is::<Box<Image>>(), "handed on, unsent");
+    assert!(handed.lock().unwrap().is_empty());
+
+    let users: Vec<_> = ["VISION", "GRIPPER", "LOGGER"]
+        .into_iter()
+        .map(|module| port.user_named(module).unwrap())
+        .collect();
+    let reading = users
+        .into_iter()
+        .map(|mut user| {
+            tokio::spawn(async move {
+                let mut read_at = Vec::new();
+                for _ in 0..2 {
+                    let (frame, reply) = user.receive().await.unwrap();
+                    read_at.push(frame.pixels.as_ptr() as usize);
+                    reply.reply(Shared::new(u64::from(frame.pixels[0])));
+                }
+                read_at
+            })
+        })
+        .collect::<Vec<_>>();
+    for value in [1, 2] {
+        let mut frame = Image::default();
+        frame.pixels[0] = value;
+        let broadcast = camera.send_all(Shared::new(frame)).await.unwrap();
+        assert_eq!(*broadcast.first, u64::from(value));
+    }
+    let handed: Vec<usize> = handed
+        .lock()
+        .unwrap()
+        .iter()
+        .map(|memory| memory.pixels.as_ptr() as usize)
+        .collect();
+    assert_eq!(handed.len(), 2, "not handed on once a broadcast");
+    for user in reading {
+        assert_eq!(user.await.unwrap(), handed, "a user read a copy of its own");
+    }
+}
