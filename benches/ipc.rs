@@ -20,7 +20,8 @@
 //!
 //! Then `SENDALL` broadcasts from this process to one user in a peer started for them, 8 B
 //! and 64 KiB, by value and built in place, each timed to its first reply; and broadcasts
-//! built in place to two users, each in a peer of its own, timed to the last reply.
+//! built in place to two users, each in a peer of its own, timed to the last reply, and
+//! the 64 KiB ones again built on the heap, which the port copies into one sample for both.
 //!
 //! Then the TIGHT cases, each against a peer started only for it (a spinning peer would
 //! otherwise take processor time from the other cases): an IMRS port declared TIGHT, beside
@@ -150,6 +151,7 @@ fn main() {
         news_loaned_large,
         pair_small,
         pair_large,
+        pair_large_heap,
     ] = broadcasts(&runtime, &cell, rounds);
 
     println!("round trip between two processes, {rounds} each   p50      p99      p99.9");
@@ -188,6 +190,7 @@ fn main() {
     for (name, times) in [
         ("IMRS SENDALL, loaned, 8 B", &pair_small),
         ("IMRS SENDALL, loaned, 64 KiB", &pair_large),
+        ("IMRS SENDALL, on the heap, 64 KiB", &pair_large_heap),
     ] {
         let [p50, p99, p999] = percentiles(times);
         println!("  {name:<38} {p50:>8.1?} {p99:>8.1?} {p999:>8.1?}");
@@ -255,6 +258,10 @@ fn main() {
     println!(
         "  SENDALL to two users, 64 KiB vs 8 B, loaned                        {}",
         show(ratio(&pair_large, &pair_small).collect())
+    );
+    println!(
+        "  SENDALL to two users, 64 KiB on the heap vs loaned                 {}",
+        show(ratio(&pair_large_heap, &pair_large).collect())
     );
     match &spinning {
         Some((raw_spin, imrs_tight)) => println!(
@@ -510,7 +517,7 @@ fn in_task(
 /// them: 8 B and 64 KiB, by value and built in place; each timed to its first reply. Then
 /// on two more, built in place, to two users, each in a peer of its own; each timed to its
 /// last reply.
-fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [Vec<Duration>; 6] {
+fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [Vec<Duration>; 7] {
     let cell = format!("{cell}-news");
     let remote = Remote::new(&cell).expect("a cell name");
     let _entered = runtime.enter();
@@ -551,19 +558,23 @@ fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [
         in_task(runtime, broadcast_times(large.owner().unwrap(), rounds)),
         in_task(
             runtime,
-            loaned_broadcast_times(loaned_small.owner().unwrap(), 1, rounds),
+            shared_broadcast_times(loaned_small.owner().unwrap(), 1, rounds, loaned),
         ),
         in_task(
             runtime,
-            loaned_broadcast_times(loaned_large.owner().unwrap(), 1, rounds),
+            shared_broadcast_times(loaned_large.owner().unwrap(), 1, rounds, loaned),
         ),
         in_task(
             runtime,
-            loaned_broadcast_times(pair_small.owner().unwrap(), 2, rounds),
+            shared_broadcast_times(pair_small.owner().unwrap(), 2, rounds, loaned),
         ),
         in_task(
             runtime,
-            loaned_broadcast_times(pair_large.owner().unwrap(), 2, rounds),
+            shared_broadcast_times(pair_large.owner().unwrap(), 2, rounds, loaned),
+        ),
+        in_task(
+            runtime,
+            shared_broadcast_times(pair_large.owner().unwrap(), 2, rounds, on_heap),
         ),
     ];
     for child in [&mut child, &mut second] {
@@ -584,15 +595,29 @@ async fn broadcast_times<T: Wire>(
     })
 }
 
-/// `rounds` broadcasts, each built in a loan of the port, and timed to the last of the
-/// replies of its `users` users.
-async fn loaned_broadcast_times<T: Wire>(
-    mut owner: End<Shared<T>, Shared<T>, usage::SendAll>,
+/// The owner's end of a `SENDALL` port of messages built in place.
+type Camera<T> = End<Shared<T>, Shared<T>, usage::SendAll>;
+
+/// A broadcast built in a loan of the port: a sample of shared memory, sent as it is.
+fn loaned<T: Wire>(owner: &mut Camera<T>) -> Shared<T> {
+    owner.loan().expect("a loan")
+}
+
+/// A broadcast built on the heap: the port copies it into one sample for all its users.
+fn on_heap<T: Wire>(_: &mut Camera<T>) -> Shared<T> {
+    Shared::new(T::default())
+}
+
+/// `rounds` broadcasts, each made by `build`, and timed to the last of the replies of its
+/// `users` users.
+async fn shared_broadcast_times<T: Wire>(
+    mut owner: Camera<T>,
     users: usize,
     rounds: usize,
+    build: fn(&mut Camera<T>) -> Shared<T>,
 ) -> Vec<Duration> {
     timed!(rounds, {
-        let message = owner.loan().expect("a loan");
+        let message = build(&mut owner);
         let mut news = owner.send_all(message).await.expect("an answer");
         std::hint::black_box(&*std::mem::take(&mut news.first));
         for _ in 1..users {
