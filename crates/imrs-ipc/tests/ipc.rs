@@ -1687,7 +1687,8 @@ async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_a
         .port()
         .responder_named("CHILD", five_times)
         .unwrap();
-    answers_an_owner_killed_and_started_again(child, first, &["parent", &cell, "ASK_STATUS", "3"])
+    let heard = answering(child);
+    answers_an_owner_killed_and_started_again(heard, first, &["parent", &cell, "ASK_STATUS", "3"])
         .await;
 }
 
@@ -1702,24 +1703,53 @@ async fn an_owner_of_callalls_killed_mid_run_and_started_again_reaches_its_user_
         .port()
         .responder_named("ANSWERER", five_times)
         .unwrap();
-    answers_an_owner_killed_and_started_again(answerer, first, &["caller", &cell, "POLL", "3"])
+    let heard = answering(answerer);
+    answers_an_owner_killed_and_started_again(heard, first, &["caller", &cell, "POLL", "3"]).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_of_broadcasts_of_numbers_killed_mid_run_and_started_again_reaches_its_user_again()
+{
+    let cell = cell("send-all-owner-killed");
+    let first = started(&["announcer", &cell, "NEWS", "1000000"]);
+    let remote = Remote::new(&cell).unwrap();
+    let imported =
+        imrs_ipc::import_send_all::<Number, Number>(&remote, "NEWS", "ANNOUNCER", "HEARER")
+            .unwrap();
+    let mut hearer = imported.port().user_named("HEARER").unwrap();
+    let (answered, heard) = tokio::sync::mpsc::unbounded_channel();
+    tokio::spawn(async move {
+        let _imported = imported;
+        while let Ok((number, reply)) = hearer.receive().await {
+            reply.reply(five_times(&(), number));
+            let _ = answered.send(());
+        }
+    });
+    answers_an_owner_killed_and_started_again(heard, first, &["announcer", &cell, "NEWS", "3"])
         .await;
 }
 
-/// `handler`, the response handler of a user here, answers the owner in `first` (which asks
-/// without end) three times; then `first` is killed (`kill -9`), and a new copy of the
-/// owner, started with `again` to ask three times, must find all three answers right.
-async fn answers_an_owner_killed_and_started_again(
+/// Serves `handler` without end; says each time it has answered.
+fn answering(
     mut handler: imrs_core::imrs_ports::ResponseEnd<Number, Number, ()>,
-    mut first: Peer,
-    again: &[&str],
-) {
-    let (answered, mut heard) = tokio::sync::mpsc::unbounded_channel();
+) -> tokio::sync::mpsc::UnboundedReceiver<()> {
+    let (answered, heard) = tokio::sync::mpsc::unbounded_channel();
     tokio::spawn(async move {
         while handler.serve(&()).await.is_ok() {
             let _ = answered.send(());
         }
     });
+    heard
+}
+
+/// A user here answers the owner in `first` (which asks without end) three times, as
+/// `heard` tells; then `first` is killed (`kill -9`), and a new copy of the owner, started
+/// with `again` to ask three times, must find all three answers right.
+async fn answers_an_owner_killed_and_started_again(
+    mut heard: tokio::sync::mpsc::UnboundedReceiver<()>,
+    mut first: Peer,
+    again: &[&str],
+) {
     for _ in 0..3 {
         within(10, heard.recv()).await.unwrap();
     }

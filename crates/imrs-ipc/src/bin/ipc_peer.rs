@@ -34,6 +34,8 @@
 //!   must be five times the question, or it exits with 2.
 //! - `ipc_peer caller CELL PORT N`: the same for PORT, a `CALLALL` port of numbers (owner
 //!   CALLER, user ANSWERER): each question goes to ANSWERER's response handler.
+//! - `ipc_peer announcer CELL PORT N`: the same for PORT, a `SENDALL` port of numbers
+//!   (owner ANNOUNCER, user HEARER): each number is broadcast, and HEARER replies.
 //! - `ipc_peer vision CELL PORT`: exports PORT, a port of 64 KiB frames built in place
 //!   (`Shared`; users CAMERA and CAMERA_2), and answers each frame with one whose word 0 is
 //!   1 if the frame was read in place (not a copy of its own), word 1 the sum of the
@@ -56,8 +58,8 @@ use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_call_all, export_query, export_response,
-    export_response_shared, export_send_all_shared, export_shared, import, import_call_all,
-    import_call_all_shared, import_query, import_query_shared, import_send_all,
+    export_response_shared, export_send_all, export_send_all_shared, export_shared, import,
+    import_call_all, import_call_all_shared, import_query, import_query_shared, import_send_all,
     import_send_all_shared,
 };
 
@@ -99,6 +101,7 @@ fn main() -> ExitCode {
             ["camera", cell, port, n] => camera(cell, port, n).await,
             ["parent", cell, port, n] => parent(cell, port, n).await,
             ["caller", cell, port, n] => caller(cell, port, n).await,
+            ["announcer", cell, port, n] => announcer(cell, port, n).await,
             ["inspector", cell, port] => inspector(cell, port).await,
             ["listener", cell, port, module, n] => listener(cell, port, module, n).await,
             ["answerer", cell, port, module, n] => answerer(cell, port, module, n).await,
@@ -262,6 +265,22 @@ async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
         let answer = caller.call_all(Number { value }).await?.first;
         if answer.value != 5 * value {
             return Err(format!("asked {value}, answered {}", answer.value).into());
+        }
+    }
+    Ok(())
+}
+
+async fn announcer(cell: &str, port: &str, n: &str) -> Result<(), Error> {
+    let port: Port<Number, Number, usage::SendAll, AnyUser, 1> =
+        Port::declare(PortSpec::new(port, "ANNOUNCER").user_list(["HEARER"]));
+    let _exported = export_send_all(&Remote::new(cell)?, &port)?;
+    println!("ready");
+    let mut announcer = port.owner()?;
+    announcer.peer_attached().await;
+    for value in 1..=n.parse::<u64>()? {
+        let answer = announcer.send_all(Number { value }).await?.first;
+        if answer.value != 5 * value {
+            return Err(format!("announced {value}, answered {}", answer.value).into());
         }
     }
     Ok(())
