@@ -547,25 +547,36 @@ mod tests {
             assert!(message.is_writable(), "a loan is built in place");
             message[7] = round;
             // A broadcast to three users hands each a clone: one send, shared by all.
-            let clones: Vec<Shared<[u64; 32]>> = (0..3).map(|_| message.clone()).collect();
-            for clone in &clones {
-                assert!(std::ptr::eq(&**clone, &*message), "a clone is a copy");
-            }
+            sent_once_to_three_users(&broadcaster, &mut inbox, &message, round);
             assert!(!message.is_writable(), "a broadcast sent is still written");
             // Changing it afterwards changes a copy: no user sees the change.
             let kept = message.clone();
             message[7] = u64::MAX;
             assert_eq!(kept[7], round);
-            let tickets: Vec<u64> = clones
-                .into_iter()
-                .map(|clone| broadcaster.ticket(clone).unwrap().seq)
-                .collect();
-            assert!(tickets.iter().all(|&seq| seq == tickets[0]));
-            // A user process gets that one sample, and no other.
-            let sample = inbox.take(tickets[0]).unwrap();
-            assert_eq!(sample.payload()[7], round);
-            assert!(inbox.subscriber.receive().unwrap().is_none());
         }
+    }
+
+    /// Hands `message` to three users, as a broadcast does: each clone reads `message`
+    /// itself, their tickets name one broadcast, and a user process gets that one sample,
+    /// with word 7 `round`, and no other.
+    fn sent_once_to_three_users(
+        broadcaster: &Arc<Broadcaster<[u64; 32]>>,
+        inbox: &mut Inbox<[u64; 32]>,
+        message: &Shared<[u64; 32]>,
+        round: u64,
+    ) {
+        let clones: Vec<Shared<[u64; 32]>> = (0..3).map(|_| message.clone()).collect();
+        for clone in &clones {
+            assert!(std::ptr::eq(&**clone, &**message), "a clone is a copy");
+        }
+        let tickets: Vec<u64> = clones
+            .into_iter()
+            .map(|clone| broadcaster.ticket(clone).unwrap().seq)
+            .collect();
+        assert!(tickets.iter().all(|&seq| seq == tickets[0]));
+        let sample = inbox.take(tickets[0]).unwrap();
+        assert_eq!(sample.payload()[7], round);
+        assert!(inbox.subscriber.receive().unwrap().is_none());
     }
 
     #[test]
@@ -587,18 +598,7 @@ mod tests {
             let at = std::ptr::from_ref(&*adopted);
             let adopted = broadcaster.adopt(adopted);
             assert!(std::ptr::eq(&*adopted, at), "copied again");
-            let clones: Vec<Shared<[u64; 32]>> = (0..3).map(|_| adopted.clone()).collect();
-            for clone in &clones {
-                assert!(std::ptr::eq(&**clone, at), "a clone is a copy");
-            }
-            let tickets: Vec<u64> = clones
-                .into_iter()
-                .map(|clone| broadcaster.ticket(clone).unwrap().seq)
-                .collect();
-            assert!(tickets.iter().all(|&seq| seq == tickets[0]));
-            let sample = inbox.take(tickets[0]).unwrap();
-            assert_eq!(sample.payload()[7], round);
-            assert!(inbox.subscriber.receive().unwrap().is_none());
+            sent_once_to_three_users(&broadcaster, &mut inbox, &adopted, round);
         }
     }
 

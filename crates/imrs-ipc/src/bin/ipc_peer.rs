@@ -245,13 +245,10 @@ async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     println!("ready");
     let mut parent = port.owner()?;
     parent.peer_attached().await;
-    for value in 1..=n.parse::<u64>()? {
-        let status = parent.query(Number { value }).await?;
-        if status.value != 5 * value {
-            return Err(format!("asked {value}, answered {}", status.value).into());
-        }
-    }
-    Ok(())
+    five_times_each(n, async |value| {
+        Ok(parent.query(Number { value }).await?.value)
+    })
+    .await
 }
 
 async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
@@ -261,13 +258,10 @@ async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     println!("ready");
     let mut caller = port.owner()?;
     caller.peer_attached().await;
-    for value in 1..=n.parse::<u64>()? {
-        let answer = caller.call_all(Number { value }).await?.first;
-        if answer.value != 5 * value {
-            return Err(format!("asked {value}, answered {}", answer.value).into());
-        }
-    }
-    Ok(())
+    five_times_each(n, async |value| {
+        Ok(caller.call_all(Number { value }).await?.first.value)
+    })
+    .await
 }
 
 async fn announcer(cell: &str, port: &str, n: &str) -> Result<(), Error> {
@@ -277,10 +271,21 @@ async fn announcer(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     println!("ready");
     let mut announcer = port.owner()?;
     announcer.peer_attached().await;
+    five_times_each(n, async |value| {
+        Ok(announcer.send_all(Number { value }).await?.first.value)
+    })
+    .await
+}
+
+/// Asks 1..=`n` with `ask`: each answer must be five times the question.
+async fn five_times_each(
+    n: &str,
+    mut ask: impl AsyncFnMut(u64) -> Result<u64, Error>,
+) -> Result<(), Error> {
     for value in 1..=n.parse::<u64>()? {
-        let answer = announcer.send_all(Number { value }).await?.first;
-        if answer.value != 5 * value {
-            return Err(format!("announced {value}, answered {}", answer.value).into());
+        let answer = ask(value).await?;
+        if answer != 5 * value {
+            return Err(format!("asked {value}, answered {answer}").into());
         }
     }
     Ok(())
