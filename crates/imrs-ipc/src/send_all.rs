@@ -135,7 +135,8 @@ where
 {
     let name = Name::from(port);
     let broadcaster = Broadcaster::<Req>::create(remote, &name, N)?;
-    // The port's lender outlives an export withdrawn; loans from then on are on the heap.
+    // The port's lender and hand outlive an export withdrawn: from then on loans are on the
+    // heap, and a broadcast is copied for each user.
     let (lender, handing) = (Arc::downgrade(&broadcaster), Arc::downgrade(&broadcaster));
     let _lends = port
         .clone()
