@@ -247,6 +247,10 @@ async fn a_broadcast_is_handed_to_the_transport_once_and_every_user_reads_what_i
         into_memory.lock().unwrap().push(Arc::clone(&memory));
         Shared::in_buffer(Received(memory))
     });
+    // The first set holds, for every handle of the port.
+    let _ignored = port
+        .clone()
+        .broadcast_with(|_| panic!("a second hand replaced the first"));
     let mut camera = port.owner().unwrap();
 
     // Refused before it is posted: the sender gets its own message back, not handed on.
