@@ -18,20 +18,16 @@ use imrs_ports::RealClock;
 fn query(iters: u64, busy: bool) -> Duration {
     current_thread().block_on(async move {
         let cell = Cell::new(std::sync::Arc::new(RealClock::new()));
-        let port = Port::<u64, u64, usage::Query>::declare(PortSpec::new("STATUS", "ASKER"));
+        let port: Port<u64, u64, usage::Query> =
+            cell.port(PortSpec::new("STATUS", "ASKER")).unwrap();
         let responder = ModuleSpec::new("ROBOT", 7u64)
             // The handler outranks the background (idle: parked there) and INSERT (busy).
             .order(["STATUS.STATE", "ROBOT", "INSERT"])
-            .sections(["INSERT"])
-            .response(
-                "STATUS.STATE",
-                port.responder_named("ROBOT", |s: &u64, q: u64| s + q)
-                    .unwrap(),
-            )
+            .respond(&port.handler("STATE"), |s: &u64, q: u64| s + q)
             .task("ROBOT", move |ctx| async move {
                 if busy {
                     // In INSERT, ranked below the handler: each suspension point admits it.
-                    ctx.section("INSERT", async {
+                    ctx.section(&Section::new("INSERT"), async {
                         loop {
                             tokio::task::yield_now().await;
                         }

@@ -17,23 +17,20 @@ pub const KEPT: usize = 4_096;
 
 /// SERVER receives and replies `iters` times; CLIENT sends `iters` times and times it.
 pub fn ctx_modules(cell: &Cell, iters: u64, timed: &Timed) -> (ModuleSpec<()>, ModuleSpec<()>) {
-    let feed = Port::<[u8; 8], u64, usage::Receive>::declare(
-        PortSpec::new("FEED", "SERVER").clock(cell.clock().clone()),
-    );
+    let feed: Port<[u8; 8], u64, usage::Receive> =
+        cell.port(PortSpec::new("FEED", "SERVER")).unwrap();
     let port = feed.clone();
-    let server = ModuleSpec::new("SERVER", ())
-        .owns(&feed)
-        .task("SERVER", move |ctx| {
-            let owner = ctx.owner(&port);
-            async move {
-                let mut feed = owner?;
-                for _ in 0..iters {
-                    let (message, reply) = ctx.receive(&mut feed).await?;
-                    reply.reply(u64::from(message[0]));
-                }
-                Ok(())
+    let server = ModuleSpec::new("SERVER", ()).task("SERVER", move |ctx| {
+        let owner = ctx.owner(&port);
+        async move {
+            let mut feed = owner?;
+            for _ in 0..iters {
+                let (message, reply) = ctx.receive(&mut feed).await?;
+                reply.reply(u64::from(message[0]));
             }
-        });
+            Ok(())
+        }
+    });
     let (port, timed) = (feed.clone(), Arc::clone(timed));
     let client = ModuleSpec::new("CLIENT", ())
         .uses(&feed)

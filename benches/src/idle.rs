@@ -32,19 +32,16 @@ pub async fn idle_modules(count: usize) -> (IdleModules, Duration) {
             format!("M{i}"),
         ));
         let own = port.clone();
-        let spec =
-            ModuleSpec::new(format!("M{i}"), ())
-                .owns(&port)
-                .task(format!("M{i}"), move |ctx| {
-                    let owner = ctx.owner(&own);
-                    async move {
-                        let mut own = owner?;
-                        loop {
-                            let (message, reply) = ctx.receive(&mut own).await?;
-                            reply.reply(message);
-                        }
-                    }
-                });
+        let spec = ModuleSpec::new(format!("M{i}"), ()).task(format!("M{i}"), move |ctx| {
+            let owner = ctx.owner(&own);
+            async move {
+                let mut own = owner?;
+                loop {
+                    let (message, reply) = ctx.receive(&mut own).await?;
+                    reply.reply(message);
+                }
+            }
+        });
         handles.push(cell.start(spec).expect("module names are unique"));
         ports.push(port);
     }

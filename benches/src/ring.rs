@@ -38,7 +38,6 @@ fn ring_module(
     let (own, next) = (ports[i].clone(), ports[(i + 1) % ports.len()].clone());
     let lap = Arc::clone(lap);
     ModuleSpec::new(format!("M{i}"), ())
-        .owns(&own)
         .uses(&next)
         .task(format!("M{i}"), move |ctx| {
             let (owner, user, lap) = (ctx.owner(&own), ctx.user(&next), Arc::clone(&lap));
@@ -71,7 +70,10 @@ pub fn imrs_ring(size: usize, hops: u64, threads: usize) -> Duration {
         // The ring's events stream to no one; keep few, as a long-running cell would.
         cell.events().set_capacity(1_024);
         let ports: Vec<Port<u64, (), usage::Receive>> = (0..size)
-            .map(|i| Port::declare(PortSpec::new(format!("P{i}"), format!("M{i}"))))
+            .map(|i| {
+                cell.port(PortSpec::new(format!("P{i}"), format!("M{i}")))
+                    .unwrap()
+            })
             .collect();
         let mut handles = Vec::with_capacity(size);
         // Module 0 last, so that every other is listening when the token starts.

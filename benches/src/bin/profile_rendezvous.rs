@@ -40,11 +40,7 @@ fn queries(round_trips: u64) {
         let port = Port::<u64, u64, usage::Query>::declare(PortSpec::new("STATUS", "ASKER"));
         let responder = ModuleSpec::new("ROBOT", 7u64)
             .order(["STATUS.STATE", "ROBOT"])
-            .response(
-                "STATUS.STATE",
-                port.responder_named("ROBOT", |s: &u64, q: u64| s + q)
-                    .expect("a new port has room for a responder"),
-            )
+            .respond(&port.handler("STATE"), |s: &u64, q: u64| s + q)
             .task("ROBOT", |_ctx| std::future::pending());
         let robot = cell.start_on(&processor, responder).unwrap();
         let mut asker = port.owner().expect("a new port has no owner yet");

@@ -243,14 +243,14 @@ pub fn chip_it(
     let twin_line = line.other();
     let line_ports = &ports.lines[line.index()];
     let twin_ports = &ports.lines[twin_line.index()];
-    let crit_section = twin_ports.share_feeder.handler("CRIT_SECTION");
-    let own_timeout = line_ports.share_feeder.handler("TIMEOUT");
+    let crit_section = twin_ports.share_feeder.handler("CRIT_SECTION").name();
+    let own_timeout = line_ports.share_feeder.handler("TIMEOUT").name();
     let mut spec = ModuleSpec::new(n.chip_it.clone(), ChipItState::default())
         // 1) timeouts first; 2) never preempt the background, else a QUERY could be
         // interrupted by a QUERY from the twin; 3) nor the critical region; 4) then the twin's
         // query; 5) the insertion last: a query is answered only while inserting.
         .order([
-            line_ports.ready_to_chip.handler("TIMEOUT"),
+            line_ports.ready_to_chip.handler("TIMEOUT").name(),
             own_timeout.clone(),
             n.chip_it.as_str().into(),
             "GRASP".into(),
@@ -258,20 +258,16 @@ pub fn chip_it(
             "INSERT".into(),
             "BACK_OFF".into(),
         ])
-        .sections(["GRASP", "INSERT", "BACK_OFF"])
         .hardware([
             format!("chip robot of line {line:?}"),
             "chip station freeze relay".into(),
         ])
-        .owns(&line_ports.ready_to_chip)
         .uses_named(n.frequency.clone(), UsageKind::Send)
         // The Appendix's feeder ports are declared under both policies, so that the module
         // keeps the Appendix's shape; under the arbiter nobody queries them.
-        .owns(&line_ports.share_feeder)
         // WHEN SHARE_FEEDER1.CRIT_SECTION(CLEAR) ==> CLEAR := 1: the order decides when.
         .respond(
-            &twin_ports.share_feeder,
-            "CRIT_SECTION",
+            &twin_ports.share_feeder.handler("CRIT_SECTION"),
             |_: &ChipItState, ()| 1,
         );
     match policy {
@@ -293,8 +289,11 @@ pub fn chip_it(
     let backs_off = line == Line::A;
     spec = spec.exception(own_timeout, move |ctx: Ctx<ChipItState>, _| async move {
         if backs_off {
-            ctx.section("BACK_OFF", ctx.delay(Duration::from_millis(500)))
-                .await;
+            ctx.section(
+                &Section::new("BACK_OFF"),
+                ctx.delay(Duration::from_millis(500)),
+            )
+            .await;
         }
     });
 
@@ -415,7 +414,7 @@ async fn chip_step(
 ) -> Result<(), DeviceError> {
     access.reserve(ctx, robot, step, waits).await?;
     let grasped = ctx
-        .section("GRASP", async {
+        .section(&Section::new("GRASP"), async {
             let grasped = async {
                 retried(ctx, "reaching into the feeders", || {
                     robot.move_to(Target::Feeder(step.feeder))
@@ -443,7 +442,7 @@ async fn chip_step(
         );
         return Err(error);
     }
-    ctx.section("INSERT", async {
+    ctx.section(&Section::new("INSERT"), async {
         retried(ctx, "inserting the chip", || robot.insert())
             .await
             .map(|_| ())
@@ -456,56 +455,52 @@ async fn chip_step(
 /// robot's reservation, and in turn where it does not.
 pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
     let (reserve, free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
-    ModuleSpec::new(FEEDER_COORDINATOR, ())
-        .owns(ZONE_RESERVE)
-        .owns(ZONE_FREE)
-        .task(FEEDER_COORDINATOR, move |_ctx| {
-            let (reserve, free) = (reserve.clone(), free.clone());
-            async move {
-                let (mut reserve, mut free) = (reserve.owner()?, free.owner()?);
-                let mut space = Reservations::new(LINK_RADIUS, SWEEP_MARGIN);
-                // Requests not yet granted, by robot: answered when their space frees.
-                let mut asleep = Vec::new();
-                loop {
-                    enum Event {
-                        // Boxed: a reservation is a record of 1.6 KiB.
-                        Reserve(Box<Reservation>, ReplyHandle<()>),
-                        Free(ModuleName, ReplyHandle<()>),
-                    }
-                    let event = select()
-                        .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
-                        .or(&mut reserve, |(reservation, reply)| {
-                            Event::Reserve(Box::new(reservation), reply)
-                        })
-                        .await?;
-                    match event {
-                        Event::Reserve(reservation, reply) => {
-                            // A record no robot wrote (a garbled peer) is not answered:
-                            // its sender fails, and asks again.
-                            let Some(sweep) = reservation.sweep() else {
-                                continue;
-                            };
-                            let robot = *reservation.robot();
-                            if space.request(robot.as_str(), &sweep.to_vec()) {
-                                reply.reply(());
-                            } else {
-                                asleep.push((robot, reply));
-                            }
-                        }
-                        Event::Free(robot, reply) => {
+    ModuleSpec::new(FEEDER_COORDINATOR, ()).task(FEEDER_COORDINATOR, move |_ctx| {
+        let (reserve, free) = (reserve.clone(), free.clone());
+        async move {
+            let (mut reserve, mut free) = (reserve.owner()?, free.owner()?);
+            let mut space = Reservations::new(LINK_RADIUS, SWEEP_MARGIN);
+            // Requests not yet granted, by robot: answered when their space frees.
+            let mut asleep = Vec::new();
+            loop {
+                enum Event {
+                    // Boxed: a reservation is a record of 1.6 KiB.
+                    Reserve(Box<Reservation>, ReplyHandle<()>),
+                    Free(ModuleName, ReplyHandle<()>),
+                }
+                let event = select()
+                    .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
+                    .or(&mut reserve, |(reservation, reply)| {
+                        Event::Reserve(Box::new(reservation), reply)
+                    })
+                    .await?;
+                match event {
+                    Event::Reserve(reservation, reply) => {
+                        // A record no robot wrote (a garbled peer) is not answered:
+                        // its sender fails, and asks again.
+                        let Some(sweep) = reservation.sweep() else {
+                            continue;
+                        };
+                        let robot = *reservation.robot();
+                        if space.request(robot.as_str(), &sweep.to_vec()) {
                             reply.reply(());
-                            for granted in space.release(robot.as_str()) {
-                                if let Some(at) =
-                                    asleep.iter().position(|(r, _)| granted == r.as_str())
-                                {
-                                    asleep.swap_remove(at).1.reply(());
-                                }
+                        } else {
+                            asleep.push((robot, reply));
+                        }
+                    }
+                    Event::Free(robot, reply) => {
+                        reply.reply(());
+                        for granted in space.release(robot.as_str()) {
+                            if let Some(at) = asleep.iter().position(|(r, _)| granted == r.as_str())
+                            {
+                                asleep.swap_remove(at).1.reply(());
                             }
                         }
                     }
                 }
             }
-        })
+        }
+    })
 }
 
 /// How far apart two reservations keep the arms' links.
@@ -515,20 +510,17 @@ const SWEEP_MARGIN: f32 = 0.03;
 pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {
     let (request, release): (ZoneLink, ZoneLink) =
         (ports.zone_request.clone(), ports.zone_release.clone());
-    ModuleSpec::new(FEEDER_MONITOR, ())
-        .owns(ZONE_REQUEST)
-        .owns(ZONE_RELEASE)
-        .task(FEEDER_MONITOR, move |ctx| {
-            let (request, release) = (request.clone(), release.clone());
-            async move {
-                let (mut request, mut release) = (request.owner()?, release.owner()?);
-                loop {
-                    // Grant the zone to the first to ask; take no other request until it is back.
-                    let (_, granted) = ctx.receive(&mut request).await?;
-                    granted.reply(());
-                    let (_, returned) = ctx.receive(&mut release).await?;
-                    returned.reply(());
-                }
+    ModuleSpec::new(FEEDER_MONITOR, ()).task(FEEDER_MONITOR, move |ctx| {
+        let (request, release) = (request.clone(), release.clone());
+        async move {
+            let (mut request, mut release) = (request.owner()?, release.owner()?);
+            loop {
+                // Grant the zone to the first to ask; take no other request until it is back.
+                let (_, granted) = ctx.receive(&mut request).await?;
+                granted.reply(());
+                let (_, returned) = ctx.receive(&mut release).await?;
+                returned.reply(());
             }
-        })
+        }
+    })
 }

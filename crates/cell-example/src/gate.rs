@@ -77,7 +77,7 @@ pub fn gate(
     history: SharedCycleTimes,
 ) -> ModuleSpec<GateState> {
     let n = LineNames::of(line);
-    let timeout = ports.let_1_go.handler("TIMEOUT");
+    let timeout = ports.let_1_go.handler("TIMEOUT").name();
     let state = GateState {
         cycle_time: 10.0,
         speeds: [20.0, 40.0],
@@ -90,7 +90,6 @@ pub fn gate(
     ModuleSpec::new(n.gate.clone(), state)
         .order([timeout.clone(), n.gate.as_str().into()])
         .hardware([format!("gate relay and photocell of line {line:?}")])
-        .owns(&ports.let_1_go)
         .filters(n.frequency.clone(), UsageKind::Receive)
         .task(n.gate.clone(), move |ctx| {
             let (let_1_go, frequency) = (let_1_go.clone(), frequency.clone());

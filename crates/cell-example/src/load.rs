@@ -38,8 +38,8 @@ pub struct LoadCardState {
 pub fn load_it(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<LoadItState> {
     let n = LineNames::of(line);
     let (timeout1, timeout2) = (
-        ports.ask_child1.handler("TIMEOUT"),
-        ports.ask_child2.handler("TIMEOUT"),
+        ports.ask_child1.handler("TIMEOUT").name(),
+        ports.ask_child2.handler("TIMEOUT").name(),
     );
     let ports = ports.clone();
     let devices = devices.clone();
@@ -50,8 +50,6 @@ pub fn load_it(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<L
             timeout2.clone(),
             n.load_it.as_str().into(),
         ])
-        .owns(&ports.ask_child1)
-        .owns(&ports.ask_child2)
         .uses_named(n.frequency.clone(), UsageKind::Send)
         .task(n.load_it.clone(), move |ctx| {
             let (ports, devices, n) = (ports.clone(), devices.clone(), n.clone());
@@ -131,20 +129,19 @@ pub fn load_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec
     let n = LineNames::of(line);
     let spec = ModuleSpec::new(n.load_card.clone(), LoadCardState::default())
         .order([
-            ports.pallet_in_place.handler("TIMEOUT"),
-            ports.ask_child1.handler("STATUS"),
+            ports.pallet_in_place.handler("TIMEOUT").name(),
+            ports.ask_child1.handler("STATUS").name(),
             n.load_card.as_str().into(),
         ])
         .hardware([
             format!("load robot of line {line:?}"),
             "load station freeze relay".into(),
         ])
-        .owns(&ports.pallet_in_place)
-        .owns(&ports.card_in_place)
         // WHEN ASK_CHILD1.STATUS(RC1, NUM1, CYCLE1) ==> RC1 := 0; NUM1 := NUM_LOADED; ...
-        .respond(&ports.ask_child1, "STATUS", |card: &LoadCardState, ()| {
-            (0, card.num_loaded, card.cycle_time)
-        });
+        .respond(
+            &ports.ask_child1.handler("STATUS"),
+            |card: &LoadCardState, ()| (0, card.num_loaded, card.cycle_time),
+        );
     let (pallet_port, card_port) = (ports.pallet_in_place.clone(), ports.card_in_place.clone());
     let robot = devices.robot(RobotId::new(line, Role::LoadCard));
     let freeze_port = ports.pallet_in_place.clone();
@@ -247,17 +244,17 @@ pub fn load_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec
 /// The SCREW_IN_CARD module of `line`: its robot screws each laid card to its pallet.
 pub fn screw_in_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<()> {
     let n = LineNames::of(line);
-    let timeout = ports.card_in_place.handler("TIMEOUT");
+    let timeout = ports.card_in_place.handler("TIMEOUT").name();
     let spec = ModuleSpec::new(n.screw_in_card.clone(), ())
         .order([
             timeout.clone(),
-            ports.ask_child2.handler("STATUS"),
+            ports.ask_child2.handler("STATUS").name(),
             n.screw_in_card.as_str().into(),
         ])
         .hardware([format!("screw robot of line {line:?}")])
         .uses(&ports.card_in_place)
         // WHEN ASK_CHILD2.STATUS(RC1) ==> RC1 := 0;
-        .respond(&ports.ask_child2, "STATUS", |_: &(), ()| 0);
+        .respond(&ports.ask_child2.handler("STATUS"), |_: &(), ()| 0);
     let port = ports.card_in_place.clone();
     let robot = devices.robot(RobotId::new(line, Role::ScrewInCard));
     let name = n.screw_in_card.clone();

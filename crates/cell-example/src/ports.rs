@@ -196,37 +196,38 @@ impl LinePorts {
                 "BOUNDED_BUFFER",
             )
             .shown(),
-            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).timeout(secs(2))).shown(),
+            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).owner_timeout(secs(2)))
+                .shown(),
             ask_child1: AskChild1::declare(
                 spec(&n.ask_child1, &n.load_it, clock)
                     .user_list([n.load_card.clone()])
-                    .timeout(secs(2)),
+                    .owner_timeout(secs(2)),
             )
             .shown(),
             ask_child2: AskChild2::declare(
                 spec(&n.ask_child2, &n.load_it, clock)
                     .user_list([n.screw_in_card.clone()])
-                    .timeout(secs(2)),
+                    .owner_timeout(secs(2)),
             )
             .shown(),
             pallet_in_place: PalletInPlace::declare(
-                spec(&n.pallet_in_place, &n.load_card, clock).timeout(secs(30)),
+                spec(&n.pallet_in_place, &n.load_card, clock).owner_timeout(secs(30)),
             )
             .shown(),
             card_in_place: CardInPlace::declare(
                 spec(&n.card_in_place, &n.load_card, clock)
                     .user_list([n.screw_in_card.clone()])
-                    .timeout(secs(30)),
+                    .owner_timeout(secs(30)),
             )
             .shown(),
             ready_to_chip: ReadyToChip::declare(
-                spec(&n.ready_to_chip, &n.chip_it, clock).timeout(secs(60)),
+                spec(&n.ready_to_chip, &n.chip_it, clock).owner_timeout(secs(60)),
             )
             .shown(),
             share_feeder: ShareFeeder::declare(
                 spec(&n.share_feeder, &n.chip_it, clock)
                     .user_list([twin.chip_it.clone()])
-                    .timeout(secs(3)),
+                    .owner_timeout(secs(3)),
             )
             .shown(),
         }
@@ -236,7 +237,7 @@ impl LinePorts {
 impl LinePorts {
     /// Makes this line's ports known to `cell`, for the wiring check.
     pub fn declare_to(&self, cell: &Cell) -> Result<(), WireError> {
-        cell.declare_filtered(&self.frequency)?;
+        cell.declare(&self.frequency)?;
         cell.declare(&self.let_1_go)?;
         cell.declare(&self.ask_child1)?;
         cell.declare(&self.ask_child2)?;

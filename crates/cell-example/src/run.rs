@@ -417,7 +417,7 @@ impl LineModules {
 
     /// Starts the line's modules in `cell`: GATE and CHIP_IT supervised, restarted as a
     /// cell engineer would want; LOAD_IT starts its own children.
-    pub(crate) fn start(self, cell: &Cell) -> Result<(), CellError> {
+    pub(crate) fn start(self, cell: &Cell) -> Result<(), CellErrors> {
         let policy = RestartPolicy::restart(3, Duration::from_secs(5));
         let (line, lines) = (self.line, self.ports.lines[self.line.index()].clone());
         let (gate_lines, gate_devices) = (lines.clone(), self.devices.clone());

@@ -188,14 +188,7 @@ pub fn coordinator(
 ) -> ModuleSpec<()> {
     let ports = ports.clone();
     let table = Arc::new(Mutex::new(table));
-    let mut spec = ModuleSpec::new(name, ())
-        .owns(&ports.to_coordinator)
-        .owns(&ports.alarm)
-        .owns(&ports.emergency);
-    for port in ports.wake.values() {
-        spec = spec.owns(port);
-    }
-    spec.task(name, move |_ctx| {
+    ModuleSpec::new(name, ()).task(name, move |_ctx| {
         let (ports, table, log) = (ports.clone(), Arc::clone(&table), Arc::clone(&log));
         async move {
             let mut to = ports.to_coordinator.owner()?;

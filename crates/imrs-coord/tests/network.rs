@@ -160,27 +160,24 @@ fn the_most_urgent_message_waits_two_periods_at_most_whatever_is_queued() {
 #[test]
 fn a_placed_cell_gets_each_ports_worst_case_and_a_warning_for_short_timeouts() {
     let (cell, _clock) = Cell::virtual_clock();
-    let grant = Port::<[f32; 30], u8, usage::Send>::declare(
-        PortSpec::new("ZONE_GRANT", "COORDINATOR")
-            .user_list(["ROBOT_1", "ROBOT_2"])
-            .timeout(Duration::from_millis(10)),
-    );
-    let stop = Port::<u8, (), usage::Send>::declare(
-        PortSpec::new("EMERGENCY_STOP", "COORDINATOR")
-            .user_list(["ROBOT_1", "ROBOT_2"])
-            .priority(1)
-            .timeout(Duration::from_micros(900)),
-    );
-    let local = Port::<u32, u32, usage::Query>::declare(
-        PortSpec::new("GRIPPER", "ROBOT_1").user_list(["ROBOT_1_HAND"]),
-    );
-    for declared in [
-        cell.declare(&grant),
-        cell.declare(&stop),
-        cell.declare(&local),
-    ] {
-        declared.unwrap();
-    }
+    let _grant: Port<[f32; 30], u8, usage::Send> = cell
+        .port(
+            PortSpec::new("ZONE_GRANT", "COORDINATOR")
+                .user_list(["ROBOT_1", "ROBOT_2"])
+                .owner_timeout(Duration::from_millis(10)),
+        )
+        .unwrap();
+    let _stop: Port<u8, (), usage::Send> = cell
+        .port(
+            PortSpec::new("EMERGENCY_STOP", "COORDINATOR")
+                .user_list(["ROBOT_1", "ROBOT_2"])
+                .priority(1)
+                .owner_timeout(Duration::from_micros(900)),
+        )
+        .unwrap();
+    let _local: Port<u32, u32, usage::Query> = cell
+        .port(PortSpec::new("GRIPPER", "ROBOT_1").user_list(["ROBOT_1_HAND"]))
+        .unwrap();
     let placement = Placement::new()
         .place("COORDINATOR", 0)
         .place("ROBOT_1", 1)

@@ -8,11 +8,11 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::usage::{Plain, Usage};
 use imrs_ports::{
-    End, FilteredPort, Instant, Name, Port, Presence, SharedClock, UserList, VirtualClock,
-    WireError, Wiring,
+    End, FilteredPort, Instant, Name, Port, PortSpec, Presence, SharedClock, UserList,
+    VirtualClock, WireError, Wiring,
 };
 
-use crate::check::{CellError, CellErrors, check};
+use crate::check::{CellError, CellErrors, check, check_module};
 use crate::deadlock::WaitGraph;
 use crate::event::{Event, EventKind, EventLog};
 use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
@@ -62,6 +62,71 @@ impl CellShared {
             task: None,
             kind,
         });
+    }
+}
+
+/// Whether two handles name the same clock: the same object, not only the same kind.
+fn same_clock(a: &SharedClock, b: &SharedClock) -> bool {
+    std::ptr::addr_eq(Arc::as_ptr(a), Arc::as_ptr(b))
+}
+
+/// A port (or pair of ports) that can be declared to a cell: see [`Cell::declare`].
+pub trait Declare: sealed::Sealed {
+    /// Declares `self` to `cell`.
+    #[doc(hidden)]
+    fn declare_to(&self, cell: &Cell) -> Result<(), WireError>;
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+impl<Req, Rep, U, L, const N: usize> sealed::Sealed for Port<Req, Rep, U, L, N>
+where
+    U: Usage,
+    L: UserList,
+{
+}
+
+impl<Req, Rep, U, L, const N: usize> Declare for Port<Req, Rep, U, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: Usage,
+    L: UserList,
+{
+    fn declare_to(&self, cell: &Cell) -> Result<(), WireError> {
+        cell.declare_port(self)
+    }
+}
+
+impl<Req, Rep, F, FReq, FRep, O, L, const N: usize> sealed::Sealed
+    for FilteredPort<Req, Rep, F, FReq, FRep, O, L, N>
+where
+    F: Usage,
+    O: Usage,
+    L: UserList,
+{
+}
+
+/// A filtered port: the users' side under the port's name, and the owner's side as
+/// `PORT.FILTER`.
+impl<Req, Rep, F, FReq, FRep, O, L, const N: usize> Declare
+    for FilteredPort<Req, Rep, F, FReq, FRep, O, L, N>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    FReq: Send + 'static,
+    FRep: Send + 'static,
+    F: Usage + Plain,
+    O: Usage + Plain,
+    O::Complement: Plain,
+    F::Complement: Plain,
+    L: UserList,
+{
+    fn declare_to(&self, cell: &Cell) -> Result<(), WireError> {
+        cell.declare_port(self.users_side())?;
+        cell.declare_port(self.filter_side())
     }
 }
 
@@ -126,8 +191,74 @@ impl Cell {
         self.shared.observe.store(on, Ordering::Relaxed);
     }
 
-    /// Makes `port` known to the cell by name, for [`Cell::check`] and [`Cell::use_port`].
-    pub fn declare<Req, Rep, U, L, const N: usize>(
+    /// `PORT ...`: makes a port on the cell's clock and declares it to the cell, owned by
+    /// the module `spec` names. This is how a cell's ports are made: the port's timeouts run
+    /// on the cell's clock (virtual or real), and the check each module passes when it starts
+    /// sees the port. A `spec` that names another clock is refused
+    /// ([`WireError::OtherClock`]), as is a second port of the same name.
+    pub fn port<Req, Rep, U, L, const N: usize>(
+        &self,
+        spec: PortSpec,
+    ) -> Result<Port<Req, Rep, U, L, N>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        L: UserList,
+    {
+        if let Some(clock) = spec.clock_of()
+            && !same_clock(clock, &self.shared.clock)
+        {
+            return Err(WireError::OtherClock {
+                port: spec.name().clone(),
+            });
+        }
+        let port = Port::declare(spec.clock(Arc::clone(&self.shared.clock)));
+        self.declare(&port)?;
+        Ok(port)
+    }
+
+    /// `PORT ...` with a filter task spliced in (seed 000, restriction 5): makes a
+    /// [`FilteredPort`] on the cell's clock and declares both its sides, as [`Cell::port`]
+    /// does for a plain port.
+    // The type is the filtered port's own, with every parameter the caller chose.
+    #[allow(clippy::type_complexity)]
+    pub fn filtered_port<Req, Rep, F, FReq, FRep, O, L, const N: usize>(
+        &self,
+        spec: PortSpec,
+        filter_task: impl Into<Name>,
+    ) -> Result<FilteredPort<Req, Rep, F, FReq, FRep, O, L, N>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        FReq: Send + 'static,
+        FRep: Send + 'static,
+        F: Usage + Plain,
+        O: Usage + Plain,
+        O::Complement: Plain,
+        F::Complement: Plain,
+        L: UserList,
+    {
+        if let Some(clock) = spec.clock_of()
+            && !same_clock(clock, &self.shared.clock)
+        {
+            return Err(WireError::OtherClock {
+                port: spec.name().clone(),
+            });
+        }
+        let port = FilteredPort::declare(spec.clock(Arc::clone(&self.shared.clock)), filter_task);
+        self.declare(&port)?;
+        Ok(port)
+    }
+
+    /// Declares to the cell a port made elsewhere — a [`FilteredPort`], or a port a
+    /// transport made — as [`Cell::port`] declares the ports it makes. A port on another
+    /// clock than the cell's is refused ([`WireError::OtherClock`]).
+    pub fn declare(&self, port: &impl Declare) -> Result<(), WireError> {
+        port.declare_to(self)
+    }
+
+    fn declare_port<Req, Rep, U, L, const N: usize>(
         &self,
         port: &Port<Req, Rep, U, L, N>,
     ) -> Result<(), WireError>
@@ -137,6 +268,11 @@ impl Cell {
         U: Usage,
         L: UserList,
     {
+        if !same_clock(port.clock(), &self.shared.clock) {
+            return Err(WireError::OtherClock {
+                port: port.name().clone(),
+            });
+        }
         lock(&self.shared.wiring).declare(port)
     }
 
@@ -154,28 +290,6 @@ impl Cell {
         L: UserList,
     {
         lock(&self.shared.wiring).declare_elsewhere(port)
-    }
-
-    /// Makes a filtered port known to the cell: the users' side under the port's name, and
-    /// the owner's side as `PORT.FILTER`.
-    pub fn declare_filtered<Req, Rep, F, FReq, FRep, O, L, const N: usize>(
-        &self,
-        port: &FilteredPort<Req, Rep, F, FReq, FRep, O, L, N>,
-    ) -> Result<(), WireError>
-    where
-        Req: Send + 'static,
-        Rep: Send + 'static,
-        FReq: Send + 'static,
-        FRep: Send + 'static,
-        F: Usage + Plain,
-        O: Usage + Plain,
-        O::Complement: Plain,
-        F::Complement: Plain,
-        L: UserList,
-    {
-        let mut wiring = lock(&self.shared.wiring);
-        wiring.declare(port.users_side())?;
-        wiring.declare(port.filter_side())
     }
 
     /// Attaches `module` to the port named `port`, checking what the types could not.
@@ -198,18 +312,24 @@ impl Cell {
         lock(&self.shared.wiring).ports()
     }
 
-    /// The seed's load-time check: every problem with these modules and the declared ports,
-    /// all at once, each naming its module and port.
+    /// The seed's load-time check over a whole cell: every problem with these modules and
+    /// the declared ports, all at once, each naming its module and port — including what
+    /// no single module shows (a port whose owner is not among them, too many users). For
+    /// tools; a cell needs no call to it, since each module is checked when it starts.
     pub fn check(&self, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
         check(&lock(&self.shared.wiring), modules)
     }
 
-    /// Starts `spec` as a top-level module. If it fails, it stays failed. Refused if a
-    /// module of the same name runs in the cell.
+    /// Starts `spec` as a top-level module. If it fails, it stays failed.
+    ///
+    /// The module is checked first, against the ports declared to the cell: every problem
+    /// the check finds in it (a port it uses that is not declared, a user list that does not
+    /// name it, a handler or section left out of its order, ...) refuses it, all of them
+    /// named in the error; so is a module of the same name already running.
     pub fn start<S: Send + Sync + 'static>(
         &self,
         spec: ModuleSpec<S>,
-    ) -> Result<ModuleHandle, CellError> {
+    ) -> Result<ModuleHandle, CellErrors> {
         self.launch(None, RestartPolicy::NEVER, spec, None)
     }
 
@@ -220,7 +340,7 @@ impl Cell {
         &self,
         policy: RestartPolicy,
         mut factory: F,
-    ) -> Result<ModuleHandle, CellError>
+    ) -> Result<ModuleHandle, CellErrors>
     where
         S: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
@@ -235,7 +355,7 @@ impl Cell {
         &self,
         processor: &Processor,
         spec: ModuleSpec<S>,
-    ) -> Result<ModuleHandle, CellError> {
+    ) -> Result<ModuleHandle, CellErrors> {
         self.launch(Some(processor), RestartPolicy::NEVER, spec, None)
     }
 
@@ -245,7 +365,7 @@ impl Cell {
         processor: &Processor,
         policy: RestartPolicy,
         mut factory: F,
-    ) -> Result<ModuleHandle, CellError>
+    ) -> Result<ModuleHandle, CellErrors>
     where
         S: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<S> + Send + 'static,
@@ -262,7 +382,7 @@ impl Cell {
         policy: RestartPolicy,
         first: ModuleSpec<S>,
         factory: Option<Factory<S>>,
-    ) -> Result<ModuleHandle, CellError> {
+    ) -> Result<ModuleHandle, CellErrors> {
         let Some(processor) = processor else {
             return spawn_module(Arc::clone(&self.shared), None, policy, first, factory);
         };
@@ -369,7 +489,7 @@ pub(crate) fn spawn_module<S: Send + Sync + 'static>(
     policy: RestartPolicy,
     first: ModuleSpec<S>,
     factory: Option<Factory<S>>,
-) -> Result<ModuleHandle, CellError> {
+) -> Result<ModuleHandle, CellErrors> {
     let (handle, supervisor) = supervisor(cell, (parent, None), policy, first, factory)?;
     tokio::spawn(supervisor);
     Ok(handle)
@@ -385,17 +505,15 @@ fn supervisor<S: Send + Sync + 'static>(
     policy: RestartPolicy,
     first: ModuleSpec<S>,
     mut factory: Option<Factory<S>>,
-) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellError> {
+) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellErrors> {
     let name = first.name.clone();
-    if let Some(problem) = first.problems.first() {
-        return Err(CellError::Wire(problem.clone()));
-    }
+    check_module(&lock(&cell.wiring), &first.declaration())?;
     let kill = Arc::new(KillSwitch::default());
     match lock(&cell.modules).entry(name.clone()) {
-        Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }),
+        Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }.into()),
         Entry::Vacant(vacant) => vacant.insert(Member {
             switch: Arc::clone(&kill),
-            placement: first.placement(parent.clone(), processor),
+            placement: first.placement(parent.clone(), processor, &lock(&cell.wiring)),
         }),
     };
     let presence = Presence::new(name.clone());
@@ -469,9 +587,10 @@ fn supervisor<S: Send + Sync + 'static>(
                 break outcome;
             }
             let copy = factory();
-            if let Some(problem) = copy.problems.first() {
+            let wired = check_module(&lock(&cell.wiring), &copy.declaration());
+            if let Err(problems) = wired {
                 // The new copy cannot even be wired (say, its response end is taken).
-                let reason = format!("a new copy cannot be wired: {problem}");
+                let reason = format!("a new copy cannot be wired: {problems}");
                 cell.record(
                     &name,
                     EventKind::ModuleFailed {

@@ -7,7 +7,7 @@ use std::fmt;
 use imrs_ports::{Name, UsageKind, WireError, Wiring};
 
 use crate::exception::Exception;
-use crate::module::spec::ModuleDecl;
+use crate::module::spec::{ModuleDecl, owned_by};
 
 /// One wiring problem of a cell.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -19,30 +19,14 @@ pub enum CellError {
         /// The name.
         module: Name,
     },
-    /// A declared port that no module owns.
+    /// A declared port whose owner is not among the modules checked.
     NoOwner {
         /// The port.
         port: Name,
         /// The owner the port was declared with.
         declared_owner: Name,
     },
-    /// A port that more than one module claims to own.
-    TwoOwners {
-        /// The port.
-        port: Name,
-        /// The modules that own it.
-        modules: Vec<Name>,
-    },
-    /// A module owns a port that was declared for another owner.
-    WrongOwner {
-        /// The port.
-        port: Name,
-        /// The module that claims it.
-        module: Name,
-        /// The owner in the port's declaration.
-        declared_owner: Name,
-    },
-    /// A module owns, uses or filters a port that was never declared.
+    /// A module uses or filters a port that was never declared to the cell.
     UnknownPort {
         /// The port.
         port: Name,
@@ -112,6 +96,14 @@ pub enum CellError {
         /// The port.
         port: Name,
     },
+    /// A response handler of the module that its order does not rank: it would answer at
+    /// any suspension point, whatever section the module is in.
+    Unranked {
+        /// The module.
+        module: Name,
+        /// The handler (`PORT.resp`).
+        handler: Name,
+    },
     /// An order names something the module does not have.
     UnknownOrderName {
         /// The module.
@@ -131,19 +123,7 @@ impl fmt::Display for CellError {
                 declared_owner,
             } => write!(
                 f,
-                "port {port} has no owner: no module declares it (its declaration names {declared_owner})"
-            ),
-            Self::TwoOwners { port, modules } => {
-                write!(f, "port {port} has {} owners:", modules.len())?;
-                modules.iter().try_for_each(|module| write!(f, " {module}"))
-            }
-            Self::WrongOwner {
-                port,
-                module,
-                declared_owner,
-            } => write!(
-                f,
-                "module {module} owns port {port}, which is declared as owned by {declared_owner}"
+                "port {port} has no owner: its owner {declared_owner} is not among the modules"
             ),
             Self::UnknownPort { port, module } => {
                 write!(
@@ -201,9 +181,14 @@ impl fmt::Display for CellError {
                 f,
                 "module {module} answers queries on port {port}, which it neither owns nor uses"
             ),
+            Self::Unranked { module, handler } => write!(
+                f,
+                "module {module} has a handler {handler} that its order does not rank: put it \
+                 in the order, where it may start"
+            ),
             Self::UnknownOrderName { module, name } => write!(
                 f,
-                "the order of module {module} names {name}, which is not its background, a section, a handler or a port of it"
+                "the order of module {module} names {name}, which is not a handler or an exception of it"
             ),
         }
     }
@@ -256,11 +241,23 @@ pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellE
     check_users(wiring, modules, &mut problems);
     check_filters(wiring, modules, &mut problems);
     for module in modules {
-        problems.extend(module.problems.iter().cloned().map(CellError::Wire));
-        check_order(module, &mut problems);
-        check_exceptions(module, &mut problems);
-        check_responses(module, &mut problems);
+        check_itself(wiring, module, &mut problems);
     }
+    into_result(problems)
+}
+
+/// The check of one module as it starts: everything the whole cell's check finds that lies
+/// in this module alone.
+pub(crate) fn check_module(wiring: &Wiring, module: &ModuleDecl) -> Result<(), CellErrors> {
+    let mut problems = Vec::new();
+    let module = std::slice::from_ref(module);
+    check_users(wiring, module, &mut problems);
+    check_filters(wiring, module, &mut problems);
+    check_itself(wiring, &module[0], &mut problems);
+    into_result(problems)
+}
+
+fn into_result(problems: Vec<CellError>) -> Result<(), CellErrors> {
     if problems.is_empty() {
         Ok(())
     } else {
@@ -268,50 +265,28 @@ pub(crate) fn check(wiring: &Wiring, modules: &[ModuleDecl]) -> Result<(), CellE
     }
 }
 
+/// What a module's declaration says of itself: its ends, order, handlers and exceptions.
+fn check_itself(wiring: &Wiring, module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    problems.extend(module.problems.iter().cloned().map(CellError::Wire));
+    let owns = owned_by(wiring, &module.name);
+    check_order(module, &owns, problems);
+    check_ranked(module, problems);
+    check_exceptions(module, &owns, problems);
+    check_responses(module, &owns, problems);
+}
+
+/// Every declared port's owner is among the modules (or runs in another process).
 fn check_owners(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<CellError>) {
-    let mut owners: BTreeMap<&Name, Vec<Name>> = BTreeMap::new();
-    for module in modules {
-        for port in module
-            .owns
-            .iter()
-            .chain(module.filters.iter().map(|(port, _)| port))
-        {
-            owners.entry(port).or_default().push(module.name.clone());
-        }
-    }
+    let present: BTreeSet<&Name> = modules.iter().map(|module| &module.name).collect();
     for port in wiring.port_names() {
         let info = wiring
             .port_info(port.as_str())
             .expect("a listed port has info");
-        // A filtered port's two halves are owned through `filters` and the owner's `owns`.
-        let owner_side_of_filter = port.as_str().ends_with(".FILTER");
-        let claimed = owners.get(port).map(Vec::as_slice).unwrap_or_default();
-        match claimed {
-            [] if owner_side_of_filter || wiring.owned_elsewhere(port.as_str()) => {}
-            [] => problems.push(CellError::NoOwner {
+        if !present.contains(&info.owner) && !wiring.owned_elsewhere(port.as_str()) {
+            problems.push(CellError::NoOwner {
                 port: port.clone(),
                 declared_owner: info.owner,
-            }),
-            [owner] if *owner != info.owner => problems.push(CellError::WrongOwner {
-                port: port.clone(),
-                module: owner.clone(),
-                declared_owner: info.owner,
-            }),
-            [_] => {}
-            many => problems.push(CellError::TwoOwners {
-                port: port.clone(),
-                modules: many.to_vec(),
-            }),
-        }
-    }
-    for (port, modules) in owners {
-        if wiring.port_info(port.as_str()).is_none() {
-            for module in modules {
-                problems.push(CellError::UnknownPort {
-                    port: port.clone(),
-                    module,
-                });
-            }
+            });
         }
     }
 }
@@ -364,7 +339,11 @@ fn check_filters(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<Cel
     for module in modules {
         for (port, usage) in &module.filters {
             let Some(info) = wiring.port_info(port.as_str()) else {
-                continue; // reported by the owner check
+                problems.push(CellError::UnknownPort {
+                    port: port.clone(),
+                    module: module.name.clone(),
+                });
+                continue;
             };
             if info.usage != *usage {
                 problems.push(CellError::FilterUsageMismatch {
@@ -378,19 +357,17 @@ fn check_filters(wiring: &Wiring, modules: &[ModuleDecl], problems: &mut Vec<Cel
     }
 }
 
-/// The ports a module declares it owns, uses or filters.
-fn ports_of(module: &ModuleDecl) -> impl Iterator<Item = &Name> {
-    module
-        .owns
-        .iter()
+/// The ports a module owns, uses or filters.
+fn ports_of<'a>(module: &'a ModuleDecl, owns: &'a [Name]) -> impl Iterator<Item = &'a Name> {
+    owns.iter()
         .chain(module.uses.iter().map(|(port, _)| port))
         .chain(module.filters.iter().map(|(port, _)| port))
 }
 
 /// Every exception module can raise: its ports' timeouts, its tasks' failures, and those it
 /// declares.
-fn raisable(module: &ModuleDecl) -> BTreeSet<Name> {
-    let mut raisable: BTreeSet<Name> = ports_of(module)
+fn raisable(module: &ModuleDecl, owns: &[Name]) -> BTreeSet<Name> {
+    let mut raisable: BTreeSet<Name> = ports_of(module, owns)
         .map(|port| Exception::timeout_of(port.as_str()))
         .collect();
     raisable.extend(
@@ -403,8 +380,8 @@ fn raisable(module: &ModuleDecl) -> BTreeSet<Name> {
     raisable
 }
 
-fn check_exceptions(module: &ModuleDecl, problems: &mut Vec<CellError>) {
-    let raisable = raisable(module);
+fn check_exceptions(module: &ModuleDecl, owns: &[Name], problems: &mut Vec<CellError>) {
+    let raisable = raisable(module, owns);
     for exception in &module.exceptions {
         if !raisable.contains(exception) {
             problems.push(CellError::UnknownException {
@@ -415,9 +392,8 @@ fn check_exceptions(module: &ModuleDecl, problems: &mut Vec<CellError>) {
     }
 }
 
-fn check_responses(module: &ModuleDecl, problems: &mut Vec<CellError>) {
-    let declared: BTreeSet<&Name> = module
-        .owns
+fn check_responses(module: &ModuleDecl, owns: &[Name], problems: &mut Vec<CellError>) {
+    let declared: BTreeSet<&Name> = owns
         .iter()
         .chain(module.uses.iter().map(|(port, _)| port))
         .collect();
@@ -439,14 +415,30 @@ fn check_responses(module: &ModuleDecl, problems: &mut Vec<CellError>) {
     }
 }
 
-fn check_order(module: &ModuleDecl, problems: &mut Vec<CellError>) {
-    let mut known = raisable(module);
-    known.insert(module.name.clone());
-    known.extend(module.sections.iter().cloned());
+/// Every response handler is in the order: one left out would answer wherever the module
+/// is. (An exception handler the order leaves out has a rank of its own, documented at
+/// [`Rank::UNRANKED_HANDLER`](crate::Rank::UNRANKED_HANDLER): it runs at the next
+/// suspension point, as an alarm should.)
+fn check_ranked(module: &ModuleDecl, problems: &mut Vec<CellError>) {
+    let ranked: BTreeSet<&Name> = module.order.iter().collect();
+    for (handler, _) in &module.responses {
+        if !ranked.contains(handler) {
+            problems.push(CellError::Unranked {
+                module: module.name.clone(),
+                handler: handler.clone(),
+            });
+        }
+    }
+}
+
+/// The order names nothing that looks like a handler (`X.Y`) the module does not have; a
+/// plain name other than the module's own is a named section.
+fn check_order(module: &ModuleDecl, owns: &[Name], problems: &mut Vec<CellError>) {
+    let mut known = raisable(module, owns);
     known.extend(module.responses.iter().map(|(handler, _)| handler.clone()));
     known.extend(module.exceptions.iter().cloned());
     for name in &module.order {
-        if !known.contains(name) {
+        if name.as_str().contains('.') && !known.contains(name) {
             problems.push(CellError::UnknownOrderName {
                 module: module.name.clone(),
                 name: name.clone(),

@@ -84,7 +84,9 @@
 //!   from tokio's paused clock: build the runtime with `new_current_thread()` and
 //!   `start_paused(true)`, which needs tokio's `test-util` feature.
 //!
-//! Two modules: LOAD_IT queries its child LOAD_CARD for its status.
+//! Two modules: LOAD_IT queries LOAD_CARD for its status. Each module, port, section and
+//! handler is named once; the cell makes the port on its own clock, and checks each module
+//! as it starts.
 //!
 //! ```
 //! use std::time::Duration;
@@ -93,33 +95,36 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! # let runtime = tokio::runtime::Builder::new_current_thread().enable_all().start_paused(true).build()?;
 //! # runtime.block_on(async {
+//! const LOAD: Section = Section::new("LOAD");
 //! let (cell, clock) = Cell::virtual_clock();
-//! // ASK_CHILD1(RC, NUM_DONE), owned by LOAD_IT: USAGE=QUERY, TIMEOUT=2 SEC.
-//! let ask_child1 = Port::<(), (i32, u32), usage::Query>::declare(
-//!     PortSpec::new("ASK_CHILD1", "LOAD_IT").timeout(Duration::from_secs(2)).clock(cell.clock().clone()),
-//! );
+//! // ASK_CHILD1(RC, NUM_DONE), owned by LOAD_IT: USAGE=QUERY, its query bounded by 5 s.
+//! let ask_child1: Port<(), (i32, u32), usage::Query> =
+//!     cell.port(PortSpec::new("ASK_CHILD1", "LOAD_IT").owner_timeout(Duration::from_secs(5)))?;
+//! let status = ask_child1.handler("STATUS");
 //!
 //! #[derive(Default)]
 //! struct LoadCard { num_loaded: u32 }
 //! let load_card = ModuleSpec::new("LOAD_CARD", LoadCard::default())
-//!     .order([ask_child1.handler("STATUS"), "LOAD_CARD".into()])
-//!     .respond(&ask_child1, "STATUS", |s: &LoadCard, ()| (0, s.num_loaded))
+//!     .order([LOAD.name(), status.name()]) // STATUS is never answered mid-load
+//!     .respond(&status, |s: &LoadCard, ()| (0, s.num_loaded))
 //!     .task("LOAD_CARD", |ctx| async move {
 //!         loop {
-//!             ctx.delay(Duration::from_secs(10)).await; // load a card
+//!             ctx.section(&LOAD, ctx.delay(Duration::from_secs(8))).await; // load a card
 //!             ctx.state().update(|s| s.num_loaded += 1);
+//!             ctx.delay(Duration::from_secs(2)).await;
 //!         }
 //!     });
 //! let loaded = load_card.view();
 //!
-//! let load_it = ModuleSpec::new("LOAD_IT", ()).owns(&ask_child1).task("LOAD_IT", move |ctx| {
+//! let load_it = ModuleSpec::new("LOAD_IT", ()).task("LOAD_IT", move |ctx| {
 //!     // Each copy of the task attaches anew: a restarted copy re-attaches to the same port.
 //!     let ask_child1 = ctx.owner(&ask_child1);
 //!     async move {
 //!         let mut ask_child1 = ask_child1?;
-//!         ctx.delay(Duration::from_secs(25)).await;
+//!         ctx.delay(Duration::from_secs(25)).await; // LOAD_CARD is in LOAD until 28 s
 //!         let (rc, num_loaded) = ctx.query(&mut ask_child1, ()).await?;
-//!         assert_eq!((rc, num_loaded), (0, 2));
+//!         assert_eq!((rc, num_loaded), (0, 3));
+//!         assert_eq!(ctx.now(), Instant::from_start(Duration::from_secs(28)));
 //!         Ok(())
 //!     }
 //! });
@@ -150,7 +155,7 @@ mod tree;
 mod waitfor;
 mod work;
 
-pub use cell::{Cell, ModuleHandle, ModuleOutcome};
+pub use cell::{Cell, Declare, ModuleHandle, ModuleOutcome};
 pub use check::{CellError, CellErrors};
 pub use event::{Event, EventKind, EventLog, Observed, Primitive};
 pub use exception::Exception;
@@ -158,7 +163,7 @@ pub use imrs_ports;
 pub use log::{Log, Record};
 pub use module::ctx::{Ctx, PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
 pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult};
-pub use order::{Order, Rank};
+pub use order::{Order, Rank, Section};
 pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;
 pub use tree::{Link, LinkKind, ModuleTree, TreeModule};
@@ -169,7 +174,7 @@ pub use work::{Performed, WorkSchedule};
 pub mod prelude {
     pub use crate::{
         Cell, Ctx, Event, EventKind, Exception, ModuleHandle, ModuleOutcome, ModuleSpec, Performed,
-        Processor, RestartPolicy, TaskError, TaskResult, WaitFor, WorkSchedule,
+        Processor, RestartPolicy, Section, TaskError, TaskResult, WaitFor, WorkSchedule,
     };
     pub use imrs_ports::prelude::*;
     pub use imrs_ports::{Instant, Name, SharedClock, UsageKind};

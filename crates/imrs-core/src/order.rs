@@ -9,8 +9,9 @@ use imrs_ports::Name;
 pub struct Rank(u32);
 
 impl Rank {
-    /// The rank of a response or exception handler that the order does not name: it may run
-    /// at any suspension point, as it would in a module without an order.
+    /// The rank of an exception handler that the order does not name: it runs at the next
+    /// suspension point, whatever section the module is in, as an alarm should. A response
+    /// handler has no such rank: one the order leaves out refuses its module at start.
     pub const UNRANKED_HANDLER: Rank = Rank(0);
 
     /// The rank at `position` (1-based) in an order.
@@ -39,12 +40,81 @@ impl fmt::Debug for Rank {
     }
 }
 
+/// A named section of a module (a subprogram such as `GRASP` or `INSERT`): made once, as a
+/// constant where the name is known when the cell is written, and used wherever the section
+/// is meant — the module's order and [`Ctx::section`](crate::Ctx::section) — so that a
+/// misspelt section is a compile error.
+///
+/// ```
+/// use imrs_core::Section;
+/// const GRASP: Section = Section::new("GRASP");
+/// assert_eq!(GRASP.name().as_str(), "GRASP");
+/// ```
+///
+/// A cell built from data names its sections with [`Section::named`]; a section entered by a
+/// module whose order does not rank it fails the task, naming the section.
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub struct Section(SectionName);
+
+#[derive(Clone, PartialEq, Eq, Hash)]
+enum SectionName {
+    Static(&'static str),
+    Named(Name),
+}
+
+impl Section {
+    /// Section `name`, known when the cell is written.
+    pub const fn new(name: &'static str) -> Self {
+        Self(SectionName::Static(name))
+    }
+
+    /// Section `name`, for a cell built from data.
+    pub fn named(name: impl Into<Name>) -> Self {
+        Self(SectionName::Named(name.into()))
+    }
+
+    /// The section's name, as the order names it.
+    pub fn name(&self) -> Name {
+        match &self.0 {
+            SectionName::Static(name) => Name::from(*name),
+            SectionName::Named(name) => name.clone(),
+        }
+    }
+
+    pub(crate) fn as_str(&self) -> &str {
+        match &self.0 {
+            SectionName::Static(name) => name,
+            SectionName::Named(name) => name.as_str(),
+        }
+    }
+}
+
+impl From<&Section> for Name {
+    fn from(section: &Section) -> Self {
+        section.name()
+    }
+}
+
+impl From<Section> for Name {
+    fn from(section: Section) -> Self {
+        section.name()
+    }
+}
+
+impl fmt::Debug for Section {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Section({})", self.as_str())
+    }
+}
+
 /// A module's order: `ORDER(READY_TO_CHIP.TIMEOUT, SHARE_FEEDER.TIMEOUT, CHIP_IT, GRASP, ...)`.
 ///
 /// Names are the module's own name (its background code), `PORT.resp` for a response
 /// handler, `PORT.TIMEOUT` (or any exception name) for an exception handler, and named
-/// sections such as `GRASP`. Code in no named section is background code; a section the
-/// order does not name ranks as the code around it.
+/// sections such as `GRASP`. Code in no named section is background code. Every response
+/// handler and section of a module must be in its order: a response handler left out
+/// refuses the module when it starts, and a section left out fails the task that enters it.
+/// An exception handler left out runs at [`Rank::UNRANKED_HANDLER`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Order {
     module: Name,

@@ -35,11 +35,11 @@ fn allocations_per_ctx_round_trips(query: bool) -> usize {
 
         let client = if query {
             // CLIENT owns the query port; SERVER, its user, answers in a response handler.
-            let status = Port::<u8, u64, usage::Query>::declare(
-                PortSpec::new("STATUS", "CLIENT").clock(cell.clock().clone()),
-            );
+            let status: Port<u8, u64, usage::Query> =
+                cell.port(PortSpec::new("STATUS", "CLIENT")).unwrap();
             let server = ModuleSpec::new("SERVER", 7u64)
-                .respond(&status, "STATUS", |state: &u64, ask: u8| {
+                .order([status.handler("STATUS").name(), "SERVER".into()])
+                .respond(&status.handler("STATUS"), |state: &u64, ask: u8| {
                     *state + u64::from(ask)
                 })
                 .task("SERVER", |ctx| async move {
@@ -48,48 +48,43 @@ fn allocations_per_ctx_round_trips(query: bool) -> usize {
                 });
             cell.start_on(&processor, server).unwrap();
             let (port, seen) = (status.clone(), Arc::clone(&measured));
-            ModuleSpec::new("CLIENT", ())
-                .owns(&status)
-                .task("CLIENT", move |ctx| {
-                    let (owner, seen) = (ctx.owner(&port), Arc::clone(&seen));
-                    async move {
-                        let mut status = owner?;
-                        for n in 0..WARM_UP {
-                            assert_eq!(
-                                ctx.query(&mut status, n as u8).await?,
-                                7 + u64::from(n as u8)
-                            );
-                        }
-                        let before = allocations();
-                        for n in 0..MEASURED {
-                            assert_eq!(
-                                ctx.query(&mut status, n as u8).await?,
-                                7 + u64::from(n as u8)
-                            );
-                        }
-                        seen.store(allocations() - before, Ordering::SeqCst);
-                        Ok(())
+            ModuleSpec::new("CLIENT", ()).task("CLIENT", move |ctx| {
+                let (owner, seen) = (ctx.owner(&port), Arc::clone(&seen));
+                async move {
+                    let mut status = owner?;
+                    for n in 0..WARM_UP {
+                        assert_eq!(
+                            ctx.query(&mut status, n as u8).await?,
+                            7 + u64::from(n as u8)
+                        );
                     }
-                })
+                    let before = allocations();
+                    for n in 0..MEASURED {
+                        assert_eq!(
+                            ctx.query(&mut status, n as u8).await?,
+                            7 + u64::from(n as u8)
+                        );
+                    }
+                    seen.store(allocations() - before, Ordering::SeqCst);
+                    Ok(())
+                }
+            })
         } else {
-            let feed = Port::<[u8; 64], u64, usage::Receive>::declare(
-                PortSpec::new("FEED", "SERVER").clock(cell.clock().clone()),
-            );
+            let feed: Port<[u8; 64], u64, usage::Receive> =
+                cell.port(PortSpec::new("FEED", "SERVER")).unwrap();
             let port = feed.clone();
-            let server = ModuleSpec::new("SERVER", ())
-                .owns(&feed)
-                .task("SERVER", move |ctx| {
-                    let owner = ctx.owner(&port);
-                    async move {
-                        let mut feed = owner?;
-                        // Serves for as long as the cell runs: a module that ends allocates
-                        // as it winds down, and that is no cost of an operation.
-                        loop {
-                            let (message, reply) = ctx.receive(&mut feed).await?;
-                            reply.reply(u64::from(message[0]));
-                        }
+            let server = ModuleSpec::new("SERVER", ()).task("SERVER", move |ctx| {
+                let owner = ctx.owner(&port);
+                async move {
+                    let mut feed = owner?;
+                    // Serves for as long as the cell runs: a module that ends allocates
+                    // as it winds down, and that is no cost of an operation.
+                    loop {
+                        let (message, reply) = ctx.receive(&mut feed).await?;
+                        reply.reply(u64::from(message[0]));
                     }
-                });
+                }
+            });
             cell.start_on(&processor, server).unwrap();
             let (port, seen) = (feed.clone(), Arc::clone(&measured));
             ModuleSpec::new("CLIENT", ())

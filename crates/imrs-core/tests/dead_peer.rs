@@ -37,12 +37,7 @@ where
 {
     ModuleSpec::new("RESPONDER", 42u32)
         .order(["WORK", "STATUS.ASK", "RESPONDER"])
-        .sections(["WORK"])
-        .owns("STATUS")
-        .response(
-            "STATUS.ASK",
-            status.owner_responder(|answer: &u32, ()| *answer).unwrap(),
-        )
+        .respond(&status.handler("ASK"), |answer: &u32, ()| *answer)
         .task("RESPONDER", work)
 }
 
@@ -69,9 +64,7 @@ fn asker(status: &Status, times: &'static [u64], seen: &Seen) -> ModuleSpec<()> 
 fn declare(cell: &Cell) -> Status {
     // Declared with the cell, as a wired cell does: the declaration lives on, so a port is
     // never "closed" here; only the peer's presence can say it is gone.
-    let status = Status::declare(PortSpec::new("STATUS", "RESPONDER").clock(cell.clock().clone()));
-    cell.declare(&status).unwrap();
-    status
+    cell.port(PortSpec::new("STATUS", "RESPONDER")).unwrap()
 }
 
 #[test]
@@ -103,7 +96,8 @@ fn a_pending_query_fails_when_its_responder_is_killed_with_no_restart_coming() {
         let status = declare(&cell);
         // In WORK, which outranks the handler, for ever: the query at 2 s waits.
         cell.start(responder(&status, |ctx| async move {
-            ctx.section("WORK", std::future::pending::<()>()).await;
+            ctx.section(&Section::new("WORK"), std::future::pending::<()>())
+                .await;
             Ok(())
         }))
         .unwrap();
@@ -138,7 +132,8 @@ fn while_a_restart_is_coming_a_query_waits_for_the_new_copy() {
                 async move {
                     if copy == 1 {
                         // The first copy works in WORK until it is killed.
-                        ctx.section("WORK", std::future::pending::<()>()).await;
+                        ctx.section(&Section::new("WORK"), std::future::pending::<()>())
+                            .await;
                     }
                     std::future::pending::<()>().await;
                     Ok(())
@@ -160,10 +155,9 @@ fn while_a_restart_is_coming_a_query_waits_for_the_new_copy() {
 fn a_send_fails_when_its_receiver_fails_beyond_its_restart_policy() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let card = Port::<u32, i32, usage::Send>::declare(
-            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
-        );
-        cell.declare(&card).unwrap();
+        let card: Port<u32, i32, usage::Send> = cell
+            .port(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"))
+            .unwrap();
         let port = card.clone();
         // Each copy attaches, fails after 1 s without receiving; one restart after 3 s.
         cell.supervise(RestartPolicy::restart(1, secs(3)), move || {
@@ -214,10 +208,8 @@ fn a_send_fails_when_its_receiver_fails_beyond_its_restart_policy() {
 fn a_receive_fails_when_every_sender_has_finished() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let frequency = Port::<u32, (), usage::Receive>::declare(
-            PortSpec::new("FREQUENCY", "GATE").clock(cell.clock().clone()),
-        );
-        cell.declare(&frequency).unwrap();
+        let frequency: Port<u32, (), usage::Receive> =
+            cell.port(PortSpec::new("FREQUENCY", "GATE")).unwrap();
         let port = frequency.clone();
         cell.start(ModuleSpec::new("SETTER", ()).task("SETTER", move |ctx| {
             let port = port.clone();
@@ -276,7 +268,8 @@ fn on_real_time_no_wait_without_a_timeout_outlives_its_peer() {
             // Killed (not supervised) while a query waits in WORK.
             let mut killed = cell
                 .start(responder(&status, |ctx: Ctx<u32>| async move {
-                    ctx.section("WORK", std::future::pending::<()>()).await;
+                    ctx.section(&Section::new("WORK"), std::future::pending::<()>())
+                        .await;
                     Ok(())
                 }))
                 .unwrap();

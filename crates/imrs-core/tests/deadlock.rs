@@ -36,13 +36,7 @@ fn chip_robot(
             "INSERT".into(),
             "BACK_OFF".into(),
         ])
-        .sections(["GRASP", "INSERT", "BACK_OFF"])
-        .owns(asks_name)
-        .uses_named(answers_name, UsageKind::Response)
-        .response(
-            crit_section,
-            answers.responder_named(name, |_: &(), ()| 1).unwrap(),
-        )
+        .respond(&answers.handler("CRIT_SECTION"), |_: &(), ()| 1)
         .task(name, move |ctx| {
             let (asks, log, robot) = (asks.clone(), Arc::clone(&log), robot.clone());
             async move {
@@ -51,7 +45,8 @@ fn chip_robot(
                     match ctx.query(&mut share_feeder, ()).await {
                         Ok(_) => break,
                         Err(error) if error.is_timeout() => {
-                            ctx.section("BACK_OFF", ctx.delay(secs(1))).await;
+                            ctx.section(&Section::new("BACK_OFF"), ctx.delay(secs(1)))
+                                .await;
                         }
                         Err(error) => return Err(error.into()),
                     }
@@ -59,8 +54,10 @@ fn chip_robot(
                 log.lock()
                     .unwrap()
                     .push((robot.clone(), ctx.now().since_start().as_secs()));
-                ctx.section("GRASP", ctx.delay(secs(2))).await;
-                ctx.section("INSERT", ctx.delay(secs(5))).await;
+                ctx.section(&Section::new("GRASP"), ctx.delay(secs(2)))
+                    .await;
+                ctx.section(&Section::new("INSERT"), ctx.delay(secs(5)))
+                    .await;
                 Ok(())
             }
         })
@@ -72,18 +69,16 @@ fn the_chip_robots_deadlock_is_reported_and_broken_by_asymmetric_timeouts() {
         let (cell, clock) = Cell::virtual_clock();
         // SHARE_FEEDER (CHIP_IT's, TIMEOUT=3 SEC) and SHARE_FEEDER1 (CHIP_IT2's, 5 s): the
         // asymmetry decides who gives way.
-        let share_feeder = Port::<(), i32, usage::Query>::declare(
+        let share_feeder: Port<(), i32, usage::Query> = cell.port(
             PortSpec::new("SHARE_FEEDER", "CHIP_IT")
                 .user_list(["CHIP_IT2"])
-                .timeout(secs(3))
-                .clock(cell.clock().clone()),
-        );
-        let share_feeder1 = Port::<(), i32, usage::Query>::declare(
+                .owner_timeout(secs(3)),
+        ).unwrap();
+        let share_feeder1: Port<(), i32, usage::Query> = cell.port(
             PortSpec::new("SHARE_FEEDER1", "CHIP_IT2")
                 .user_list(["CHIP_IT"])
-                .timeout(secs(5))
-                .clock(cell.clock().clone()),
-        );
+                .owner_timeout(secs(5)),
+        ).unwrap();
         let log: Log = Arc::default();
         let chip_it = chip_robot("CHIP_IT", share_feeder.clone(), &share_feeder1, Arc::clone(&log));
         let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));

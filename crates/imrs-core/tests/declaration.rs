@@ -1,34 +1,33 @@
-//! A module declared with each port named once: `.owns(&port)`, `.uses(&port)`,
-//! `.respond(&port, "STATUS", handler)` with its name built from the port, `ctx.owner(&port)`
+//! A module declared with each port named once: made by the cell, `.uses(&port)`,
+//! `.respond(&port.handler("STATUS"), handler)` with its name built from the port, `ctx.owner(&port)`
 //! and `ctx.user(&port)` attaching for the module; and its state read from outside.
 
 mod common;
 
 use common::{at, paused_runtime, secs};
 
+use imrs_core::CellError;
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
-use imrs_core::{CellError, CellErrors};
 use imrs_ports::WireError;
 
 #[test]
 fn a_cell_declared_through_its_ports_checks_runs_and_can_be_read_after() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let status = Port::<(), u32, usage::Query>::declare(
-            PortSpec::new("B_STATUS", "WELD_CELL").clock(cell.clock().clone()),
-        );
-        let seams = Port::<u32, (), usage::Receive>::declare(
-            PortSpec::new("SEAMS", "WELD_CELL").clock(cell.clock().clone()),
-        );
-        cell.declare(&status).unwrap();
-        cell.declare(&seams).unwrap();
+        let status: Port<(), u32, usage::Query> =
+            cell.port(PortSpec::new("B_STATUS", "WELD_CELL")).unwrap();
+        let seams: Port<u32, (), usage::Receive> =
+            cell.port(PortSpec::new("SEAMS", "WELD_CELL")).unwrap();
 
         let welder = ModuleSpec::new("WELDER_B", 0u32)
-            .order(["WELD".into(), status.handler("STATUS"), "WELDER_B".into()])
-            .sections(["WELD"])
+            .order([
+                "WELD".into(),
+                status.handler("STATUS").name(),
+                "WELDER_B".into(),
+            ])
             .uses(&seams)
-            .respond(&status, "STATUS", |welded: &u32, ()| *welded)
+            .respond(&status.handler("STATUS"), |welded: &u32, ()| *welded)
             .task("WELDER_B", {
                 let port = seams.clone(); // the one clone: this task's own handle
                 move |ctx| {
@@ -36,7 +35,7 @@ fn a_cell_declared_through_its_ports_checks_runs_and_can_be_read_after() {
                     async move {
                         let mut seams = seams?;
                         for seam in 1..=3 {
-                            ctx.section("WELD", ctx.delay(secs(5))).await;
+                            ctx.section(&Section::new("WELD"), ctx.delay(secs(5))).await;
                             ctx.state().update(|welded| *welded += 1);
                             ctx.send(&mut seams, seam).await?;
                         }
@@ -47,23 +46,20 @@ fn a_cell_declared_through_its_ports_checks_runs_and_can_be_read_after() {
         let welded = welder.view();
         let reports = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
         let noted = std::sync::Arc::clone(&reports);
-        let weld_cell = ModuleSpec::new("WELD_CELL", ())
-            .owns(&status)
-            .owns(&seams)
-            .task("WELD_CELL", move |ctx| {
-                let (status, seams) = (ctx.owner(&status), ctx.owner(&seams));
-                let noted = std::sync::Arc::clone(&noted);
-                async move {
-                    let (mut status, mut seams) = (status?, seams?);
-                    for _ in 0..3 {
-                        let (_, done) = ctx.receive(&mut seams).await?;
-                        done.reply(());
-                        let count = ctx.query(&mut status, ()).await?;
-                        noted.lock().unwrap().push(count);
-                    }
-                    Ok(())
+        let weld_cell = ModuleSpec::new("WELD_CELL", ()).task("WELD_CELL", move |ctx| {
+            let (status, seams) = (ctx.owner(&status), ctx.owner(&seams));
+            let noted = std::sync::Arc::clone(&noted);
+            async move {
+                let (mut status, mut seams) = (status?, seams?);
+                for _ in 0..3 {
+                    let (_, done) = ctx.receive(&mut seams).await?;
+                    done.reply(());
+                    let count = ctx.query(&mut status, ()).await?;
+                    noted.lock().unwrap().push(count);
                 }
-            });
+                Ok(())
+            }
+        });
         cell.check(&[welder.declaration(), weld_cell.declaration()])
             .unwrap();
         cell.start(welder).unwrap();
@@ -79,10 +75,10 @@ fn a_cell_declared_through_its_ports_checks_runs_and_can_be_read_after() {
 fn a_response_end_that_cannot_attach_is_reported_and_the_module_is_refused() {
     let (cell, _clock) = Cell::virtual_clock();
     // #USERS=1: one responder only.
-    let status = Port::<(), u32, usage::Query>::declare(PortSpec::new("B_STATUS", "WELD_CELL"));
-    cell.declare(&status).unwrap();
-    let first = ModuleSpec::new("WELDER_A", ()).respond(&status, "STATUS", |_: &(), ()| 1);
-    let second = ModuleSpec::new("WELDER_B", ()).respond(&status, "STATUS", |_: &(), ()| 2);
+    let status: Port<(), u32, usage::Query> =
+        cell.port(PortSpec::new("B_STATUS", "WELD_CELL")).unwrap();
+    let first = ModuleSpec::new("WELDER_A", ()).respond(&status.handler("STATUS"), |_: &(), ()| 1);
+    let second = ModuleSpec::new("WELDER_B", ()).respond(&status.handler("STATUS"), |_: &(), ()| 2);
     let taken = WireError::TooManyUsers {
         port: "B_STATUS".into(),
         module: "WELDER_B".into(),
@@ -96,9 +92,9 @@ fn a_response_end_that_cannot_attach_is_reported_and_the_module_is_refused() {
         "{problems}"
     );
     let refused = paused_runtime().block_on(async { cell.start(second).unwrap_err() });
-    assert_eq!(refused, CellError::Wire(taken));
+    assert!(refused.0.contains(&CellError::Wire(taken)), "{refused}");
     assert!(
-        CellErrors(vec![refused])
+        refused
             .to_string()
             .contains("module WELDER_B cannot use port B_STATUS")
     );
@@ -108,11 +104,9 @@ fn a_response_end_that_cannot_attach_is_reported_and_the_module_is_refused() {
 fn ctx_user_attaches_under_the_module_name_and_the_user_list_names_it() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let torch = Port::<(), (), usage::Send>::declare(
-            PortSpec::new("TORCH", "WELD_CELL")
-                .user_list(["WELDER_A"])
-                .clock(cell.clock().clone()),
-        );
+        let torch: Port<(), (), usage::Send> = cell
+            .port(PortSpec::new("TORCH", "WELD_CELL").user_list(["WELDER_A"]))
+            .unwrap();
         let refused = std::sync::Arc::new(std::sync::Mutex::new(None));
         let noted = std::sync::Arc::clone(&refused);
         cell.start(

@@ -16,12 +16,13 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
         cell.observe(true);
         // LOAD_CARD sends a card at 2 s; SCREW_IN_CARD takes 3 s to screw it and reply. The
         // second card waits past the port's 4 s TIMEOUT.
-        let card_in_place = Port::<u32, i32, usage::Send>::declare(
-            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD")
-                .user_list(["SCREW_IN_CARD"])
-                .timeout(secs(4))
-                .clock(cell.clock().clone()),
-        );
+        let card_in_place: Port<u32, i32, usage::Send> = cell
+            .port(
+                PortSpec::new("CARD_IN_PLACE", "LOAD_CARD")
+                    .user_list(["SCREW_IN_CARD"])
+                    .owner_timeout(secs(4)),
+            )
+            .unwrap();
         let (sender, receiver) = (card_in_place.clone(), card_in_place);
         let screwer = ModuleSpec::new("SCREW_IN_CARD", ())
             .uses_named("CARD_IN_PLACE", UsageKind::Receive)
@@ -39,7 +40,6 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
                 }
             });
         let loader = ModuleSpec::new("LOAD_CARD", ())
-            .owns("CARD_IN_PLACE")
             .exception("CARD_IN_PLACE.TIMEOUT", |_ctx: Ctx<()>, _| async {})
             .task("LOAD_CARD", move |ctx| {
                 let port = sender.clone();
@@ -95,10 +95,10 @@ fn one_card(observe: bool) -> Vec<Option<Box<Observed>>> {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         cell.observe(observe);
-        let card_in_place = Port::<u32, i32, usage::Send>::declare(
-            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
-        )
-        .shown();
+        let card_in_place: Port<u32, i32, usage::Send> = cell
+            .port(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"))
+            .unwrap()
+            .shown();
         let (sender, receiver) = (card_in_place.clone(), card_in_place);
         let screwer = ModuleSpec::new("SCREW_IN_CARD", ()).task("SCREW_IN_CARD", move |ctx| {
             let port = receiver.clone();

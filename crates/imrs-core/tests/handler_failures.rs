@@ -17,22 +17,15 @@ use imrs_ports::QueryError;
 fn a_panicking_response_handler_fails_its_query_and_the_module_answers_the_next() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let status = Port::<u32, u32, usage::Response, AnyUser, 2>::declare(
-            PortSpec::new("STATUS", "WELDER")
-                .timeout(secs(5))
-                .clock(cell.clock().clone()),
-        );
+        let status: Port<u32, u32, usage::Response, AnyUser, 2> = cell
+            .port(PortSpec::new("STATUS", "WELDER").owner_timeout(secs(5)))
+            .unwrap();
         let welder = ModuleSpec::new("WELDER", 7u32)
-            .owns("STATUS")
-            .response(
-                "STATUS.ASK",
-                status
-                    .owner_responder(|seams: &u32, question: u32| {
-                        assert!(question != 0, "question 0 is a bug in the handler");
-                        *seams + question
-                    })
-                    .unwrap(),
-            )
+            .order([status.handler("ASK").name(), "WELDER".into()])
+            .respond(&status.handler("ASK"), |seams: &u32, question: u32| {
+                assert!(question != 0, "question 0 is a bug in the handler");
+                *seams + question
+            })
             .task("WELDER", |ctx| async move {
                 loop {
                     ctx.delay(secs(1)).await;
@@ -87,6 +80,7 @@ fn an_exception_handler_that_raises_itself_again_does_not_starve_its_thread() {
         let handled = Arc::new(AtomicU32::new(0));
         let count = Arc::clone(&handled);
         let looping = ModuleSpec::new("LOOPING", ())
+            .raises(["AGAIN"])
             .exception("AGAIN", move |ctx: Ctx<()>, _| {
                 let count = Arc::clone(&count);
                 async move {

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
-use imrs_core::{CellError, TaskError};
+use imrs_core::{CellError, CellErrors, TaskError};
 
 /// A child that works for ever on its owned port CHILD_PORT, which a second copy of it could
 /// not own while the first still runs.
@@ -30,9 +30,8 @@ fn child(port: &Port<(), (), usage::Receive>) -> ModuleSpec<()> {
 fn a_restarted_parent_starts_its_child_anew_and_the_old_child_is_gone() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let port = Port::<(), (), usage::Receive>::declare(
-            PortSpec::new("CHILD_PORT", "CHILD").clock(cell.clock().clone()),
-        );
+        let port: Port<(), (), usage::Receive> =
+            cell.port(PortSpec::new("CHILD_PORT", "CHILD")).unwrap();
         let costarts: Arc<Mutex<Vec<Result<(), String>>>> = Arc::default();
         let seen = Arc::clone(&costarts);
         let parent = cell
@@ -85,11 +84,11 @@ fn a_second_module_of_the_same_name_is_refused() {
         let second = cell.start(idle()).unwrap_err();
         assert_eq!(
             second,
-            CellError::DuplicateModule {
+            CellErrors(vec![CellError::DuplicateModule {
                 module: "GATE".into()
-            }
+            }])
         );
-        assert_eq!(second.to_string(), "two modules are named GATE");
+        assert_eq!(second.0[0].to_string(), "two modules are named GATE");
         // The first one is untouched, and `kill` still reaches it.
         assert!(cell.kill("GATE"));
         drop(first);
@@ -100,9 +99,8 @@ fn a_second_module_of_the_same_name_is_refused() {
 fn killing_a_parent_stops_its_children() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let port = Port::<(), (), usage::Receive>::declare(
-            PortSpec::new("CHILD_PORT", "CHILD").clock(cell.clock().clone()),
-        );
+        let port: Port<(), (), usage::Receive> =
+            cell.port(PortSpec::new("CHILD_PORT", "CHILD")).unwrap();
         let mut parent = cell
             .start(ModuleSpec::new("PARENT", ()).task("PARENT", move |ctx| {
                 let port = port.clone();
@@ -127,16 +125,9 @@ fn killing_a_parent_stops_its_children() {
     });
 }
 
-/// A module that holds its ends and idles: owner of `owns`, user of `uses`.
-fn idle(
-    name: &str,
-    owns: Option<&Port<(), (), usage::Receive>>,
-    uses: Option<&Port<(), (), usage::Receive>>,
-) -> ModuleSpec<()> {
+/// A module that idles: the owner of the ports declared for it, and a user of `uses`.
+fn idle(name: &str, uses: Option<&Port<(), (), usage::Receive>>) -> ModuleSpec<()> {
     let mut spec = ModuleSpec::new(name, ());
-    if let Some(port) = owns {
-        spec = spec.owns(port);
-    }
     if let Some(port) = uses {
         spec = spec.uses(port);
     }
@@ -152,9 +143,8 @@ fn the_cell_draws_its_tree_with_vertical_and_horizontal_links() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         let declare = |port: &str, owner: &str| {
-            Port::<(), (), usage::Receive>::declare(
-                PortSpec::new(port, owner).clock(cell.clock().clone()),
-            )
+            let port: Port<(), (), usage::Receive> = cell.port(PortSpec::new(port, owner)).unwrap();
+            port
         };
         // LOADER costarts two cards; each card asks LOADER (vertical), CARD2 asks CARD1, its
         // sibling (horizontal), and GATE, another branch, asks CARD2 (horizontal).
@@ -163,29 +153,24 @@ fn the_cell_draws_its_tree_with_vertical_and_horizontal_links() {
         let share = declare("SHARE", "CARD1");
         let pass = declare("PASS", "CARD2");
         let (card1, card2) = (
-            idle("CARD1", Some(&share), Some(&load)),
-            idle("CARD2", Some(&pass), Some(&share)).uses(&load2),
+            idle("CARD1", Some(&load)),
+            idle("CARD2", Some(&share)).uses(&load2),
         );
         let children = Arc::new(Mutex::new(Some((card1, card2))));
-        let loader =
-            ModuleSpec::new("LOADER", ())
-                .owns(&load)
-                .owns(&load2)
-                .task("LOADER", move |ctx| {
-                    let children = Arc::clone(&children);
-                    async move {
-                        let (card1, card2) =
-                            children.lock().unwrap().take().ok_or("started twice")?;
-                        ctx.costart(card1)?;
-                        ctx.costart(card2)?;
-                        loop {
-                            ctx.delay(secs(1)).await;
-                        }
-                    }
-                });
+        let loader = ModuleSpec::new("LOADER", ()).task("LOADER", move |ctx| {
+            let children = Arc::clone(&children);
+            async move {
+                let (card1, card2) = children.lock().unwrap().take().ok_or("started twice")?;
+                ctx.costart(card1)?;
+                ctx.costart(card2)?;
+                loop {
+                    ctx.delay(secs(1)).await;
+                }
+            }
+        });
         let processor = Processor::new("CPU1");
         cell.start_on(&processor, loader.priority(2)).unwrap();
-        cell.start(idle("GATE", None, Some(&pass))).unwrap();
+        cell.start(idle("GATE", Some(&pass))).unwrap();
         drive(&clock, at(1)).await;
 
         let tree = cell.tree();

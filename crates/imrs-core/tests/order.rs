@@ -22,18 +22,19 @@ fn events_of(cell: &Cell, module: &str) -> Vec<Event> {
 fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_outrank_all() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let shared = cell.clock().clone();
         // SHARE_FEEDER1, answered by CHIP_IT's CRIT_SECTION handler. (In the Appendix CHIP_IT2
         // owns it; here CHIP_IT owns it so that four queriers can ask at overlapping times.)
-        let share_feeder1 = Port::<(), i32, usage::Response, AnyUser, 4>::declare(
-            PortSpec::new("SHARE_FEEDER1", "CHIP_IT").clock(shared.clone()),
-        );
+        let share_feeder1: Port<(), i32, usage::Response, AnyUser, 4> = cell
+            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT"))
+            .unwrap();
         // SHARE_FEEDER, owned by CHIP_IT (TIMEOUT=3 SEC); its responder never answers here.
-        let share_feeder = Port::<(), i32, usage::Query>::declare(
-            PortSpec::new("SHARE_FEEDER", "CHIP_IT")
-                .timeout(secs(3))
-                .clock(shared.clone()),
-        );
+        let share_feeder: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").owner_timeout(secs(3)))
+            .unwrap();
+        // READY_TO_CHIP, owned by CHIP_IT (TIMEOUT=60 SEC): its timeout is in the order.
+        let _ready_to_chip: Port<(), (), usage::Receive> = cell
+            .port(PortSpec::new("READY_TO_CHIP", "CHIP_IT").owner_timeout(secs(60)))
+            .unwrap();
         let _silent_chip_it2 = share_feeder
             .responder_named("CHIP_IT2", |_: &(), ()| 1)
             .unwrap();
@@ -42,13 +43,7 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
         // which times out at 15 s), INSERT 20-30 s, background again 30-40 s.
         let chip_it = ModuleSpec::new("CHIP_IT", ())
             .order(CHIP_IT_ORDER)
-            .sections(["GRASP", "INSERT"])
-            .owns("SHARE_FEEDER")
-            .owns("SHARE_FEEDER1")
-            .response(
-                "SHARE_FEEDER1.CRIT_SECTION",
-                share_feeder1.owner_responder(|_: &(), ()| 1).unwrap(),
-            )
+            .respond(&share_feeder1.handler("CRIT_SECTION"), |_: &(), ()| 1)
             .exception("SHARE_FEEDER.TIMEOUT", |ctx: Ctx<()>, _| async move {
                 ctx.alarm("SHARE_FEEDER timed out");
             })
@@ -57,14 +52,15 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
                 async move {
                     let mut share_feeder = share_feeder.owner()?;
                     ctx.delay(secs(10)).await;
-                    ctx.section("GRASP", async {
+                    ctx.section(&Section::new("GRASP"), async {
                         ctx.delay(secs(2)).await;
                         let refused = ctx.query(&mut share_feeder, ()).await;
                         assert!(refused.is_err_and(|error| error.is_timeout()));
                         ctx.delay(secs(5)).await;
                     })
                     .await;
-                    ctx.section("INSERT", ctx.delay(secs(10))).await;
+                    ctx.section(&Section::new("INSERT"), ctx.delay(secs(10)))
+                        .await;
                     ctx.delay(secs(10)).await;
                     Ok(())
                 }
@@ -151,16 +147,14 @@ fn a_let_1_go_timeout_interrupts_gates_background_which_restarts_release() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         // LET_1_GO: USAGE=SEND, #USERS=1, TIMEOUT=2 sec.
-        let let_1_go = Port::<(), i32, usage::Send>::declare(
+        let let_1_go: Port<(), i32, usage::Send> = cell.port(
             PortSpec::new("LET_1_GO", "GATE")
-                .timeout(secs(2))
-                .clock(cell.clock().clone()),
-        );
+                .owner_timeout(secs(2)),
+        ).unwrap();
         let release_port = let_1_go.clone();
         let first_copy = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
         let gate = ModuleSpec::new("GATE", 0u32)
             .order(["LET_1_GO.TIMEOUT", "GATE"])
-            .owns("LET_1_GO")
             .exception("LET_1_GO.TIMEOUT", |ctx: Ctx<u32>, _| async move {
                 // {Signal for help. Perhaps reset timer, perhaps kill and restart RELEASE}
                 ctx.alarm("RELEASE does not answer");
@@ -226,13 +220,11 @@ fn a_high_rank_handler_waiting_on_a_low_rank_task_of_its_module_is_not_blocked()
     // thread's progress, so the background task serves the handler.
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let shared = cell.clock().clone();
-        let help = Port::<&'static str, u8, usage::Send>::declare(
-            PortSpec::new("HELP", "GATE").clock(shared.clone()),
-        );
-        let dead = Port::<(), (), usage::Send>::declare(
-            PortSpec::new("DEAD", "GATE").timeout(secs(1)).clock(shared),
-        );
+        let help: Port<&'static str, u8, usage::Send> =
+            cell.port(PortSpec::new("HELP", "GATE")).unwrap();
+        let dead: Port<(), (), usage::Send> = cell
+            .port(PortSpec::new("DEAD", "GATE").owner_timeout(secs(1)))
+            .unwrap();
         let _nobody = dead.user_named("NOBODY").unwrap();
         let operator_port = help.clone();
         let gate = ModuleSpec::new("GATE", Vec::<u8>::new())

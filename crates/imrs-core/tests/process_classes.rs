@@ -16,21 +16,14 @@ use imrs_ports::{AnyUser, RealClock};
 fn independent_a_proprietor_owns_the_shared_conveyor_state() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let shared = cell.clock().clone();
         // Pallets put on (+1) or taken off (-1) the conveyor.
-        let update = Port::<i32, (), usage::Receive, AnyUser, 2>::declare(
-            PortSpec::new("UPDATE", "CONVEYOR").clock(shared.clone()),
-        );
-        let occupancy = Port::<(), i32, usage::Response>::declare(
-            PortSpec::new("OCCUPANCY", "CONVEYOR").clock(shared),
-        );
+        let update: Port<i32, (), usage::Receive, AnyUser, 2> =
+            cell.port(PortSpec::new("UPDATE", "CONVEYOR")).unwrap();
+        let occupancy: Port<(), i32, usage::Response> =
+            cell.port(PortSpec::new("OCCUPANCY", "CONVEYOR")).unwrap();
         let proprietor = ModuleSpec::new("CONVEYOR", 0i32)
-            .owns("UPDATE")
-            .owns("OCCUPANCY")
-            .response(
-                "OCCUPANCY.COUNT",
-                occupancy.owner_responder(|on: &i32, ()| *on).unwrap(),
-            )
+            .order([occupancy.handler("COUNT").name(), "CONVEYOR".into()])
+            .respond(&occupancy.handler("COUNT"), |on: &i32, ()| *on)
             .task("CONVEYOR", {
                 let update = update.clone();
                 move |ctx| {
@@ -87,13 +80,10 @@ fn independent_a_proprietor_owns_the_shared_conveyor_state() {
 fn loosely_coupled_two_robots_share_a_tool_through_a_monitor() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let shared = cell.clock().clone();
-        let take = Port::<(), (), usage::Receive, AnyUser, 2>::declare(
-            PortSpec::new("TAKE", "TOOL_CRIB").clock(shared.clone()),
-        );
-        let give_back = Port::<(), (), usage::Receive, AnyUser, 2>::declare(
-            PortSpec::new("GIVE_BACK", "TOOL_CRIB").clock(shared),
-        );
+        let take: Port<(), (), usage::Receive, AnyUser, 2> =
+            cell.port(PortSpec::new("TAKE", "TOOL_CRIB")).unwrap();
+        let give_back: Port<(), (), usage::Receive, AnyUser, 2> =
+            cell.port(PortSpec::new("GIVE_BACK", "TOOL_CRIB")).unwrap();
         let crib = ModuleSpec::new("TOOL_CRIB", ()).task("TOOL_CRIB", {
             let (take, give_back) = (take.clone(), give_back.clone());
             move |ctx| {
@@ -113,7 +103,7 @@ fn loosely_coupled_two_robots_share_a_tool_through_a_monitor() {
         let robot = |name: &'static str, work: u64| {
             let (take, give_back) = (take.clone(), give_back.clone());
             ModuleSpec::new(name, ())
-                .sections(["USE_TOOL"])
+                .order(["USE_TOOL", name])
                 .task(name, move |ctx| {
                     let (take, give_back) = (take.clone(), give_back.clone());
                     async move {
@@ -121,7 +111,8 @@ fn loosely_coupled_two_robots_share_a_tool_through_a_monitor() {
                             (take.user_named(name)?, give_back.user_named(name)?);
                         for _ in 0..4 {
                             ctx.send(&mut take, ()).await?;
-                            ctx.section("USE_TOOL", ctx.delay(secs(work))).await;
+                            ctx.section(&Section::new("USE_TOOL"), ctx.delay(secs(work)))
+                                .await;
                             ctx.send(&mut give_back, ()).await?;
                             ctx.delay(secs(1)).await;
                         }
@@ -209,25 +200,26 @@ fn tightly_coupled_a_parent_directs_its_child_through_a_tight_port() {
 fn serialized_motion_a_send_releases_the_next_step() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let card_in_place = Port::<(), i32, usage::Send>::declare(
-            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
-        );
+        let card_in_place: Port<(), i32, usage::Send> = cell
+            .port(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"))
+            .unwrap();
         let load_card = ModuleSpec::new("LOAD_CARD", ())
-            .sections(["MOVE_CARD"])
+            .order(["MOVE_CARD", "LOAD_CARD"])
             .task("LOAD_CARD", {
                 let port = card_in_place.clone();
                 move |ctx| {
                     let port = port.clone();
                     async move {
                         let mut card_in_place = port.owner()?;
-                        ctx.section("MOVE_CARD", ctx.delay(secs(5))).await;
+                        ctx.section(&Section::new("MOVE_CARD"), ctx.delay(secs(5)))
+                            .await;
                         assert_eq!(ctx.send(&mut card_in_place, ()).await?, 0);
                         Ok(())
                     }
                 }
             });
         let screw_in_card = ModuleSpec::new("SCREW_IN_CARD", ())
-            .sections(["SCREW"])
+            .order(["SCREW", "SCREW_IN_CARD"])
             .task("SCREW_IN_CARD", {
                 let port = card_in_place.clone();
                 move |ctx| {
@@ -235,7 +227,8 @@ fn serialized_motion_a_send_releases_the_next_step() {
                     async move {
                         let mut card_in_place = port.user_named("SCREW_IN_CARD")?;
                         let ((), anchored) = ctx.receive(&mut card_in_place).await?;
-                        ctx.section("SCREW", ctx.delay(secs(3))).await;
+                        ctx.section(&Section::new("SCREW"), ctx.delay(secs(3)))
+                            .await;
                         anchored.reply(0);
                         Ok(())
                     }
@@ -274,11 +267,9 @@ fn work_coupled_a_mate_takes_over_and_nothing_is_applied_twice_or_lost() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         // UPDATES: LOAD_B receives (seq) updates; a silence of 3 s means LOAD_A is gone.
-        let updates = Port::<u32, (), usage::Receive>::declare(
-            PortSpec::new("UPDATES", "LOAD_B")
-                .timeout(secs(3))
-                .clock(cell.clock().clone()),
-        );
+        let updates: Port<u32, (), usage::Receive> = cell
+            .port(PortSpec::new("UPDATES", "LOAD_B").owner_timeout(secs(3)))
+            .unwrap();
         // The physical result: the cards loaded, in order.
         let loaded = Arc::new(Mutex::new(Vec::new()));
         const CARDS: u32 = 10;

@@ -21,9 +21,8 @@ fn feeder_and_robot(rounds: u32) -> Vec<Event> {
     paused_runtime().block_on(async move {
         let (cell, clock) = Cell::virtual_clock();
         let processor = Processor::new("CPU1");
-        let port = Port::<u32, u32, usage::Receive>::declare(
-            PortSpec::new("FEED", "FEEDER").clock(cell.clock().clone()),
-        );
+        let port: Port<u32, u32, usage::Receive> =
+            cell.port(PortSpec::new("FEED", "FEEDER")).unwrap();
         let serving = port.clone();
         let feeder = ModuleSpec::new("FEEDER", ()).task("FEEDER", move |ctx| {
             let port = serving.clone();

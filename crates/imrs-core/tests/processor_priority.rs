@@ -80,8 +80,7 @@ fn emergency_stop(estop: PortSpec) -> Stopped {
     paused_runtime().block_on(async move {
         let (cell, _clock) = Cell::virtual_clock();
         let processor = Processor::new("CPU1");
-        let estop =
-            Port::<&'static str, (), usage::Receive>::declare(estop.clock(cell.clock().clone()));
+        let estop: Port<&'static str, (), usage::Receive> = cell.port(estop).unwrap();
         let steps = Arc::new(AtomicU64::new(0));
         let halt = Arc::new(AtomicBool::new(false));
         let sent_at = Arc::new(AtomicU64::new(u64::MAX));
@@ -106,26 +105,24 @@ fn emergency_stop(estop: PortSpec) -> Stopped {
             Arc::clone(&halt),
             Arc::clone(&seen_at),
         );
-        let safety =
-            ModuleSpec::new("SAFETY", ())
-                .priority(4)
-                .owns(&estop)
-                .task("SAFETY", move |ctx| {
-                    let owner = ctx.owner(&port);
-                    let (steps, halt, seen) = (
-                        Arc::clone(&watching),
-                        Arc::clone(&halting),
-                        Arc::clone(&seen),
-                    );
-                    async move {
-                        let mut estop = owner?;
-                        let (_why, reply) = ctx.receive(&mut estop).await?;
-                        seen.store(steps.load(Ordering::SeqCst), Ordering::SeqCst);
-                        halt.store(true, Ordering::SeqCst);
-                        reply.reply(());
-                        Ok(())
-                    }
-                });
+        let safety = ModuleSpec::new("SAFETY", ())
+            .priority(4)
+            .task("SAFETY", move |ctx| {
+                let owner = ctx.owner(&port);
+                let (steps, halt, seen) = (
+                    Arc::clone(&watching),
+                    Arc::clone(&halting),
+                    Arc::clone(&seen),
+                );
+                async move {
+                    let mut estop = owner?;
+                    let (_why, reply) = ctx.receive(&mut estop).await?;
+                    seen.store(steps.load(Ordering::SeqCst), Ordering::SeqCst);
+                    halt.store(true, Ordering::SeqCst);
+                    reply.reply(());
+                    Ok(())
+                }
+            });
         let (port, counting, sent) = (estop.clone(), Arc::clone(&steps), Arc::clone(&sent_at));
         let routine = ModuleSpec::new("CONVEYOR", ())
             .uses(&estop)

@@ -33,15 +33,11 @@ fn run_cell(seed: u64) -> Vec<Event> {
         .unwrap();
     runtime.block_on(async move {
         let (cell, clock) = Cell::virtual_clock();
-        let shared = cell.clock().clone();
-        let parts = Port::<u32, i32, usage::Receive>::declare(
-            PortSpec::new("PARTS", "ROBOT").clock(shared.clone()),
-        );
-        let inspect = Port::<u32, bool, usage::Query>::declare(
-            PortSpec::new("INSPECT", "ROBOT")
-                .timeout(Duration::from_millis(700))
-                .clock(shared),
-        );
+        let parts: Port<u32, i32, usage::Receive> =
+            cell.port(PortSpec::new("PARTS", "ROBOT")).unwrap();
+        let inspect: Port<u32, bool, usage::Query> = cell
+            .port(PortSpec::new("INSPECT", "ROBOT").owner_timeout(Duration::from_millis(700)))
+            .unwrap();
         let rng = Rng(seed.max(1));
 
         let feeder_rng = rng.clone();
@@ -62,18 +58,15 @@ fn run_cell(seed: u64) -> Vec<Event> {
         let inspector = ModuleSpec::new("INSPECTOR", 0u32)
             // A check waits while the inspector measures: long measurements time queries out.
             .order(["MEASURE", "INSPECT.CHECK", "INSPECTOR"])
-            .sections(["MEASURE"])
-            .response(
-                "INSPECT.CHECK",
-                inspect
-                    .responder_named("INSPECTOR", |_: &u32, part: u32| part % 7 != 3)
-                    .unwrap(),
-            )
+            .respond(&inspect.handler("CHECK"), |_: &u32, part: u32| {
+                part % 7 != 3
+            })
             .task("INSPECTOR", move |ctx| {
                 let mut rng = Rng(inspector_rng.next());
                 async move {
                     loop {
-                        ctx.section("MEASURE", ctx.delay(rng.millis(1_500))).await;
+                        ctx.section(&Section::new("MEASURE"), ctx.delay(rng.millis(1_500)))
+                            .await;
                         ctx.state().update(|measured| *measured += 1);
                         ctx.delay(Duration::from_millis(300)).await;
                     }
@@ -83,9 +76,6 @@ fn run_cell(seed: u64) -> Vec<Event> {
         let mut robot_rng = Rng(rng.clone().next().rotate_left(7));
         let robot = ModuleSpec::new("ROBOT", 0u32)
             .order(["INSPECT.TIMEOUT", "ROBOT", "INSERT"])
-            .sections(["INSERT"])
-            .owns("PARTS")
-            .owns("INSPECT")
             .exception("INSPECT.TIMEOUT", |ctx: Ctx<u32>, _| async move {
                 ctx.alarm("inspector slow");
             })
@@ -99,7 +89,8 @@ fn run_cell(seed: u64) -> Vec<Event> {
                         let (part, reply) = ctx.receive(&mut parts).await?;
                         let good = ctx.query(&mut inspect, part).await.unwrap_or(false);
                         if good {
-                            ctx.section("INSERT", ctx.delay(insert_time)).await;
+                            ctx.section(&Section::new("INSERT"), ctx.delay(insert_time))
+                                .await;
                             ctx.state().update(|inserted| *inserted += 1);
                         }
                         reply.reply(i32::from(!good));

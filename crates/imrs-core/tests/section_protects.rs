@@ -79,24 +79,18 @@ fn all_finished(askers: &[ModuleHandle]) {
 fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_background() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let status = Port::<(), (u32, u32), usage::Response, AnyUser, 8>::declare(
-            PortSpec::new("B_STATUS", "WELDER_B").clock(cell.clock().clone()),
-        );
+        let status: Port<(), (u32, u32), usage::Response, AnyUser, 8> =
+            cell.port(PortSpec::new("B_STATUS", "WELDER_B")).unwrap();
         let welder = ModuleSpec::new("WELDER_B", Welder::default())
             .order(["WELD", "B_STATUS.STATUS", "WELDER_B"])
-            .sections(["WELD"])
-            .owns("B_STATUS")
-            .response(
-                "B_STATUS.STATUS",
-                status
-                    .owner_responder(|welder: &Welder, ()| (welder.started, welder.finished))
-                    .unwrap(),
-            )
+            .respond(&status.handler("STATUS"), |welder: &Welder, ()| {
+                (welder.started, welder.finished)
+            })
             // Background 0-5 s, WELD 5-15 s, background 15-20 s, WELD 20-30 s, ... until 45 s.
             .task("WELDER_B", |ctx| async move {
                 for _ in 0..3 {
                     ctx.delay(secs(5)).await;
-                    ctx.section("WELD", async {
+                    ctx.section(&Section::new("WELD"), async {
                         ctx.state().update(|welder| welder.started += 1);
                         ctx.delay(secs(10)).await;
                         ctx.state().update(|welder| welder.finished += 1);
@@ -140,23 +134,27 @@ fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_backg
 fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_freeze_card_runs() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let share_feeder1 = Port::<(), i32, usage::Response, AnyUser, 8>::declare(
-            PortSpec::new("SHARE_FEEDER1", "CHIP_IT").clock(cell.clock().clone()),
-        );
+        let share_feeder1: Port<(), i32, usage::Response, AnyUser, 8> = cell
+            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT"))
+            .unwrap();
+        // The ports whose timeouts CHIP_IT's order ranks; nobody else uses them here.
+        let _ready_to_chip: Port<(), (), usage::Receive> = cell
+            .port(PortSpec::new("READY_TO_CHIP", "CHIP_IT").owner_timeout(secs(60)))
+            .unwrap();
+        let _share_feeder: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").owner_timeout(secs(3)))
+            .unwrap();
         let chip_it = ModuleSpec::new("CHIP_IT", ())
             .order(CHIP_IT_ORDER)
-            .sections(["GRASP", "INSERT"])
-            .owns("SHARE_FEEDER1")
-            .response(
-                "SHARE_FEEDER1.CRIT_SECTION",
-                share_feeder1.owner_responder(|_: &(), ()| 0).unwrap(),
-            )
+            .respond(&share_feeder1.handler("CRIT_SECTION"), |_: &(), ()| 0)
             // Background 0-10 s, GRASP 10-20 s, INSERT 20-30 s, twice, then done at 60 s.
             .task("CHIP_IT", |ctx| async move {
                 for _ in 0..2 {
                     ctx.delay(secs(10)).await;
-                    ctx.section("GRASP", ctx.delay(secs(10))).await;
-                    ctx.section("INSERT", ctx.delay(secs(10))).await;
+                    ctx.section(&Section::new("GRASP"), ctx.delay(secs(10)))
+                        .await;
+                    ctx.section(&Section::new("INSERT"), ctx.delay(secs(10)))
+                        .await;
                 }
                 Ok(())
             })

@@ -27,9 +27,9 @@ fn a_module_killed_mid_rendezvous_fails_its_users_and_its_copy_serves_them_after
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
         // SCREW_IN_CARD's port: LOAD_CARD sends a card, the screwer replies when done.
-        let card_in_place = Port::<u32, i32, usage::Send>::declare(
-            PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").clock(cell.clock().clone()),
-        );
+        let card_in_place: Port<u32, i32, usage::Send> = cell
+            .port(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"))
+            .unwrap();
         let copies = Arc::new(AtomicU32::new(0));
         let screwer_port = card_in_place.clone();
         let screwer_copies = Arc::clone(&copies);
@@ -181,11 +181,9 @@ fn a_panicking_task_is_reported_with_module_and_task_names_and_raises_its_except
 fn costarted_children_run_under_their_parent_and_answer_its_queries() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let ask_child2 = Port::<(), i32, usage::Query>::declare(
-            PortSpec::new("ASK_CHILD2", "LOAD_IT")
-                .timeout(secs(2))
-                .clock(cell.clock().clone()),
-        );
+        let ask_child2: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("ASK_CHILD2", "LOAD_IT").owner_timeout(secs(2)))
+            .unwrap();
         let results = Arc::new(std::sync::Mutex::new(Vec::new()));
         let seen = Arc::clone(&results);
         let load_it = ModuleSpec::new("LOAD_IT", ()).task("LOAD_IT", move |ctx| {
@@ -193,10 +191,7 @@ fn costarted_children_run_under_their_parent_and_answer_its_queries() {
             async move {
                 let child = ModuleSpec::new("SCREW_IN_CARD", ())
                     .order(["ASK_CHILD2.STATUS", "SCREW_IN_CARD"])
-                    .response(
-                        "ASK_CHILD2.STATUS",
-                        port.responder_named("SCREW_IN_CARD", |_: &(), ()| 0)?,
-                    )
+                    .respond(&port.handler("STATUS"), |_: &(), ()| 0)
                     .task("SCREW_IN_CARD", |ctx| async move {
                         ctx.delay(secs(100)).await;
                         Ok(())

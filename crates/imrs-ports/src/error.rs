@@ -196,6 +196,21 @@ pub enum WireError {
         /// The user's request and reply types.
         used: String,
     },
+    /// A module attached the owner end of a port that another module owns.
+    NotOwner {
+        /// The port.
+        port: Name,
+        /// The module that tried.
+        module: Name,
+        /// The port's owner.
+        owner: Name,
+    },
+    /// The port runs its timeouts on another clock than the cell it is declared to: on a
+    /// virtual clock, its timeouts would never fire (or fire in wall time).
+    OtherClock {
+        /// The port.
+        port: Name,
+    },
 }
 
 impl<T> SendError<T> {
@@ -446,6 +461,19 @@ impl fmt::Display for WireError {
             } => write!(
                 f,
                 "module {module} uses port {port} as {used}, but it is declared as {declared}"
+            ),
+            Self::NotOwner {
+                port,
+                module,
+                owner,
+            } => write!(
+                f,
+                "module {module} attached the owner end of port {port}, which {owner} owns"
+            ),
+            Self::OtherClock { port } => write!(
+                f,
+                "port {port} runs on another clock than its cell: make it with `Cell::port`, \
+                 which gives it the cell's clock"
             ),
         }
     }

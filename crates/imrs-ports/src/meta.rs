@@ -24,7 +24,10 @@ pub(crate) struct PortMeta {
     /// The port was declared with a typed user list and a named one: refused on every
     /// attach and by the wiring, never resolved silently.
     pub(crate) two_user_lists: bool,
+    /// Bounds the owner's end.
     pub(crate) timeout: Option<Duration>,
+    /// Bounds every user's end.
+    pub(crate) user_timeout: Option<Duration>,
     pub(crate) priority: Priority,
     pub(crate) process_type: ProcessType,
 }

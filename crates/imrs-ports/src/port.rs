@@ -31,6 +31,7 @@ pub struct PortSpec {
     name: Name,
     owner: Name,
     timeout: Option<Duration>,
+    user_timeout: Option<Duration>,
     priority: Priority,
     process_type: ProcessType,
     user_list: Option<Vec<Name>>,
@@ -44,6 +45,7 @@ impl PortSpec {
             name: name.into(),
             owner: owner.into(),
             timeout: None,
+            user_timeout: None,
             priority: Priority::DEFAULT,
             process_type: ProcessType::default(),
             user_list: None,
@@ -51,9 +53,21 @@ impl PortSpec {
         }
     }
 
-    /// `TIMEOUT=`: the owner end's primitives fail with a timeout after `timeout`.
-    pub fn timeout(mut self, timeout: Duration) -> Self {
+    /// `PORT ... TIMEOUT=`: bounds the **owner's** end only. Each wait of the owner's
+    /// primitives (send, receive, query, sendall, callall, answering) fails with a timeout
+    /// after `timeout`; the users' ends are not bounded by it (see
+    /// [`PortSpec::user_timeout`]).
+    pub fn owner_timeout(mut self, timeout: Duration) -> Self {
         self.timeout = Some(timeout);
+        self
+    }
+
+    /// `USE PORT ... TIMEOUT=`: bounds **every user's** end. Each wait of a user's
+    /// primitives fails with a timeout after `timeout`; the owner's end is not bounded by it
+    /// (see [`PortSpec::owner_timeout`]). One end may still set its own with
+    /// [`End::with_timeout`](crate::End::with_timeout).
+    pub fn user_timeout(mut self, timeout: Duration) -> Self {
+        self.user_timeout = Some(timeout);
         self
     }
 
@@ -97,6 +111,7 @@ impl PortSpec {
 
     pub(crate) fn with_timeout_of(mut self, other: &PortSpec) -> Self {
         self.timeout = other.timeout;
+        self.user_timeout = other.user_timeout;
         self
     }
 
@@ -107,7 +122,13 @@ impl PortSpec {
 
     pub(crate) fn without_timeout(mut self) -> Self {
         self.timeout = None;
+        self.user_timeout = None;
         self
+    }
+
+    /// The clock the spec names, if it names one.
+    pub fn clock_of(&self) -> Option<&SharedClock> {
+        self.clock.as_ref()
     }
 }
 
@@ -157,6 +178,7 @@ where
             user_list,
             two_user_lists,
             timeout: spec.timeout,
+            user_timeout: spec.user_timeout,
             priority: spec.priority,
             process_type: spec.process_type,
         };
@@ -233,6 +255,11 @@ where
         &self.core.meta.name
     }
 
+    /// The clock the port's timeouts run on.
+    pub fn clock(&self) -> &SharedClock {
+        &self.core.clock
+    }
+
     /// The owning module's name.
     pub fn owner_module(&self) -> &Name {
         &self.core.meta.owner
@@ -243,11 +270,16 @@ where
         self.core.meta.process_type
     }
 
-    /// The name of this port's handler or exception `what`: `PORT.what`, as an order names
-    /// it (`ask_child1.handler("STATUS")` is `"ASK_CHILD1.STATUS"`, `.handler("TIMEOUT")`
-    /// its timeout). Built from the port, so it cannot name another one by a typo.
-    pub fn handler(&self, what: &str) -> Name {
-        Name::from(format!("{}.{what}", self.core.meta.name))
+    /// This port's handler or exception `what`: `PORT.what`, as an order names it
+    /// (`ask_child1.handler("STATUS")` is `ASK_CHILD1.STATUS`, `.handler("TIMEOUT")` its
+    /// timeout). Make it once, and use the value wherever the handler is meant — the
+    /// module's order, the handler itself — so that it cannot name another port, or another
+    /// handler, by a typo.
+    pub fn handler(&self, what: &str) -> Handler<Req, Rep, U, L, N> {
+        Handler {
+            name: Name::from(format!("{}.{what}", self.core.meta.name)),
+            port: self.clone(),
+        }
     }
 
     /// The usage of this port's owner end.
@@ -390,9 +422,55 @@ where
 }
 
 impl<Req, Rep, U: Usage, L: UserList, const N: usize> From<&Port<Req, Rep, U, L, N>> for Name {
-    /// The port's name: `.owns(&port)` names a port through its declaration.
+    /// The port's name: a port is named through its declaration.
     fn from(port: &Port<Req, Rep, U, L, N>) -> Self {
         port.core.meta.name.clone()
+    }
+}
+
+/// A handler of a port, `PORT.what`: a response handler, or an exception such as the
+/// port's `TIMEOUT`. Made by [`Port::handler`]; the order ranks it by its name.
+pub struct Handler<Req, Rep, U: Usage, L: UserList = AnyUser, const N: usize = 1> {
+    name: Name,
+    port: Port<Req, Rep, U, L, N>,
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> Handler<Req, Rep, U, L, N> {
+    /// `PORT.what`, as an order names it.
+    pub fn name(&self) -> Name {
+        self.name.clone()
+    }
+
+    /// The port it handles.
+    pub fn port(&self) -> &Port<Req, Rep, U, L, N> {
+        &self.port
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> From<&Handler<Req, Rep, U, L, N>> for Name {
+    fn from(handler: &Handler<Req, Rep, U, L, N>) -> Self {
+        handler.name.clone()
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> From<Handler<Req, Rep, U, L, N>> for Name {
+    fn from(handler: Handler<Req, Rep, U, L, N>) -> Self {
+        handler.name
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> Clone for Handler<Req, Rep, U, L, N> {
+    fn clone(&self) -> Self {
+        Self {
+            name: self.name.clone(),
+            port: self.port.clone(),
+        }
+    }
+}
+
+impl<Req, Rep, U: Usage, L: UserList, const N: usize> fmt::Debug for Handler<Req, Rep, U, L, N> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Handler({})", self.name)
     }
 }
 
@@ -423,7 +501,7 @@ pub(crate) fn attach_user<Req: Send + 'static, Rep: Send + 'static>(
         core: Arc::clone(core),
         at: SlotId::User(index),
         module,
-        timeout: None,
+        timeout: meta.user_timeout,
         parked: false,
     })
 }
@@ -454,7 +532,8 @@ impl<Req, Rep, U: Usage, L: UserList, const N: usize> fmt::Debug for Port<Req, R
             .field("request", &type_name::<Req>())
             .field("reply", &type_name::<Rep>())
             .field("users", &N)
-            .field("timeout", &meta.timeout)
+            .field("owner_timeout", &meta.timeout)
+            .field("user_timeout", &meta.user_timeout)
             .field("priority", &meta.priority)
             .finish()
     }

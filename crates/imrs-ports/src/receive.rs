@@ -98,20 +98,22 @@ pub(crate) fn poll_take<Req, Rep>(
 /// Where a reply goes: the slot of the request it answers. Erases the request type, so that
 /// a reply handle is typed by its reply alone.
 trait ReplyTarget<Rep>: Send + Sync {
-    fn reply(&self, to: SlotId, reply: Rep);
+    fn reply(&self, to: SlotId, reply: Rep) -> Result<(), Rep>;
     fn unreplied(&self, to: SlotId);
     fn port(&self) -> &Name;
 }
 
 impl<Req: Send, Rep: Send> ReplyTarget<Rep> for Core<Req, Rep> {
-    fn reply(&self, to: SlotId, reply: Rep) {
+    fn reply(&self, to: SlotId, reply: Rep) -> Result<(), Rep> {
         // A reply is a message too: its wake is lifted to the port's priority.
+        let mut delivered = Ok(());
         wake_at(self.meta.priority, || {
             // SAFETY: a reply handle exists only for a request taken from slot `to`, and it
             // is consumed by its first answer, so this is the one answer of the server that
             // took it.
-            unsafe { self.slot(to).reply(reply) }
-        })
+            delivered = unsafe { self.slot(to).reply(reply) };
+        });
+        delivered
     }
 
     fn unreplied(&self, to: SlotId) {
@@ -121,6 +123,27 @@ impl<Req: Send, Rep: Send> ReplyTarget<Rep> for Core<Req, Rep> {
 
     fn port(&self) -> &Name {
         &self.meta.name
+    }
+}
+
+/// What became of a reply ([`ReplyHandle::reply`]).
+///
+/// Not `must_use`: most replies need no follow-up, and a late one is also in the sender's
+/// own error ([`SendError::Timeout`](crate::SendError::Timeout)). A replier whose reply
+/// carries something that must not be lost (a granted resource) looks.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Replied<Rep> {
+    /// The sender was still waiting, and has the reply.
+    Delivered,
+    /// The sender had given up (timed out, or its module died): nobody reads this reply,
+    /// which is handed back.
+    Late(Rep),
+}
+
+impl<Rep> Replied<Rep> {
+    /// Whether the sender got the reply.
+    pub fn is_delivered(&self) -> bool {
+        matches!(self, Self::Delivered)
     }
 }
 
@@ -145,9 +168,18 @@ impl<Rep: Send + 'static> ReplyHandle<Rep> {
     }
 
     /// `REPLY`: answers the sender and unblocks it. Never blocks.
-    pub fn reply(mut self, reply: Rep) {
-        if let Some(target) = self.target.take() {
-            target.reply(self.to, reply);
+    ///
+    /// Says whether the sender got the reply: a sender that gave up first (its timeout
+    /// fired, or its module died) never reads it, and the reply comes back as
+    /// [`Replied::Late`] so that the replier can tell, and keep or undo what it did.
+    pub fn reply(mut self, reply: Rep) -> Replied<Rep> {
+        let target = self
+            .target
+            .take()
+            .expect("a reply handle holds its target until it is consumed");
+        match target.reply(self.to, reply) {
+            Ok(()) => Replied::Delivered,
+            Err(reply) => Replied::Late(reply),
         }
     }
 

@@ -131,21 +131,35 @@ impl<Req, Rep> Slot<Req, Rep> {
     /// # Safety
     ///
     /// The caller took the current request with [`Slot::take`] and has not answered it.
-    pub(crate) unsafe fn reply(&self, reply: Rep) {
+    ///
+    /// Hands the reply back if the poster had given up (timed out, or its module died):
+    /// nobody would read it, and the server is told so.
+    pub(crate) unsafe fn reply(&self, reply: Rep) -> Result<(), Rep> {
         // SAFETY: while TAKEN or ABANDONED the reply cell belongs to the server (the poster
         // reads it only in REPLIED), and the caller is that server.
         self.reply.with_mut(|cell| unsafe { (*cell).write(reply) });
-        if let Err(state) =
-            self.state
+        let late =
+            match self
+                .state
                 .compare_exchange(TAKEN, REPLIED, Ordering::AcqRel, Ordering::Acquire)
-        {
-            debug_assert_eq!(state, ABANDONED);
-            // SAFETY: the poster gave up, so nobody will read the reply written just above.
-            self.reply
-                .with_mut(|cell| unsafe { (*cell).assume_init_drop() });
-            self.state.store(EMPTY, Ordering::Release);
-        }
+            {
+                Ok(_) => None,
+                Err(state) => {
+                    debug_assert_eq!(state, ABANDONED);
+                    // SAFETY: the poster gave up, so nobody will read the reply written just
+                    // above: it is taken back, once, before the slot is emptied.
+                    let late = self
+                        .reply
+                        .with_mut(|cell| unsafe { (*cell).assume_init_read() });
+                    self.state.store(EMPTY, Ordering::Release);
+                    Some(late)
+                }
+            };
         self.poster.wake();
+        match late {
+            None => Ok(()),
+            Some(reply) => Err(reply),
+        }
     }
 
     /// Server: drops the request it took without answering, so its poster is not left hanging.

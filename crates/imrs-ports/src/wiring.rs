@@ -174,7 +174,8 @@ impl Wiring {
             reply,
             request_size,
             reply_size,
-            timeout: meta.timeout,
+            owner_timeout: meta.timeout,
+            user_timeout: meta.user_timeout,
             priority: meta.priority,
         })
     }
@@ -277,8 +278,14 @@ pub struct PortInfo {
     pub request_size: usize,
     /// The reply type's size in memory, in bytes.
     pub reply_size: usize,
-    /// The port's `TIMEOUT`, if it has one.
-    pub timeout: Option<std::time::Duration>,
+    /// The timeout that bounds the owner's end ([`PortSpec::owner_timeout`]), if any.
+    ///
+    /// [`PortSpec::owner_timeout`]: crate::PortSpec::owner_timeout
+    pub owner_timeout: Option<std::time::Duration>,
+    /// The timeout that bounds each user's end ([`PortSpec::user_timeout`]), if any.
+    ///
+    /// [`PortSpec::user_timeout`]: crate::PortSpec::user_timeout
+    pub user_timeout: Option<std::time::Duration>,
     /// The port's priority.
     pub priority: crate::Priority,
 }

@@ -47,7 +47,7 @@ fn a_reply_reaches_the_waiting_poster() {
             thread::spawn(move || {
                 let request = take_eventually(&slot);
                 // SAFETY: this thread took the request and answers it once.
-                unsafe { slot.reply(counted(request.0 + 1, &live)) };
+                let _ = unsafe { slot.reply(counted(request.0 + 1, &live)) };
             })
         };
         // SAFETY: this thread is the slot's only poster.
@@ -108,7 +108,7 @@ fn a_withdrawal_racing_a_take_and_reply_loses_and_duplicates_nothing() {
                     return false;
                 };
                 // SAFETY: this thread took the request and answers it once.
-                unsafe { slot.reply(counted(request.0 * 10, &live)) };
+                let _ = unsafe { slot.reply(counted(request.0 * 10, &live)) };
                 true
             })
         };

@@ -60,7 +60,7 @@ fn a_timed_rendezvous_on_the_real_clock_allocates_nothing() {
     // Timeouts on both ends. They never fire (the round trips complete at once); their
     // timers live inline in the send and receive futures.
     let hour = Duration::from_secs(3600);
-    let spec = PortSpec::new("P", "OWNER").timeout(hour);
+    let spec = PortSpec::new("P", "OWNER").owner_timeout(hour);
     let allocated = allocations_per_round_trips(spec, Some(hour), 100, 1_000);
     assert_eq!(allocated, 0, "allocations in 1000 timed round trips");
 }

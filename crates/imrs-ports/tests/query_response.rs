@@ -121,7 +121,7 @@ fn a_query_times_out_and_hands_the_query_back() {
         let port = Port::<u8, i32, usage::Query>::declare(
             PortSpec::new("SHARE_FEEDER", "CHIP_IT")
                 .user_list(["CHIP_IT2"])
-                .timeout(Duration::from_secs(3))
+                .owner_timeout(Duration::from_secs(3))
                 .clock(shared),
         );
         let mut chip_it = port.owner().unwrap();

@@ -65,7 +65,7 @@ fn send_all_times_out_when_nobody_answers() {
         let (clock, shared) = virtual_clock();
         let port = Stop::declare(
             PortSpec::new("STOP", "SUPERVISOR")
-                .timeout(Duration::from_secs(1))
+                .owner_timeout(Duration::from_secs(1))
                 .clock(shared),
         );
         let mut supervisor = port.owner().unwrap();

@@ -97,7 +97,7 @@ fn a_send_times_out_on_the_virtual_clock_and_hands_the_message_back() {
         // LET_1_GO with TIMEOUT=2 sec, and nobody receiving.
         let port = Port::<&str, i32, usage::Send>::declare(
             PortSpec::new("LET_1_GO", "GATE")
-                .timeout(Duration::from_secs(2))
+                .owner_timeout(Duration::from_secs(2))
                 .clock(shared),
         );
         let mut gate = port.owner().unwrap();
@@ -165,7 +165,7 @@ fn a_receive_times_out() {
         // PALLET_IN_PLACE: TIMEOUT=30 SEC, USAGE=RECEIVE, #USERS=1.
         let port = Port::<(), (), usage::Receive>::declare(
             PortSpec::new("PALLET_IN_PLACE", "LOAD_CARD")
-                .timeout(Duration::from_secs(30))
+                .owner_timeout(Duration::from_secs(30))
                 .clock(shared),
         );
         let mut load_card = port.owner().unwrap();
@@ -266,7 +266,7 @@ fn a_tight_port_round_trips_across_threads() {
 fn an_endless_timeout_on_the_real_clock_is_no_overflow() {
     on_both_runtimes(|| async {
         let port = Port::<u8, u8, usage::Receive>::declare(
-            PortSpec::new("P", "OWNER").timeout(Duration::MAX),
+            PortSpec::new("P", "OWNER").owner_timeout(Duration::MAX),
         );
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap().with_timeout(Duration::MAX);

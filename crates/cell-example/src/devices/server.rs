@@ -50,7 +50,6 @@ pub fn world(ports: &DevicePorts, sim: &Sim) -> ModuleSpec<()> {
     let devices = Devices::Local(sim.clone());
     let mut spec = ModuleSpec::new(WORLD, ());
     for (device, port) in &ports.ports {
-        spec = spec.owns(port);
         let (device, port, devices) = (*device, port.clone(), devices.clone());
         spec = spec.task(device.port(), move |ctx| {
             let (port, devices) = (port.clone(), devices.clone());

@@ -162,7 +162,7 @@ pub fn report(
                 stations,
                 one_way,
                 round_trip: 2 * one_way,
-                timeout: port.timeout,
+                timeout: port.owner_timeout,
             }
         })
         .collect())

@@ -57,42 +57,40 @@ pub(super) fn scheduler(
 ) -> ModuleSpec<()> {
     let port = port.clone();
     let run = Arc::new(Mutex::new((dispatch, policy)));
-    ModuleSpec::new(SCHEDULER, ())
-        .owns(&port)
-        .task(SCHEDULER, move |ctx| {
-            let (port, run, done) = (port.clone(), Arc::clone(&run), Arc::clone(&done));
-            async move {
-                let mut jobs = port.owner()?;
-                loop {
-                    let ((robot, finished), reply) = jobs.receive().await?;
-                    let now = ctx.now();
-                    let seconds = now.since_start().as_secs_f64();
-                    let mut run = lock(&run);
-                    let (dispatch, policy) = &mut *run;
-                    if let Some((unit, task)) = finished
-                        && dispatch.finished(robot, unit, task, seconds)
-                    {
-                        lock(&done).push(now);
-                    }
-                    // A refused choice leaves the arm without work this time; it asks again.
-                    let job = dispatch
-                        .next(robot, seconds, policy.as_mut())
-                        .ok()
-                        .flatten()
-                        .map(|(unit, task, _)| {
-                            let cell = dispatch.cell();
-                            let spec = &cell.tasks[task];
-                            Job {
-                                unit,
-                                task,
-                                at: spec.at.map(|x| x as f32),
-                                work: Duration::from_secs_f64(spec.work / cell.robots[robot].speed),
-                                tool: super::layout::needs_tool(spec),
-                            }
-                        });
-                    drop(run);
-                    reply.reply(job);
+    ModuleSpec::new(SCHEDULER, ()).task(SCHEDULER, move |ctx| {
+        let (port, run, done) = (port.clone(), Arc::clone(&run), Arc::clone(&done));
+        async move {
+            let mut jobs = port.owner()?;
+            loop {
+                let ((robot, finished), reply) = jobs.receive().await?;
+                let now = ctx.now();
+                let seconds = now.since_start().as_secs_f64();
+                let mut run = lock(&run);
+                let (dispatch, policy) = &mut *run;
+                if let Some((unit, task)) = finished
+                    && dispatch.finished(robot, unit, task, seconds)
+                {
+                    lock(&done).push(now);
                 }
+                // A refused choice leaves the arm without work this time; it asks again.
+                let job = dispatch
+                    .next(robot, seconds, policy.as_mut())
+                    .ok()
+                    .flatten()
+                    .map(|(unit, task, _)| {
+                        let cell = dispatch.cell();
+                        let spec = &cell.tasks[task];
+                        Job {
+                            unit,
+                            task,
+                            at: spec.at.map(|x| x as f32),
+                            work: Duration::from_secs_f64(spec.work / cell.robots[robot].speed),
+                            tool: super::layout::needs_tool(spec),
+                        }
+                    });
+                drop(run);
+                reply.reply(job);
             }
-        })
+        }
+    })
 }

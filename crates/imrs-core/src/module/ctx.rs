@@ -21,10 +21,10 @@ use tracing::Instrument;
 
 use super::spec::ModuleSpec;
 use crate::cell::{CellShared, Children, ModuleHandle, spawn_module};
-use crate::check::CellError;
+use crate::check::CellErrors;
 use crate::event::{Event, EventKind, Observed, Primitive};
 use crate::exception::Exception;
-use crate::order::{Order, Rank};
+use crate::order::{Order, Rank, Section};
 use crate::supervision::RestartPolicy;
 use crate::waitfor::{Pool, WaitFor, WaitForError};
 use crate::work::{Performed, WorkSchedule};
@@ -243,6 +243,13 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         U: Usage + Plain,
         L: UserList,
     {
+        if port.owner_module() != &self.module.name {
+            return Err(WireError::NotOwner {
+                port: port.name().clone(),
+                module: self.module.name.clone(),
+                owner: port.owner_module().clone(),
+            });
+        }
         port.owner()
     }
 
@@ -278,11 +285,22 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     }
 
     /// Runs `body` inside the named section: while it runs, the module's scheduler sees this
-    /// thread at the section's rank. A section the order does not name keeps the rank of the
-    /// code around it.
-    pub async fn section<F: Future>(&self, name: &str, body: F) -> F::Output {
-        let rank = self.module.order.rank_of(name);
-        let name: Name = name.into();
+    /// thread at the section's rank in the module's order.
+    ///
+    /// # Panics
+    ///
+    /// If the module's order does not rank `section`: the task fails at once, its failure
+    /// naming the module and the section, rather than run a section that protects nothing.
+    pub async fn section<F: Future>(&self, section: &Section, body: F) -> F::Output {
+        let Some(rank) = self.module.order.rank_of(section.as_str()) else {
+            panic!(
+                "module {} entered section {}, which its order does not rank",
+                self.module.name,
+                section.as_str()
+            );
+        };
+        let rank = Some(rank);
+        let name: Name = section.name();
         let _inside = SectionGuard::enter(self, name.clone(), rank);
         let span = tracing::debug_span!("section", module = %self.module.name, section = %name);
         body.instrument(span).await
@@ -495,7 +513,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     pub fn costart<C: Send + Sync + 'static>(
         &self,
         child: ModuleSpec<C>,
-    ) -> Result<ModuleHandle, CellError> {
+    ) -> Result<ModuleHandle, CellErrors> {
         let cell = Arc::clone(&self.module.cell);
         let parent = Some(self.module.name.clone());
         let handle = spawn_module(cell, parent, RestartPolicy::NEVER, child, None)?;
@@ -509,7 +527,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         &self,
         policy: RestartPolicy,
         mut factory: F,
-    ) -> Result<ModuleHandle, CellError>
+    ) -> Result<ModuleHandle, CellErrors>
     where
         C: Send + Sync + 'static,
         F: FnMut() -> ModuleSpec<C> + Send + 'static,

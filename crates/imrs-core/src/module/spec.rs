@@ -8,7 +8,9 @@ use std::pin::Pin;
 use std::sync::Arc;
 
 use imrs_ports::usage::{Answers, Usage};
-use imrs_ports::{ModuleState, Name, Port, Priority, Respond, UsageKind, UserList, WireError};
+use imrs_ports::{
+    Handler, ModuleState, Name, Port, Priority, Respond, UsageKind, UserList, WireError, Wiring,
+};
 
 use super::ctx::Ctx;
 use crate::exception::Exception;
@@ -40,9 +42,7 @@ pub struct ModuleSpec<S> {
     pub(crate) name: Name,
     pub(crate) state: Arc<ModuleState<S>>,
     pub(crate) order: Vec<Name>,
-    pub(crate) sections: Vec<Name>,
     pub(crate) hardware: Vec<Name>,
-    pub(crate) owns: Vec<Name>,
     pub(crate) uses: Vec<(Name, UsageKind)>,
     pub(crate) filters: Vec<(Name, UsageKind)>,
     pub(crate) tasks: Vec<TaskSpec<S>>,
@@ -63,9 +63,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
             name: name.into(),
             state: Arc::new(ModuleState::new(state)),
             order: Vec::new(),
-            sections: Vec::new(),
             hardware: Vec::new(),
-            owns: Vec::new(),
             uses: Vec::new(),
             filters: Vec::new(),
             tasks: Vec::new(),
@@ -82,23 +80,16 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         &self.name
     }
 
-    /// `ORDER(...)`: the module's sections, most urgent first. See [`Order`](crate::Order).
+    /// `ORDER(...)`: the module's sections, most urgent first: its handlers
+    /// ([`Port::handler`]), its named [`Section`](crate::Section)s, and its own name for its
+    /// background code. Every handler and section of the module must be in it; see
+    /// [`Order`](crate::Order).
     pub fn order<I, N>(mut self, names: I) -> Self
     where
         I: IntoIterator<Item = N>,
         N: Into<Name>,
     {
         self.order = names.into_iter().map(Into::into).collect();
-        self
-    }
-
-    /// Declares named sections (subprograms such as `GRASP` and `INSERT`).
-    pub fn sections<I, N>(mut self, names: I) -> Self
-    where
-        I: IntoIterator<Item = N>,
-        N: Into<Name>,
-    {
-        self.sections.extend(names.into_iter().map(Into::into));
         self
     }
 
@@ -125,13 +116,6 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         self
     }
 
-    /// `PORT ...`: declares that this module owns `port` — its declaration (`&port`), or
-    /// its name.
-    pub fn owns(mut self, port: impl Into<Name>) -> Self {
-        self.owns.push(port.into());
-        self
-    }
-
     /// `USE PORT ...`: declares that this module uses `port`, with the usage its type gives
     /// a user (the complement of the owner's).
     pub fn uses<Req, Rep, U, L, const N: usize>(mut self, port: &Port<Req, Rep, U, L, N>) -> Self
@@ -152,16 +136,15 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         self
     }
 
-    /// `WHEN PORT.what ==>`: a response handler on `port`, named `PORT.what` as the order
-    /// names it (build the name with [`Port::handler`]). The answering end is attached here,
-    /// for this module: the owner end of a `RESPONSE` port, or a user end of a `QUERY` or
-    /// `CALLALL` port; and the module is declared to own or use the port. An end that cannot
-    /// be attached is reported by the wiring check and refuses the module at start.
+    /// `WHEN PORT.what ==>`: the response handler `handler` (made by [`Port::handler`], and
+    /// ranked by the module's order under the same value). Its answering end is attached
+    /// here, for this module: the owner end of a `RESPONSE` port, or a user end of a `QUERY`
+    /// or `CALLALL` port, which declares that the module uses the port. An end that cannot
+    /// be attached refuses the module when it starts, by name.
     pub fn respond<Req, Rep, U, L, const N: usize>(
         mut self,
-        port: &Port<Req, Rep, U, L, N>,
-        what: &str,
-        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
+        handler: &Handler<Req, Rep, U, L, N>,
+        answer: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
     ) -> Self
     where
         Req: Send + 'static,
@@ -169,13 +152,12 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         U: Answers,
         L: UserList,
     {
-        if U::OWNER_ANSWERS {
-            self.owns.push(port.name().clone());
-        } else {
+        let port = handler.port();
+        if !U::OWNER_ANSWERS {
             self.uses.push((port.name().clone(), UsageKind::Response));
         }
-        match port.answer(self.name.clone(), handler) {
-            Ok(end) => self.responses.push((port.handler(what), Box::new(end))),
+        match port.answer(self.name.clone(), answer) {
+            Ok(end) => self.responses.push((handler.name(), Box::new(end))),
             Err(problem) => self.problems.push(problem),
         }
         self
@@ -224,17 +206,6 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         self
     }
 
-    /// `WHEN PORT.resp ==>`: a response handler, named as the order names it
-    /// (`"ASK_CHILD1.STATUS"`), on a response end built with its handler.
-    pub fn response(
-        mut self,
-        name: impl Into<Name>,
-        end: impl Respond<S> + Send + 'static,
-    ) -> Self {
-        self.responses.push((name.into(), Box::new(end)));
-        self
-    }
-
     /// `WHEN exception ==>`: an exception handler, named as the order names it
     /// (`"LET_1_GO.TIMEOUT"`, `"RELEASE.FAILED"`).
     pub fn exception<F, Fut>(mut self, name: impl Into<Name>, handler: F) -> Self
@@ -262,10 +233,22 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
     }
 
     /// Where the module sits in the cell's tree, for [`Cell::tree`](crate::Cell::tree).
-    pub(crate) fn placement(&self, parent: Option<Name>, processor: Option<Name>) -> Placement {
+    pub(crate) fn placement(
+        &self,
+        parent: Option<Name>,
+        processor: Option<Name>,
+        wiring: &Wiring,
+    ) -> Placement {
         // A response handler answers on an end the module owns or uses, so the port is
-        // already among `owns` or `uses`.
-        let filtered = self.filters.iter().map(|(port, _)| port.clone());
+        // already among the ports it owns or `uses`.
+        let owns = owned_by(wiring, &self.name);
+        // A module that filters a port it owns (its filter task) is not its own user.
+        let filtered = self
+            .filters
+            .iter()
+            .map(|(port, _)| port.clone())
+            .filter(|port| !owns.contains(port))
+            .collect::<Vec<_>>();
         Placement {
             module: TreeModule {
                 name: self.name.clone(),
@@ -273,7 +256,7 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
                 priority: self.priority,
                 processor,
             },
-            owns: self.owns.clone(),
+            owns,
             uses: self
                 .uses
                 .iter()
@@ -288,8 +271,6 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         ModuleDecl {
             name: self.name.clone(),
             order: self.order.clone(),
-            sections: self.sections.clone(),
-            owns: self.owns.clone(),
             uses: self.uses.clone(),
             filters: self.filters.clone(),
             responses: self
@@ -329,10 +310,6 @@ pub struct ModuleDecl {
     pub name: Name,
     /// Its order.
     pub order: Vec<Name>,
-    /// Its named sections.
-    pub sections: Vec<Name>,
-    /// The ports it owns.
-    pub owns: Vec<Name>,
     /// The ports it uses, with its usage.
     pub uses: Vec<(Name, UsageKind)>,
     /// The ports it filters, with the filter's usage toward the users.
@@ -346,7 +323,21 @@ pub struct ModuleDecl {
     /// The exceptions it declares it raises itself ([`ModuleSpec::raises`]).
     pub raises: Vec<Name>,
     /// The ends it could not attach when it was declared ([`ModuleSpec::respond`]).
+    /// (The ports it owns are those declared with it as their owner.)
     pub problems: Vec<WireError>,
+}
+
+/// The ports declared to `wiring` whose owner is `module`.
+pub(crate) fn owned_by(wiring: &Wiring, module: &Name) -> Vec<Name> {
+    wiring
+        .port_names()
+        .filter(|port| {
+            wiring
+                .port_info(port.as_str())
+                .is_some_and(|info| info.owner == *module)
+        })
+        .cloned()
+        .collect()
 }
 
 /// A module's state seen from outside; see [`ModuleSpec::view`].

@@ -4,7 +4,7 @@
 use std::collections::VecDeque;
 
 use super::{FilterEnds, FilteredPort};
-use crate::receive::ReplyHandle;
+use crate::receive::{Replied, ReplyHandle};
 use crate::select::{AllClosed, select, when};
 use crate::usage;
 use crate::user_list::AnyUser;
@@ -67,9 +67,17 @@ impl<T: Send + 'static, const CAP: usize> BoundedBuffer<T, CAP> {
             match event {
                 Ok(Event::FromUser(message, reply)) => {
                     self.queue.push_back(message);
-                    reply.reply(());
+                    // A user that gave up was told its message was not taken: keep it so.
+                    if let Replied::Late(()) = reply.reply(()) {
+                        self.queue.pop_back();
+                    }
                 }
-                Ok(Event::FromOwner(reply)) => reply.reply(self.queue.pop_front()),
+                Ok(Event::FromOwner(reply)) => {
+                    // An owner that gave up never reads the message: it stays first in line.
+                    if let Replied::Late(Some(message)) = reply.reply(self.queue.pop_front()) {
+                        self.queue.push_front(message);
+                    }
+                }
                 Err(AllClosed) => unreachable!("the FILTER alternative has no guard"),
             }
         }

@@ -59,13 +59,7 @@ fn chip_robot(
             "INSERT".into(),
             "BACK_OFF".into(),
         ])
-        .sections(["GRASP", "INSERT", "BACK_OFF"])
-        .owns(asks_name)
-        .uses_named(answers_name, UsageKind::Response)
-        .response(
-            crit_section,
-            answers.responder_named(name, |_: &(), ()| 1).unwrap(),
-        )
+        .respond(&answers.handler("CRIT_SECTION"), |_: &(), ()| 1)
         .task(name, move |ctx| {
             let (asks, robot) = (asks.clone(), robot.clone());
             async move {
@@ -74,18 +68,20 @@ fn chip_robot(
                     match ctx.query(&mut share_feeder, ()).await {
                         Ok(_) => break,
                         Err(error) if error.is_timeout() => {
-                            ctx.section("BACK_OFF", ctx.delay(secs(1))).await;
+                            ctx.section(&Section::new("BACK_OFF"), ctx.delay(secs(1)))
+                                .await;
                         }
                         Err(error) => return Err(error.into()),
                     }
                 }
-                ctx.section("GRASP", async {
+                ctx.section(&Section::new("GRASP"), async {
                     robot.move_to(Target::Feeder(feeder)).await?;
                     robot.grasp(feeder).await?;
                     robot.move_to(Target::Home).await
                 })
                 .await?;
-                ctx.section("INSERT", ctx.delay(secs(5))).await;
+                ctx.section(&Section::new("INSERT"), ctx.delay(secs(5)))
+                    .await;
                 Ok(())
             }
         })
@@ -111,20 +107,22 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
             timeline.record_sim(sim.log());
         }
         sim.spawn();
-        let share_feeder = Port::<(), i32, usage::Query>::declare(
-            PortSpec::new("SHARE_FEEDER", "CHIP_IT")
-                .user_list(["CHIP_IT2"])
-                .timeout(secs(3))
-                .clock(cell.clock().clone()),
-        )
-        .shown();
-        let share_feeder1 = Port::<(), i32, usage::Query>::declare(
-            PortSpec::new("SHARE_FEEDER1", "CHIP_IT2")
-                .user_list(["CHIP_IT"])
-                .timeout(secs(5))
-                .clock(cell.clock().clone()),
-        )
-        .shown();
+        let share_feeder: Port<(), i32, usage::Query> = cell
+            .port(
+                PortSpec::new("SHARE_FEEDER", "CHIP_IT")
+                    .user_list(["CHIP_IT2"])
+                    .owner_timeout(secs(3)),
+            )
+            .unwrap()
+            .shown();
+        let share_feeder1: Port<(), i32, usage::Query> = cell
+            .port(
+                PortSpec::new("SHARE_FEEDER1", "CHIP_IT2")
+                    .user_list(["CHIP_IT"])
+                    .owner_timeout(secs(5)),
+            )
+            .unwrap()
+            .shown();
         let a = chip_robot(
             Line::A,
             share_feeder.clone(),

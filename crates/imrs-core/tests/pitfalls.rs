@@ -1,0 +1,250 @@
+//! The slips a new user made that used to compile, pass the check and misbehave in silence:
+//! each now fails loudly, by name, when the cell starts (or in the task that makes it).
+
+mod common;
+
+use common::{at, paused_runtime, secs};
+use imrs_core::prelude::*;
+use imrs_core::time::drive;
+use imrs_core::{CellError, ModuleOutcome};
+use imrs_ports::{Replied, SendError, WireError};
+
+#[test]
+fn a_section_the_order_does_not_rank_fails_its_task_by_name() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        const PLACE: Section = Section::new("PLACE");
+        // A cell built from data misspells the section it enters.
+        let misspelt = Section::named("PLACEE");
+        let spec = ModuleSpec::new("PALLETIZER", ())
+            .order([PLACE.name(), "PALLETIZER".into()])
+            .task("PALLETIZER", move |ctx| {
+                let misspelt = misspelt.clone();
+                async move {
+                    ctx.section(&PLACE, ctx.delay(secs(1))).await;
+                    ctx.section(&misspelt, ctx.delay(secs(1))).await;
+                    Ok(())
+                }
+            });
+        let mut module = cell.start(spec).unwrap();
+        drive(&clock, at(5)).await;
+        let ModuleOutcome::Failed(reason) = module.finished().await else {
+            panic!("the module must fail");
+        };
+        assert!(
+            reason.contains(
+                "module PALLETIZER entered section PLACEE, which its order does not rank"
+            ),
+            "{reason}"
+        );
+    });
+}
+
+#[test]
+fn a_response_handler_left_out_of_the_order_refuses_the_module_at_start() {
+    paused_runtime().block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        let status: Port<(), u32, usage::Response> =
+            cell.port(PortSpec::new("STATUS", "PALLETIZER")).unwrap();
+        const PLACE: Section = Section::new("PLACE");
+        let spec = ModuleSpec::new("PALLETIZER", 0u32)
+            .order([PLACE.name(), "PALLETIZER".into()])
+            .respond(&status.handler("ASK"), |placed: &u32, ()| *placed)
+            .task("PALLETIZER", |_| async { Ok(()) });
+        let refused = cell.start(spec).unwrap_err();
+        assert_eq!(
+            refused.0,
+            [CellError::Unranked {
+                module: "PALLETIZER".into(),
+                handler: "STATUS.ASK".into(),
+            }]
+        );
+        assert!(refused.to_string().contains("STATUS.ASK"), "{refused}");
+    });
+}
+
+#[test]
+fn a_port_on_another_clock_is_refused_by_name() {
+    let (cell, _clock) = Cell::virtual_clock();
+    // Made outside the cell: it runs on a wall clock of its own.
+    let stray = Port::<(), (), usage::Send>::declare(PortSpec::new("STRAY", "GATE"));
+    assert_eq!(
+        cell.declare(&stray),
+        Err(WireError::OtherClock {
+            port: "STRAY".into()
+        })
+    );
+    // Made by the cell, but told to use another clock.
+    let (_other, other_clock) = Cell::virtual_clock();
+    let refused = cell
+        .port::<(), (), usage::Send, AnyUser, 1>(
+            PortSpec::new("ELSEWHERE", "GATE").clock(std::sync::Arc::new(other_clock)),
+        )
+        .unwrap_err();
+    assert_eq!(
+        refused,
+        WireError::OtherClock {
+            port: "ELSEWHERE".into()
+        }
+    );
+    assert!(
+        refused
+            .to_string()
+            .contains("port ELSEWHERE runs on another clock")
+    );
+}
+
+#[test]
+fn a_port_the_cell_makes_times_out_on_the_cells_virtual_clock() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let pick: Port<(), (), usage::Send> = cell
+            .port(PortSpec::new("PICK", "PALLETIZER").owner_timeout(secs(2)))
+            .unwrap();
+        let spec = ModuleSpec::new("PALLETIZER", ()).task("PALLETIZER", move |ctx| {
+            let pick = ctx.owner(&pick);
+            async move {
+                let mut pick = pick?;
+                // Nobody receives: five sends, five timeouts, 2 s apart on the cell's clock.
+                for n in 1..=5u64 {
+                    let failed = ctx.send(&mut pick, ()).await.unwrap_err();
+                    assert!(failed.is_timeout(), "{failed}");
+                    assert_eq!(ctx.now(), at(2 * n));
+                }
+                Ok(())
+            }
+        });
+        let mut module = cell.start(spec).unwrap();
+        drive(&clock, at(20)).await;
+        assert_eq!(module.finished().await, ModuleOutcome::Finished);
+    });
+}
+
+#[test]
+fn a_module_using_a_port_the_cell_never_declared_is_refused_at_start() {
+    paused_runtime().block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        let undeclared = Port::<(), (), usage::Send>::declare(
+            PortSpec::new("PLACE", "PALLETIZER").clock(cell.clock().clone()),
+        );
+        let spec = ModuleSpec::new("GRIPPER", ())
+            .uses(&undeclared)
+            .task("GRIPPER", |_| async { Ok(()) });
+        let refused = cell.start(spec).unwrap_err();
+        assert_eq!(
+            refused.0,
+            [CellError::UnknownPort {
+                port: "PLACE".into(),
+                module: "GRIPPER".into(),
+            }]
+        );
+        assert!(
+            refused
+                .to_string()
+                .contains("module GRIPPER names port PLACE, which is not declared"),
+            "{refused}"
+        );
+    });
+}
+
+#[test]
+fn a_module_cannot_attach_the_owner_end_of_another_modules_port() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let place: Port<(), (), usage::Send> =
+            cell.port(PortSpec::new("PLACE", "PALLETIZER")).unwrap();
+        let spec = ModuleSpec::new("GRIPPER", ()).task("GRIPPER", move |ctx| {
+            let place = ctx.owner(&place);
+            async move {
+                place?;
+                Ok(())
+            }
+        });
+        let mut module = cell.start(spec).unwrap();
+        drive(&clock, at(1)).await;
+        let ModuleOutcome::Failed(reason) = module.finished().await else {
+            panic!("the module must fail");
+        };
+        assert!(
+            reason.contains(
+                "module GRIPPER attached the owner end of port PLACE, which PALLETIZER owns"
+            ),
+            "{reason}"
+        );
+    });
+}
+
+#[test]
+fn a_reply_to_a_sender_that_timed_out_comes_back_to_the_replier() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let place: Port<u32, u32, usage::Send> = cell
+            .port(PortSpec::new("PLACE", "PALLETIZER").owner_timeout(secs(1)))
+            .unwrap();
+        let sender = place.owner().unwrap();
+        let mut receiver = place.user_named("GRIPPER").unwrap();
+        let send = tokio::spawn(async move {
+            let mut sender = sender;
+            sender.send(7).await
+        });
+        let (box_no, reply) = receiver.receive().await.unwrap();
+        // The gripper takes 3 s; the palletizer gives up after 1 s.
+        drive(&clock, at(3)).await;
+        let gave_up: SendError<u32> = send.await.unwrap().unwrap_err();
+        assert!(gave_up.is_timeout(), "{gave_up}");
+        assert_eq!(reply.reply(box_no + 1), Replied::Late(8));
+
+        // A sender still waiting gets its reply, and the replier is told so.
+        let sender = place.owner().unwrap();
+        let send = tokio::spawn(async move {
+            let mut sender = sender;
+            sender.send(1).await
+        });
+        let (box_no, reply) = receiver.receive().await.unwrap();
+        assert_eq!(reply.reply(box_no * 10), Replied::Delivered);
+        assert_eq!(send.await.unwrap().unwrap(), 10);
+    });
+}
+
+#[test]
+fn a_timeout_bounds_only_the_ends_it_is_declared_for() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        // The owner's end is bounded, the users' are not.
+        let owner_bounded: Port<(), (), usage::Response> = cell
+            .port(PortSpec::new("OWNER_BOUNDED", "CELL").owner_timeout(secs(2)))
+            .unwrap();
+        // The users' ends are bounded, the owner's is not.
+        let users_bounded: Port<(), (), usage::Response> = cell
+            .port(PortSpec::new("USERS_BOUNDED", "CELL").user_timeout(secs(2)))
+            .unwrap();
+        let mut unbounded_user = owner_bounded.user_named("ASKER").unwrap();
+        let mut bounded_user = users_bounded.user_named("ASKER").unwrap();
+        assert_eq!(unbounded_user.timeout(), None);
+        assert_eq!(bounded_user.timeout(), Some(secs(2)));
+        let ports = cell.ports();
+        let bounds: Vec<_> = ports
+            .iter()
+            .map(|port| (port.name.as_str(), port.owner_timeout, port.user_timeout))
+            .collect();
+        assert_eq!(
+            bounds,
+            [
+                ("OWNER_BOUNDED", Some(secs(2)), None),
+                ("USERS_BOUNDED", None, Some(secs(2)))
+            ]
+        );
+
+        // Nobody answers either port: the bounded query fails at 2 s, the other still waits.
+        let unbounded = tokio::spawn(async move { unbounded_user.query(()).await });
+        let bounded = tokio::spawn(async move { bounded_user.query(()).await });
+        drive(&clock, at(10)).await;
+        let failed = bounded.await.unwrap().unwrap_err();
+        assert!(failed.is_timeout(), "{failed}");
+        assert!(
+            !unbounded.is_finished(),
+            "the users' end of OWNER_BOUNDED has no timeout"
+        );
+        unbounded.abort();
+    });
+}
