@@ -50,7 +50,7 @@ pub struct CellConfig {
     /// Draw a timeline of a window of the run.
     pub timeline: Option<TimelineConfig>,
     /// Run across processes: the world in this one, each line in its own (see
-    /// [`processes`](crate::processes)).
+    /// [`processes`]).
     pub processes: bool,
     /// Across processes, how many times as fast as the wall clock the cell runs.
     pub speed: f64,

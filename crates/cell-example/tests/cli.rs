@@ -170,9 +170,11 @@ fn the_example_draws_the_appendix_module_tree() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert_eq!(output.status.code(), Some(0), "{stdout}");
     // LOAD_IT costarts its two children and asks each down the tree; the children hand the
-    // card to each other across it, and the chip robots share the feeder across lines.
+    // card to each other across it, the chip robots share the feeder across lines, and
+    // LOAD_IT sends its cycle times to GATE through FREQUENCY, across the tree.
     for line in [
-        "├─ LOAD_IT  [2 vertical, 0 horizontal]",
+        "├─ LOAD_IT  [2 vertical, 1 horizontal]",
+        "FREQUENCY        GATE <- LOAD_IT  horizontal",
         "│  ├─ LOAD_CARD  [1 vertical, 1 horizontal]",
         "│  └─ SCREW_IN_CARD  [1 vertical, 1 horizontal]",
         "ASK_CHILD1       LOAD_IT <- LOAD_CARD  vertical",

@@ -8,9 +8,11 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::usage::{Plain, Usage};
 use imrs_ports::{
-    End, FilteredPort, Instant, Name, Port, PortSpec, Presence, SharedClock, UserList,
-    VirtualClock, WireError, Wiring,
+    End, FilteredPort, Instant, Name, Port, PortSpec, SharedClock, UserList, VirtualClock,
+    WireError, Wiring,
 };
+
+use imrs_ports::transport::Presence;
 
 use crate::check::{CellError, CellErrors, check, check_module};
 use crate::deadlock::WaitGraph;

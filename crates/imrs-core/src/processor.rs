@@ -18,7 +18,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::task::{Context, Poll, Wake, Waker};
 
-use imrs_ports::{Name, Priority, urgency};
+use imrs_ports::transport::waking;
+use imrs_ports::{Name, Priority};
 use tokio::sync::{Notify, oneshot};
 
 type Job = Pin<Box<dyn Future<Output = ()> + Send>>;
@@ -115,7 +116,7 @@ impl Wake for JobWake {
     }
 
     fn wake_by_ref(self: &Arc<Self>) {
-        let lift = urgency::waking();
+        let lift = waking();
         if lift != Priority::DEFAULT {
             // Published by the store of `ready` below, which the turn takes before it
             // reads the lift.

@@ -35,9 +35,7 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
         let _ready_to_chip: Port<(), (), usage::Receive> = cell
             .port(PortSpec::new("READY_TO_CHIP", "CHIP_IT").owner_timeout(secs(60)))
             .unwrap();
-        let _silent_chip_it2 = share_feeder
-            .responder_named("CHIP_IT2", |_: &(), ()| 1)
-            .unwrap();
+        let _silent_chip_it2 = share_feeder.answer("CHIP_IT2", |_: &(), ()| 1).unwrap();
 
         // CHIP_IT's script: background 0-10 s, GRASP 10-20 s (asking SHARE_FEEDER at 12 s,
         // which times out at 15 s), INSERT 20-30 s, background again 30-40 s.

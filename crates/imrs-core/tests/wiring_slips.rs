@@ -100,9 +100,7 @@ fn a_port_with_a_typed_and_a_named_user_list_is_refused_everywhere() {
     assert_eq!(cell.declare(&status), Err(refused.clone()));
     assert_eq!(status.owner().unwrap_err(), refused);
     assert_eq!(
-        status
-            .responder_named("WELDER_A", |_: &(), ()| 0)
-            .unwrap_err(),
+        status.answer("WELDER_A", |_: &(), ()| 0).unwrap_err(),
         refused
     );
     assert_eq!(

@@ -10,7 +10,7 @@
 //! which a broadcast makes for each user): the owner's own subscription then holds the
 //! sample, so the owner's handles read it where it lies too. A message built anywhere else
 //! (the heap) is copied into a sample once, when the port hands the broadcast over
-//! ([`Port::broadcast_with`](imrs_core::imrs_ports::Port::broadcast_with)), and goes out
+//! ([`Port::broadcast_with`](imrs_core::imrs_ports::transport::PortTransport::broadcast_with)), and goes out
 //! as one built in a loan does.
 
 use std::any::Any;

@@ -5,6 +5,7 @@
 //! in the reactor's thread as the request comes, in the module's as it answers. On a TIGHT
 //! port the owner's spinning receive does the same in its turns.
 
+use imrs_core::imrs_ports::transport::{EndTransport as _, PortTransport as _};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 use std::pin::Pin;

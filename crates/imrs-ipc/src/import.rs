@@ -4,6 +4,7 @@
 //! ([`crate::dispatch`]): in the module's thread as it sends, in the reactor's as the reply
 //! comes. On a TIGHT port the user's spinning send does the same in its turns.
 
+use imrs_core::imrs_ports::transport::{EndTransport as _, PortTransport as _};
 use std::marker::PhantomData;
 use std::sync::{Arc, Mutex, Weak};
 use std::task::{Context, Poll, Waker};
@@ -161,7 +162,9 @@ pub fn import_response<Req: Wire, Rep: Wire>(
         // The handler never runs: the bridge takes each query and answers it with the
         // other process's reply.
         |local: &Port<Req, Rep, usage::Response, AnyUser, 1>| {
-            local.owner_responder(|_: &(), _: Req| Rep::default())
+            local.answer(local.owner_module().clone(), |_: &(), _: Req| {
+                Rep::default()
+            })
         },
         owner,
     )
@@ -183,7 +186,9 @@ pub fn import_response_shared<Req: Wire, Rep: Wire>(
         module,
         // The handler never runs, as for `import_response`.
         |local: &Port<Shared<Req>, Shared<Rep>, usage::Response, AnyUser, 1>| {
-            local.owner_responder(|_: &(), _: Shared<Req>| Shared::<Rep>::default())
+            local.answer(local.owner_module().clone(), |_: &(), _: Shared<Req>| {
+                Shared::<Rep>::default()
+            })
         },
         owner,
     )

@@ -47,7 +47,7 @@
 //! functions from within a runtime whose I/O driver is enabled (`enable_all`).
 //!
 //! A TIGHT port's modules spin on both sides, and the bridges' work is done in their turns
-//! ([`Pump`](imrs_core::imrs_ports::Pump)): the user's spinning send puts its request into
+//! ([`Pump`](imrs_core::imrs_ports::transport::Pump)): the user's spinning send puts its request into
 //! shared memory and reads the reply there itself, and the owner's spinning receive takes
 //! the request from shared memory and sends the reply itself, so that a round trip wakes
 //! no task and no thread. The importing process learns that the port is TIGHT when it
@@ -55,7 +55,7 @@
 //! other process while the other may be spinning too, and sends it once a message has
 //! waited a few tens of turns, or when its own wait parks, or when its bridge's task next
 //! runs; so a side that has parked is woken as on any port. The bridges'
-//! own ends park at once ([`End::park_waits`](imrs_core::imrs_ports::End::park_waits)).
+//! own ends park at once ([`End::park_waits`](imrs_core::imrs_ports::transport::EndTransport::park_waits)).
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
@@ -142,7 +142,7 @@
 //! than copying it). Every user, in any process, reads that one sample where the owner
 //! built it, and it is let go when the last handle is dropped. A broadcast built on the
 //! heap is copied into a sample once, as the port hands it over
-//! ([`Port::broadcast_with`](imrs_core::imrs_ports::Port::broadcast_with)), and goes out
+//! ([`Port::broadcast_with`](imrs_core::imrs_ports::transport::PortTransport::broadcast_with)), and goes out
 //! the same way. The user module builds its answer in a reply loan, read in place by the
 //! owner.
 //!

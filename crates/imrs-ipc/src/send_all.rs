@@ -4,6 +4,7 @@
 //! owner's process relays to it whatever that module's end of the real port receives — a
 //! message to reply to, or a query its response handler would answer.
 
+use imrs_core::imrs_ports::transport::PortTransport as _;
 use imrs_core::imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ResponseEnd, Shared, UserList, WireError, usage,
 };
@@ -175,10 +176,10 @@ fn relayed_responder<M, R, U, L, const N: usize>(
 where
     M: Send + 'static,
     R: Default + Send + 'static,
-    U: Usage<Complement = usage::Response>,
+    U: usage::Answers,
     L: UserList,
 {
-    port.responder_named(module, |_: &(), _: M| R::default())
+    port.answer(module, |_: &(), _: M| R::default())
 }
 
 /// Exports `port`, a `QUERY` port (the owner queries its users), to the other processes of

@@ -879,7 +879,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
     let mut caller = port.owner().unwrap();
     // A response handler in this process, beside two in others (which answer with 4 n).
     let mut local = port
-        .responder_named("LOCAL", |_: &(), n: Number| Number { value: 3 * n.value })
+        .answer("LOCAL", |_: &(), n: Number| Number { value: 3 * n.value })
         .unwrap();
     let answerers: Vec<Peer> = ["REMOTE_1", "REMOTE_2"]
         .iter()
@@ -1683,10 +1683,7 @@ async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_a
     let remote = Remote::new(&cell).unwrap();
     let imported =
         imrs_ipc::import_query::<Number, Number>(&remote, "ASK_STATUS", "PARENT", "CHILD").unwrap();
-    let child = imported
-        .port()
-        .responder_named("CHILD", five_times)
-        .unwrap();
+    let child = imported.port().answer("CHILD", five_times).unwrap();
     let heard = answering(child);
     answers_an_owner_killed_and_started_again(heard, first, &["parent", &cell, "ASK_STATUS", "3"])
         .await;
@@ -1699,10 +1696,7 @@ async fn an_owner_of_callalls_killed_mid_run_and_started_again_reaches_its_user_
     let remote = Remote::new(&cell).unwrap();
     let imported =
         imrs_ipc::import_call_all::<Number, Number>(&remote, "POLL", "CALLER", "ANSWERER").unwrap();
-    let answerer = imported
-        .port()
-        .responder_named("ANSWERER", five_times)
-        .unwrap();
+    let answerer = imported.port().answer("ANSWERER", five_times).unwrap();
     let heard = answering(answerer);
     answers_an_owner_killed_and_started_again(heard, first, &["caller", &cell, "POLL", "3"]).await;
 }

@@ -16,7 +16,7 @@ pub(crate) struct Attachment<Req, Rep> {
     pub(crate) at: SlotId,
     pub(crate) module: Name,
     pub(crate) timeout: Option<Duration>,
-    /// Whether this end's waits park at once ([`End::park_waits`](crate::End::park_waits)).
+    /// Whether this end's waits park at once ([`End::park_waits`](crate::transport::EndTransport::park_waits)).
     pub(crate) parked: bool,
 }
 
@@ -191,7 +191,7 @@ mod tests {
         let owner = port.owner().unwrap();
         assert!(owner.attachment.spins() > 0);
         // Set through another handle: it holds for every end, attached before or after.
-        port.clone().park_waits();
+        crate::transport::PortTransport::park_waits(&port.clone());
         let user = port.user_named("USER").unwrap();
         assert_eq!(owner.attachment.spins(), 0);
         assert_eq!(user.attachment.spins(), 0);

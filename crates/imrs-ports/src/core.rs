@@ -119,16 +119,16 @@ pub(crate) struct Core<Req, Rep> {
     /// How the port's values read in event logs, if the port says.
     pub(crate) shown: OnceLock<Shown<Req, Rep>>,
     /// Where a sender's messages are built, if a transport lends memory of its own
-    /// ([`Port::lend_with`](crate::Port::lend_with)).
+    /// ([`Port::lend_with`](crate::transport::PortTransport::lend_with)).
     pub(crate) lender: OnceLock<Lender<Req>>,
     /// Where a broadcast is moved before it is cloned for each user, if a transport says
-    /// ([`Port::broadcast_with`](crate::Port::broadcast_with)).
+    /// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
     pub(crate) handing: OnceLock<Handing<Req>>,
     /// Whether waits park at once, whatever the process type says
-    /// ([`Port::park_waits`](crate::Port::park_waits)).
+    /// ([`Port::park_waits`](crate::transport::PortTransport::park_waits)).
     pub(crate) parked: AtomicBool,
     /// The transport's turn in a spinning wait, if a transport gives one
-    /// ([`Port::pump_with`](crate::Port::pump_with)).
+    /// ([`Port::pump_with`](crate::transport::PortTransport::pump_with)).
     pub(crate) pump: OnceLock<Box<dyn Pump>>,
 }
 
@@ -191,7 +191,7 @@ impl<Req, Rep> Core<Req, Rep> {
     }
 
     /// Tells whoever serves the posts of `poster` that something arrived.
-    /// The wake is lifted to the port's priority (see [`crate::urgency`]).
+    /// The wake is lifted to the port's priority (see [`waking`](crate::transport::waking)).
     pub(crate) fn wake_servers_of(&self, poster: SlotId) {
         wake_at(self.meta.priority, || match poster {
             SlotId::User(_) => self.owner_waker.wake(),

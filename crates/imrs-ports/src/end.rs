@@ -43,10 +43,8 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> End<Req, Rep, U> {
         self.attachment.timeout
     }
 
-    /// Makes this end's waits park at once, whatever the port's process type says: for an
-    /// end a transport waits on in a task of its own, beside a module that spins on the
-    /// port's other end ([`Port::pump_with`](crate::Port::pump_with)).
-    pub fn park_waits(&mut self) {
+    /// See [`EndTransport::park_waits`](crate::transport::EndTransport::park_waits).
+    pub(crate) fn set_parked(&mut self) {
         self.attachment.parked = true;
     }
 
@@ -171,7 +169,7 @@ impl<Req, Rep, U: Usage> fmt::Debug for End<Req, Rep, U> {
 
 impl<T: Default + Send + 'static, Rep: Send + 'static, U: Usage> End<Shared<T>, Rep, U> {
     /// A message to build in place and send: in the memory the port's transport lends
-    /// ([`Port::lend_with`](crate::Port::lend_with)) — shared memory, for a port that
+    /// ([`Port::lend_with`](crate::transport::PortTransport::lend_with)) — shared memory, for a port that
     /// crosses processes — or, in one process, on the heap. It starts as `T::default()`
     /// (all zeros, for a message that crosses processes). Refused, naming the port, when the
     /// transport has no memory left: every loan and every request out.

@@ -12,8 +12,8 @@
 //! | user list | types ([`user_list!`]) or on attach ([`PortSpec::user_list`]) |
 //! | number of active users | const generic `N`, buffers sized once; a user beyond `N` is a [`WireError`] |
 //! | filter | [`FilteredPort`]; the [`BoundedBuffer`] of the seed's Appendix ships ready |
-//! | timeout | run time, on the framework [`Clock`]: a typed timeout error |
-//! | priority | run time: [`select()`] serves the highest-priority ready port, FIFO within a port; a message's wake carries its port's priority ([`urgency`]), which a processor uses to lift the module it wakes |
+//! | timeout | run time, on the framework [`Clock`], on each end it is declared for ([`PortSpec::owner_timeout`], [`PortSpec::user_timeout`]): a typed timeout error |
+//! | priority | run time: [`select()`] serves the highest-priority ready port, FIFO within a port; a message's wake carries its port's priority ([`transport::waking`]), which a processor uses to lift the module it wakes |
 //! | process type | [`ProcessType::Tight`] ports spin briefly before parking |
 //!
 //! A send, a receive and a reply between two tasks:
@@ -58,10 +58,10 @@ mod meta;
 mod name;
 mod port;
 pub mod post;
-pub mod presence;
+mod presence;
 mod priority;
 mod process_type;
-pub mod pump;
+mod pump;
 mod receive;
 mod response;
 pub mod select;
@@ -69,7 +69,8 @@ pub mod shared;
 pub mod shown;
 mod slot;
 pub mod synchronous;
-pub mod urgency;
+pub mod transport;
+mod urgency;
 pub mod usage;
 mod user_list;
 mod wiring;
@@ -81,10 +82,8 @@ pub use error::{BroadcastError, QueryError, ReceiveError, SendError, WireError};
 pub use filter::{BoundedBuffer, BoundedBufferPort, FilterEnds, FilteredPort};
 pub use meta::{Name, Named};
 pub use port::{Handler, Port, PortSpec};
-pub use presence::Presence;
 pub use priority::Priority;
 pub use process_type::ProcessType;
-pub use pump::Pump;
 pub use receive::{Receiving, Replied, ReplyHandle};
 pub use response::{ModuleState, Respond, ResponseEnd, respond_while};
 pub use select::{AllClosed, Select, select, when};

@@ -11,16 +11,13 @@ use crate::clock::{RealClock, SharedClock};
 use crate::core::{Core, SlotId, hold};
 use crate::end::End;
 use crate::error::WireError;
-use crate::loom::Ordering;
 use crate::meta::{Name, Named, PortMeta};
 use crate::presence::Presence;
 use crate::priority::Priority;
 use crate::process_type::ProcessType;
-use crate::pump::Pump;
 use crate::response::ResponseEnd;
-use crate::shared::LoanError;
 use crate::shown::Shown;
-use crate::usage::{self, Answers, Plain, Usage, UsageKind};
+use crate::usage::{Answers, Plain, Usage, UsageKind};
 use crate::user_list::{Admits, AnyUser, UserList};
 
 /// The restrictions of a port that are values rather than types: its name and owner,
@@ -189,50 +186,6 @@ where
         }
     }
 
-    /// Lends the memory the port's messages are built in: each [`End::loan`] of the port
-    /// calls `lender`. For a transport whose messages lie in memory of its own (shared
-    /// memory, across processes); without a lender, a loan is on the heap. The first lender
-    /// set holds, for every handle of the port.
-    ///
-    /// [`End::loan`]: crate::End::loan
-    pub fn lend_with(
-        self,
-        lender: impl Fn() -> Result<Req, LoanError> + Send + Sync + 'static,
-    ) -> Self {
-        let _first_holds = self.core.lender.set(Box::new(lender));
-        self
-    }
-
-    /// Hands each broadcast of the port (`SENDALL` or `CALLALL`) to its transport before
-    /// the port clones it for each user: the port clones what `hand` returns. For a
-    /// transport whose users all read one copy where it lies (shared memory, across
-    /// processes): a broadcast built elsewhere, such as the heap, is moved there once, and
-    /// every user's clone reads that one copy, rather than each being copied on its way.
-    /// The first set holds, for every handle of the port.
-    pub fn broadcast_with(self, hand: impl Fn(Req) -> Req + Send + Sync + 'static) -> Self {
-        let _first_holds = self.core.handing.set(Box::new(hand));
-        self
-    }
-
-    /// Makes every wait on the port park at once, whatever its process type says: for a
-    /// transport whose side of the rendezvous is a task on the same runtime as the module's,
-    /// which a TIGHT port's spin would keep off its worker until the spin ends. Holds for
-    /// every handle of the port.
-    pub fn park_waits(&self) {
-        self.core.parked.store(true, Ordering::Relaxed);
-    }
-
-    /// Gives `pump` a turn between the looks of each wait on the port that spins (a TIGHT
-    /// port's), in the waiting module's own thread: for a transport that can move a message
-    /// there rather than in a task of its own, which would first have to be woken. The
-    /// ends the transport itself waits on should park ([`End::park_waits`]). The first pump
-    /// set holds, for every handle of the port.
-    ///
-    /// [`End::park_waits`]: crate::End::park_waits
-    pub fn pump_with(&self, pump: impl Pump) {
-        let _first_holds = self.core.pump.set(Box::new(pump));
-    }
-
     /// Shows the port's messages and replies as `Debug` writes them, in the event log of a
     /// cell that asks for them (a recorder does; see [`shown`](crate::shown)). The first way
     /// of showing set holds, for every handle of the port.
@@ -351,52 +304,6 @@ where
     }
 }
 
-impl<Req, Rep, L, const N: usize> Port<Req, Rep, usage::Response, L, N>
-where
-    Req: Send + 'static,
-    Rep: Send + 'static,
-    L: UserList,
-{
-    /// Attaches the owner end of a `RESPONSE` port with its response handler, which reads
-    /// the module's state `S` and answers each query.
-    pub fn owner_responder<S>(
-        &self,
-        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
-    ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
-        Ok(ResponseEnd::new(self.attach_owner()?, Box::new(handler)))
-    }
-}
-
-impl<Req, Rep, U, L, const N: usize> Port<Req, Rep, U, L, N>
-where
-    Req: Send + 'static,
-    Rep: Send + 'static,
-    U: Usage<Complement = usage::Response>,
-    L: UserList,
-{
-    /// Attaches the user end of a `QUERY` (or `CALLALL`) port for module `M`, with the
-    /// response handler that answers the owner's queries from the state `S`.
-    pub fn responder<M: Named, S>(
-        &self,
-        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
-    ) -> Result<ResponseEnd<Req, Rep, S>, WireError>
-    where
-        L: Admits<M>,
-    {
-        self.responder_named(M::NAME, handler)
-    }
-
-    /// As [`Port::responder`], for a module known by name.
-    pub fn responder_named<S>(
-        &self,
-        module: impl Into<Name>,
-        handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
-    ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
-        let attachment = attach_user(&self.core, module.into())?;
-        Ok(ResponseEnd::new(attachment, Box::new(handler)))
-    }
-}
-
 impl<Req, Rep, U, L, const N: usize> Port<Req, Rep, U, L, N>
 where
     Req: Send + 'static,
@@ -405,17 +312,29 @@ where
     L: UserList,
 {
     /// Attaches the side of this port that answers queries, for module `module`, with its
-    /// response handler: the owner end of a `RESPONSE` port, or a user end of a `QUERY` or
-    /// `CALLALL` port (checked against the user list and the number of users).
+    /// response handler, which reads the module's state `S`: the owner end of a `RESPONSE`
+    /// port (refused unless `module` is its owner), or a user end of a `QUERY` or `CALLALL`
+    /// port (checked against the user list and the number of users). In a module, give the
+    /// handler to [`ModuleSpec::respond`] instead, which attaches it for the module.
+    ///
+    /// [`ModuleSpec::respond`]: https://docs.rs/imrs-core/latest/imrs_core/struct.ModuleSpec.html#method.respond
     pub fn answer<S>(
         &self,
         module: impl Into<Name>,
         handler: impl Fn(&S, Req) -> Rep + Send + Sync + 'static,
     ) -> Result<ResponseEnd<Req, Rep, S>, WireError> {
+        let module = module.into();
         let attachment = if U::OWNER_ANSWERS {
+            if module != self.core.meta.owner {
+                return Err(WireError::NotOwner {
+                    port: self.core.meta.name.clone(),
+                    module,
+                    owner: self.core.meta.owner.clone(),
+                });
+            }
             self.attach_owner()?
         } else {
-            attach_user(&self.core, module.into())?
+            attach_user(&self.core, module)?
         };
         Ok(ResponseEnd::new(attachment, Box::new(handler)))
     }

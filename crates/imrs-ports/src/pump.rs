@@ -8,7 +8,7 @@
 //! message moves with no task woken. The transport's tasks stay for the waits that park.
 
 /// What a transport does in the thread of a module whose wait on the port spins
-/// ([`Port::pump_with`](crate::Port::pump_with)).
+/// ([`Port::pump_with`](crate::transport::PortTransport::pump_with)).
 pub trait Pump: Send + Sync + 'static {
     /// A turn, between two looks of a spinning wait: moves what has arrived, either way. It
     /// must not block; a turn that finds the transport busy elsewhere skips.

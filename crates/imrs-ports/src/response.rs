@@ -26,8 +26,7 @@ type Handler<S, Req, Rep> = Box<dyn Fn(&S, Req) -> Rep + Send + Sync>;
 
 /// The end of a port that answers queries with a response handler (`USAGE=RESPONSE`).
 ///
-/// Built only together with its handler: [`Port::responder`](crate::Port::responder),
-/// [`Port::owner_responder`](crate::Port::owner_responder).
+/// Built only together with its handler: [`Port::answer`](crate::Port::answer).
 pub struct ResponseEnd<Req, Rep, S> {
     attachment: Attachment<Req, Rep>,
     handler: Handler<S, Req, Rep>,
@@ -149,7 +148,7 @@ impl<Req, Rep, S> fmt::Debug for ResponseEnd<Req, Rep, S> {
 #[diagnostic::on_unimplemented(
     message = "`{Self}` is not a response end answering from a state `{S}`",
     label = "expected an end built with its response handler",
-    note = "build one with `Port::answer`, `responder` or `owner_responder`, whose handler takes `&{S}`"
+    note = "build one with `Port::answer`, whose handler takes `&{S}`"
 )]
 pub trait Respond<S> {
     /// The port this end answers.
@@ -162,7 +161,7 @@ pub trait Respond<S> {
     /// Answers one waiting query; see [`ResponseEnd::respond`].
     fn respond(&mut self, state: &S) -> bool;
     /// Records that this end is held by the module of `presence`, for an end attached before
-    /// its module ran (see [`presence`](crate::presence)). By default, nothing.
+    /// its module ran (see [`Presence`](crate::transport::Presence)). By default, nothing.
     fn bind(&mut self, presence: &Arc<Presence>) {
         let _ = presence;
     }

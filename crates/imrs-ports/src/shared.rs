@@ -6,7 +6,7 @@
 //! sample of shared memory, which crosses to the other process with nothing copied, and is
 //! read there in place. The module's code is the same either way — where its port's memory
 //! comes from is decided when the cell is wired, by whoever lends it
-//! ([`Port::lend_with`](crate::Port::lend_with)).
+//! ([`Port::lend_with`](crate::transport::PortTransport::lend_with)).
 //!
 //! ```
 //! use imrs_ports::{Port, PortSpec, Shared, usage};

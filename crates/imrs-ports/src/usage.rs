@@ -138,7 +138,7 @@ impl CallsAll for CallAll {}
 #[diagnostic::on_unimplemented(
     message = "a `{Self}` end answers queries, so it must be built with its response handler",
     label = "this end would answer queries with no handler",
-    note = "build it with `responder(handler)` (user end) or `owner_responder(handler)` (owner end)"
+    note = "build it with `Port::answer(module, handler)`"
 )]
 pub trait Plain: Usage {}
 impl Plain for Send {}

@@ -8,7 +8,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll, Waker};
 
-use imrs_ports::{End, Port, PortSpec, ProcessType, Pump, usage};
+use imrs_ports::transport::{EndTransport as _, PortTransport as _, Pump};
+use imrs_ports::{End, Port, PortSpec, ProcessType, usage};
 
 type Doubler = Port<u64, u64, usage::Receive>;
 

@@ -38,7 +38,7 @@ fn a_parent_queries_its_child_and_the_handler_reads_the_childs_state() {
             PortSpec::new("ASK_CHILD1", "LOAD_IT"),
         );
         let mut load_it = port.owner().unwrap();
-        let mut ask_child1 = port.responder::<LoadCard, _>(status).unwrap();
+        let mut ask_child1 = port.answer(LoadCard::NAME, status).unwrap();
         let child = tokio::spawn(async move {
             let state = ModuleState::new(LoadCardState::default());
             let background = async {
@@ -76,7 +76,9 @@ fn a_parent_queries_its_child_and_the_handler_reads_the_childs_state() {
 fn the_default_hook_runs_handlers_once_the_background_is_suspended() {
     on_both_runtimes(|| async {
         let port = Port::<(), u32, usage::Response>::declare(PortSpec::new("PEEK", "ROBOT"));
-        let mut peek = port.owner_responder(|state: &u32, ()| *state).unwrap();
+        let mut peek = port
+            .answer(port.owner_module().clone(), |state: &u32, ()| *state)
+            .unwrap();
         let mut asker = port.user_named("ASKER").unwrap();
         // The query is posted before the robot's task first runs (on the current-thread
         // runtime): the hook must still let the background run to its suspension point
@@ -100,7 +102,9 @@ fn a_panicking_handler_fails_the_query_instead_of_hanging_it() {
     on_both_runtimes(|| async {
         let port = Port::<u8, u8, usage::Response>::declare(PortSpec::new("FRAGILE", "OWNER"));
         let mut fragile = port
-            .owner_responder(|_: &(), n: u8| if n == 0 { panic!("no zero") } else { n })
+            .answer(port.owner_module().clone(), |_: &(), n: u8| {
+                if n == 0 { panic!("no zero") } else { n }
+            })
             .unwrap();
         let mut asker = port.user_named("ASKER").unwrap();
         let asking = tokio::spawn(async move { asker.query(0).await });
@@ -126,7 +130,7 @@ fn a_query_times_out_and_hands_the_query_back() {
         );
         let mut chip_it = port.owner().unwrap();
         // CHIP_IT2 attached, but its handler never gets to run.
-        let _chip_it2 = port.responder_named("CHIP_IT2", |_: &(), _: u8| 1).unwrap();
+        let _chip_it2 = port.answer("CHIP_IT2", |_: &(), _: u8| 1).unwrap();
         let asking = tokio::spawn(async move { chip_it.query(4).await });
         until_sleepers(&clock, 1).await;
         clock.advance(Duration::from_secs(3));
@@ -151,7 +155,7 @@ fn call_all_returns_the_first_answer_and_keeps_the_later_ones() {
         let mut cells = Vec::new();
         for name in ["GATE", "LOAD_IT", "CHIP_IT"] {
             let end = port
-                .responder_named(name, move |_: &(), n: u8| format!("{name}:{n}"))
+                .answer(name, move |_: &(), n: u8| format!("{name}:{n}"))
                 .unwrap();
             cells.push(end);
         }
@@ -187,7 +191,9 @@ fn a_transport_takes_a_query_and_answers_it_later_or_fails_the_querier_by_droppi
         // A RESPONSE port whose answers come from elsewhere: its handler never runs.
         let port = Port::<u32, u32, usage::Response>::declare(PortSpec::new("REMOTE", "BRIDGE"));
         let mut bridge = port
-            .owner_responder(|_: &(), _: u32| unreachable!("the bridge takes every query"))
+            .answer(port.owner_module().clone(), |_: &(), _: u32| {
+                unreachable!("the bridge takes every query")
+            })
             .unwrap();
         let mut asker = port.user_named("ASKER").unwrap();
         let asking = tokio::spawn(async move {

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use imrs_ports::shared::Buffer;
+use imrs_ports::transport::PortTransport as _;
 use imrs_ports::{LoanError, Name, Port, PortSpec, Shared, usage};
 
 /// An image, too large to copy on every hop.

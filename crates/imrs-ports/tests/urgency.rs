@@ -1,12 +1,13 @@
 //! A port says, for the length of the wake its message causes, which priority it was declared
-//! with, so that an executor's waker can lift the woken task (`imrs_ports::urgency`).
+//! with, so that an executor's waker can lift the woken task (`imrs_ports::transport::waking`).
 
 use std::future::Future;
 use std::pin::pin;
 use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll, Wake, Waker};
 
-use imrs_ports::{Port, PortSpec, Priority, urgency, usage};
+use imrs_ports::transport::waking;
+use imrs_ports::{Port, PortSpec, Priority, usage};
 
 /// A waker that notes the urgency of each wake it gets.
 #[derive(Default)]
@@ -18,7 +19,7 @@ impl Wake for Noting {
     }
 
     fn wake_by_ref(self: &Arc<Self>) {
-        self.0.lock().unwrap().push(urgency::waking());
+        self.0.lock().unwrap().push(waking());
     }
 }
 
@@ -62,7 +63,7 @@ fn wakes_of_one_message(spec: PortSpec) -> (Vec<Priority>, Vec<Priority>) {
         panic!("the reply was given");
     };
     assert_eq!(answer, 8);
-    assert_eq!(urgency::waking(), Priority::DEFAULT, "no wake runs now");
+    assert_eq!(waking(), Priority::DEFAULT, "no wake runs now");
     let noted = |noting: &Noting| noting.0.lock().unwrap().clone();
     (noted(&receiver), noted(&sender))
 }

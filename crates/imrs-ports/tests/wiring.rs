@@ -33,9 +33,7 @@ fn a_user_not_on_the_list_is_refused() {
     let port = Port::<u8, i32, usage::Query>::declare(
         PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]),
     );
-    let refused = port
-        .responder_named("LOAD_IT", |_: &(), _: u8| 0)
-        .unwrap_err();
+    let refused = port.answer("LOAD_IT", |_: &(), _: u8| 0).unwrap_err();
     assert_eq!(
         refused,
         WireError::NotOnUserList {
@@ -47,7 +45,7 @@ fn a_user_not_on_the_list_is_refused() {
         refused.to_string(),
         "module LOAD_IT is not on the user list of port SHARE_FEEDER"
     );
-    port.responder_named("CHIP_IT2", |_: &(), _: u8| 1).unwrap();
+    port.answer("CHIP_IT2", |_: &(), _: u8| 1).unwrap();
 }
 
 #[test]

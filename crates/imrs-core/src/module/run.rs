@@ -24,7 +24,8 @@ use std::task::{Context, Poll, Waker};
 
 use atomic_waker::AtomicWaker;
 use imrs_ports::clock::Sleep;
-use imrs_ports::{Name, Presence, Respond};
+use imrs_ports::transport::Presence;
+use imrs_ports::{Name, Respond};
 
 use super::ctx::{Ctx, ModuleShared, SectionCell};
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};

@@ -54,7 +54,6 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::usage::Usage;
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{
     FromBytes, Remote, ZeroCopySend, export, export_call_all, export_query, export_response,
@@ -192,7 +191,7 @@ async fn inspector(cell: &str, port: &str) -> Result<(), Error> {
     let _exported = export_response_shared(&Remote::new(cell)?, &port)?;
     println!("ready");
     let factor = 5;
-    let mut inspector = port.owner_responder(inspect)?;
+    let mut inspector = port.answer(port.owner_module().clone(), inspect)?;
     loop {
         inspector.serve(&factor).await?;
     }
@@ -332,7 +331,7 @@ async fn responder(cell: &str, port: &str) -> Result<(), Error> {
     println!("ready");
     // The module's state: the factor its handler answers with.
     let factor = 3;
-    let mut responder = port.owner_responder(multiply)?;
+    let mut responder = port.answer(port.owner_module().clone(), multiply)?;
     loop {
         responder.serve(&factor).await?;
     }
@@ -386,9 +385,9 @@ async fn answer<M, U>(
 ) -> Result<(), Error>
 where
     M: Send + 'static,
-    U: Usage<Complement = usage::Response>,
+    U: usage::Answers,
 {
-    let mut answering = port.responder_named(module, handler)?;
+    let mut answering = port.answer(module, handler)?;
     for _ in 0..n.parse::<u64>()? {
         answering.serve(&factor).await?;
         println!("answered");

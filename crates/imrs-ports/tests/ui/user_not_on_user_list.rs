@@ -1,21 +1,21 @@
 use imrs_ports::{Named, Port, PortSpec, usage, user_list};
 
-struct LoadCard;
-impl Named for LoadCard {
-    const NAME: &'static str = "LOAD_CARD";
-}
 struct ScrewInCard;
 impl Named for ScrewInCard {
     const NAME: &'static str = "SCREW_IN_CARD";
 }
+struct Gate;
+impl Named for Gate {
+    const NAME: &'static str = "GATE";
+}
 
 user_list! {
-    /// ASK_CHILD1: USERLIST=(LOAD_CARD).
-    AskChild1Users = [LoadCard];
+    /// CARD_IN_PLACE: USERLIST=(SCREW_IN_CARD).
+    CardInPlaceUsers = [ScrewInCard];
 }
 
 fn main() {
-    let port = Port::<(), i32, usage::Query, AskChild1Users>::declare(PortSpec::new("ASK_CHILD1", "LOAD_IT"));
-    // SCREW_IN_CARD answers ASK_CHILD2, not ASK_CHILD1.
-    let _ = port.responder::<ScrewInCard, ()>(|_, ()| 0);
+    let port = Port::<(), i32, usage::Send, CardInPlaceUsers>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+    // GATE has no business with the card in place.
+    let _ = port.user::<Gate>();
 }
