@@ -2,8 +2,8 @@
 //! schemas that let Foxglove show the fields.
 
 use foxglove::messages::{Log, log::Level};
-use imrs_sim::imrs_core::imrs_ports::Instant;
-use imrs_sim::imrs_core::{Event, EventKind, Observed};
+use imrs_core::imrs_ports::Instant;
+use imrs_core::{Event, EventKind, Observed};
 use imrs_sim::{SimEvent, SimEventKind};
 use serde_json::{Value, json};
 

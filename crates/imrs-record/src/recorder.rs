@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
 use foxglove::{Channel, Context, McapWriter, McapWriterHandle, RawChannel, Schema};
-use imrs_sim::imrs_core::Cell;
+use imrs_core::Cell;
 use imrs_sim::{Scene, Sim};
 use serde_json::Value;
 
@@ -116,7 +116,7 @@ impl Recorder {
 
     /// Records every event of `cell` from now on: each on its port's or its module's
     /// channel, with the text of the messages and replies of the ports that show them
-    /// ([`Port::shown`](imrs_sim::imrs_core::imrs_ports::Port::shown)), how long each
+    /// ([`Port::shown`](imrs_core::imrs_ports::Port::shown)), how long each
     /// primitive waited (the recorder turns [`Cell::observe`] on), and the events an
     /// engineer should see also on `/log`.
     pub fn record_cell(&self, cell: &Cell) {

@@ -4,7 +4,7 @@
 //! cell's own clock, so that two runs of the same seed give the same timestamps.
 
 use foxglove::messages::Timestamp;
-use imrs_sim::imrs_core::imrs_ports::Instant;
+use imrs_core::imrs_ports::Instant;
 
 /// Nanoseconds since the clock's start.
 pub(crate) fn nanos(at: Instant) -> u64 {

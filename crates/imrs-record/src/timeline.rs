@@ -15,7 +15,7 @@ use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_sim::imrs_core::{Cell, EventKind};
+use imrs_core::{Cell, EventKind};
 use imrs_sim::{SimEventKind, SimLog};
 use plotters::prelude::*;
 

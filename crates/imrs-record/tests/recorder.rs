@@ -9,8 +9,8 @@ use std::collections::BTreeMap;
 
 use common::{name, run, temp};
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
+use imrs_core::EventKind;
 use imrs_record::{Recorder, read_summary};
-use imrs_sim::imrs_core::EventKind;
 use prost::Message as _;
 use serde_json::Value;
 

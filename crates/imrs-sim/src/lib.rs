@@ -60,7 +60,6 @@ pub use error::DeviceError;
 pub use event::{SimEvent, SimEventKind, SimLog};
 pub use fault::{Fault, FaultKind};
 pub use ids::{FeederId, Line, PalletId, RobotId, Role, Station};
-pub use imrs_core;
 pub use rng::Rng;
 pub use scene::{ArmPose, BoxPose, FeederView, LinkPose, PalletPose, Scene};
 pub use sim::{Sim, SimConfig};

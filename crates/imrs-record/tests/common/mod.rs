@@ -8,12 +8,12 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
+use imrs_core::Event;
+use imrs_core::imrs_ports::Instant;
+use imrs_core::imrs_ports::Name;
+use imrs_core::prelude::*;
+use imrs_core::time::drive;
 use imrs_record::{Recorder, Timeline};
-use imrs_sim::imrs_core::Event;
-use imrs_sim::imrs_core::imrs_ports::Instant;
-use imrs_sim::imrs_core::imrs_ports::Name;
-use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::time::drive;
 use imrs_sim::{FeederId, Line, RobotId, Role, Scene, Sim, SimConfig, SimEvent, Target};
 
 /// `n` seconds.
