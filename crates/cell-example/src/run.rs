@@ -259,7 +259,7 @@ async fn simulate(
     let timeline = config.timeline.as_ref().map(|window| {
         let timeline = Timeline::new(window.from, window.from + window.span);
         timeline.record_cell(&cell);
-        timeline.record_sim(sim.log());
+        timeline.record_sim(&sim);
         (timeline, &window.path)
     });
     cell.events().set_capacity(config.kept_events);

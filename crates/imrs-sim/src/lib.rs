@@ -50,6 +50,8 @@
 #[cfg(feature = "chip")]
 mod device;
 #[cfg(feature = "chip")]
+mod drawn;
+#[cfg(feature = "chip")]
 mod error;
 #[cfg(feature = "chip")]
 mod event;

@@ -108,7 +108,7 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
         }
         if let Some(timeline) = timeline {
             timeline.record_cell(&cell);
-            timeline.record_sim(sim.log());
+            timeline.record_sim(&sim);
         }
         sim.spawn();
         let share_feeder = Port::<(), i32, usage::Query>::declare(
