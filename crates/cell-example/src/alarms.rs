@@ -3,8 +3,8 @@
 
 use std::fmt;
 
+use imrs_core::Ctx;
 use imrs_sim::DeviceError;
-use imrs_sim::imrs_core::Ctx;
 
 /// What an alarm is about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use std::time::{Duration, UNIX_EPOCH};
 
 use clap::Parser;
+use imrs_core::imrs_ports::RealClock;
 use imrs_sim::Line;
-use imrs_sim::imrs_core::imrs_ports::RealClock;
 
 use crate::chip::FeederPolicy;
 use crate::faults::CellFault;

@@ -4,9 +4,9 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
+use imrs_core::imrs_ports::{BoundedBuffer, Instant};
+use imrs_core::prelude::*;
 use imrs_sim::Line;
-use imrs_sim::imrs_core::imrs_ports::{BoundedBuffer, Instant};
-use imrs_sim::imrs_core::prelude::*;
 
 use crate::devices::Devices;
 

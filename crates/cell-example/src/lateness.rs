@@ -110,8 +110,8 @@ mod tests {
 
     #[test]
     fn the_shortest_timeout_is_that_of_the_cells_ports() {
+        use imrs_core::imrs_ports::{SharedClock, VirtualClock};
         use imrs_sim::Line;
-        use imrs_sim::imrs_core::imrs_ports::{SharedClock, VirtualClock};
 
         use crate::ports::LinePorts;
 

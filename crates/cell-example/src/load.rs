@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use imrs_sim::imrs_core::prelude::*;
+use imrs_core::prelude::*;
 use imrs_sim::{Line, RobotId, Role, Station, Target};
 
 use crate::devices::Devices;

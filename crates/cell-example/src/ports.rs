@@ -5,11 +5,11 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
-use imrs_sim::imrs_core::Cell;
-use imrs_sim::imrs_core::imrs_ports::{
+use imrs_core::Cell;
+use imrs_core::imrs_ports::{
     AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage,
 };
+use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
 use imrs_sim::{Line, PalletId};
 
 use crate::chip::FeederPolicy;

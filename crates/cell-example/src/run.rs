@@ -4,10 +4,10 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
+use imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
+use imrs_core::prelude::*;
+use imrs_core::{CellError, CellErrors, Log, ModuleDecl, ModuleTree, time::drive};
 use imrs_record::{RecordError, Recorder, Timeline};
-use imrs_sim::imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
-use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::{CellError, CellErrors, Log, ModuleDecl, ModuleTree, time::drive};
 use imrs_sim::{
     Fault, FaultKind, FeederId, Line, PalletId, RobotId, RobotTimes, Role, Sim, SimConfig,
     SimEvent, Station,
@@ -259,7 +259,7 @@ async fn simulate(
     let timeline = config.timeline.as_ref().map(|window| {
         let timeline = Timeline::new(window.from, window.from + window.span);
         timeline.record_cell(&cell);
-        timeline.record_sim(sim.log());
+        timeline.record_sim(&sim);
         (timeline, &window.path)
     });
     cell.events().set_capacity(config.kept_events);

@@ -6,7 +6,7 @@ use std::time::Duration;
 use cell_example::{
     CellConfig, CellFault, CellFaultKind, FeederPolicy, Report, keeping_up_line, run,
 };
-use imrs_sim::imrs_core::EventKind;
+use imrs_core::EventKind;
 use imrs_sim::{FeederId, Line, SimEventKind};
 
 fn config(hours: f64, seed: u64, feeder: FeederPolicy) -> CellConfig {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use cell_example::{CellConfig, FeederPolicy, TimelineConfig, run};
-use imrs_sim::imrs_core::EventKind;
+use imrs_core::EventKind;
 use serde_json::Value;
 
 fn temp(name: &str) -> PathBuf {

@@ -12,15 +12,17 @@
 //!   detection among exclusive resources and its resolution, the alternative trajectory
 //!   round a stopped robot, and the arm's pipeline of points checked ahead;
 //! - [`coordinator`]: the zone coordinator as a module, speaking the seed's message set over
-//!   typed ports;
-//! - [`table_cell`]: a cell of four arms on the simulated table under the coordinator, fed
-//!   by the run-time scheduler (`cargo run --release --example coord_cell`).
+//!   typed ports.
 //!
-//! Why a crate of its own: the layer uses the core and the simulation but the core must not
-//! depend on it; a robot crate embedding `imrs-core` does not compile it.
+//! A cell of four arms on the simulated table under the coordinator, fed by the run-time
+//! scheduler, is the `table-cell` crate (`cargo run --release --example coord_cell`).
+//!
+//! Why a crate of its own: the layer uses the core, but the core must not depend on it; a
+//! robot crate embedding `imrs-core` does not compile it. It drives no simulated world
+//! (parry3d measures its zones and sweeps, with no physics engine), so a user of the layer
+//! compiles neither rapier nor a simulation.
 
 pub mod coordinator;
 pub mod network;
 pub mod scheduler;
-pub mod table_cell;
 pub mod zones;

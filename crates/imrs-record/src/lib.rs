@@ -8,7 +8,7 @@
 //! use std::sync::Arc;
 //! use std::time::Duration;
 //! use imrs_record::{Recorder, Timeline, read_summary};
-//! use imrs_sim::imrs_core::{Cell, imrs_ports::Instant, time::drive};
+//! use imrs_core::{Cell, imrs_ports::Instant, time::drive};
 //! use imrs_sim::{FeederId, Line, Role, RobotId, Sim, SimConfig, Target};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -22,7 +22,7 @@
 //! recorder.record_cell(&cell);
 //! recorder.record_sim(&sim, Recorder::SCENE_PERIOD);
 //! let timeline = Timeline::new(Duration::ZERO, Duration::from_secs(60));
-//! timeline.record_sim(sim.log());
+//! timeline.record_sim(&sim);
 //!
 //! sim.spawn();
 //! let robot = sim.robot(RobotId::new(Line::A, Role::ChipIt));
@@ -41,6 +41,11 @@
 //! # Ok(())
 //! # }
 //! ```
+//!
+//! The simulation is any world that implements [`imrs_scene::World`]: it gives the
+//! recorder and the timeline its conveyors, arms, pallets, feeders and zone, and the facts
+//! it measures, so that this crate compiles no world (neither rapier nor one cell's
+//! geometry); the chip line's `imrs_sim::Sim` implements it.
 //!
 //! The scene and the log use Foxglove's well-known schemas through the `foxglove` crate,
 //! Foxglove's own SDK, rather than schemas written out here: its message types are generated

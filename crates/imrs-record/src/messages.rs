@@ -2,9 +2,10 @@
 //! schemas that let Foxglove show the fields.
 
 use foxglove::messages::{Log, log::Level};
-use imrs_sim::imrs_core::imrs_ports::Instant;
-use imrs_sim::imrs_core::{Event, EventKind, Observed};
-use imrs_sim::{SimEvent, SimEventKind};
+use std::time::Duration;
+
+use imrs_core::{Event, EventKind, Observed};
+use imrs_scene::{Fact, Field, Severity};
 use serde_json::{Value, json};
 
 use crate::time::stamp;
@@ -206,15 +207,15 @@ pub(crate) fn cell_log(event: &Event) -> Option<Log> {
         _ => return None,
     };
     Some(log_entry(
-        event.at,
+        event.at.since_start(),
         level,
         event.to_string(),
         event.module.as_str(),
     ))
 }
 
-/// A line of Foxglove's log panel, from `name`, at `at` of the cell's clock.
-fn log_entry(at: Instant, level: Level, message: String, name: &str) -> Log {
+/// A line of Foxglove's log panel, from `name`, at `at` since the start of the cell's clock.
+fn log_entry(at: Duration, level: Level, message: String, name: &str) -> Log {
     Log {
         timestamp: Some(stamp(at)),
         level: level as i32,
@@ -225,64 +226,24 @@ fn log_entry(at: Instant, level: Level, message: String, name: &str) -> Log {
     }
 }
 
-/// The JSON of a measured fact.
-pub(crate) fn sim_message(event: &SimEvent) -> Value {
-    let text = event.to_string();
-    match &event.kind {
-        SimEventKind::ZoneEntered { robot } => {
-            json!({"kind": "zone_entered", "robot": robot.to_string(), "text": text})
-        }
-        SimEventKind::ZoneLeft { robot } => {
-            json!({"kind": "zone_left", "robot": robot.to_string(), "text": text})
-        }
-        SimEventKind::Collision { a, b, point } => json!({
-            "kind": "collision", "robot": format!("{a} {b}"), "point": point, "text": text
-        }),
-        SimEventKind::PalletReleased { line, pallet } => json!({
-            "kind": "pallet_released", "line": format!("{line:?}"), "pallet": pallet.0, "text": text
-        }),
-        SimEventKind::PalletDone {
-            line,
-            pallet,
-            chips,
-        } => json!({
-            "kind": "pallet_done", "line": format!("{line:?}"), "pallet": pallet.0,
-            "chips": chips, "text": text
-        }),
-        SimEventKind::ChipInserted {
-            line,
-            pallet,
-            chip,
-            on_card,
-        } => json!({
-            "kind": "chip_inserted", "line": format!("{line:?}"), "pallet": pallet.0, "chip": chip,
-            "on_card_mm": [on_card[0] * 1000.0, on_card[1] * 1000.0], "text": text
-        }),
-        SimEventKind::FeederRefilled { feeder, chips } => json!({
-            "kind": "feeder_refilled", "feeder": feeder.0, "chips": chips, "text": text
-        }),
-        _ => json!({"kind": sim_kind(&event.kind), "text": text}),
+/// The JSON of a measured fact: its kind, its fields, and its text.
+pub(crate) fn sim_message(fact: &Fact) -> Value {
+    let mut message = json!({"kind": fact.kind, "text": fact.text});
+    for (name, field) in &fact.fields {
+        message[*name] = match field {
+            Field::Text(text) => json!(text),
+            Field::Count(count) => json!(count),
+            Field::Numbers(numbers) => json!(numbers),
+        };
     }
-}
-
-fn sim_kind(kind: &SimEventKind) -> &'static str {
-    match kind {
-        SimEventKind::PalletInPlace { .. } => "pallet_in_place",
-        SimEventKind::PalletJammed { .. } => "pallet_jammed",
-        SimEventKind::PalletScrapped { .. } => "pallet_scrapped",
-        SimEventKind::CardPlaced { .. } => "card_placed",
-        SimEventKind::CardScrewed { .. } => "card_screwed",
-        SimEventKind::FaultStruck { .. } => "fault_struck",
-        _ => "other",
-    }
+    message
 }
 
 /// The log entry of a measured fact an engineer should see: collisions and faults.
-pub(crate) fn sim_log(event: &SimEvent) -> Option<Log> {
-    let level = match event.kind {
-        SimEventKind::Collision { .. } => Level::Error,
-        SimEventKind::FaultStruck { .. } | SimEventKind::PalletJammed { .. } => Level::Warning,
-        _ => return None,
+pub(crate) fn sim_log(fact: &Fact) -> Option<Log> {
+    let level = match fact.severity? {
+        Severity::Error => Level::Error,
+        Severity::Warning => Level::Warning,
     };
-    Some(log_entry(event.at, level, event.to_string(), "simulation"))
+    Some(log_entry(fact.at, level, fact.text.clone(), "simulation"))
 }

@@ -1,5 +1,6 @@
 //! The recorder: the cell's and the simulation's event streams, and the scene, into one MCAP
-//! file, streamed as they come.
+//! file, streamed as they come. The simulation is any [`World`]: the recorder draws what the
+//! world gives it and knows no world's layout.
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -11,8 +12,8 @@ use std::time::Duration;
 
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
 use foxglove::{Channel, Context, McapWriter, McapWriterHandle, RawChannel, Schema};
-use imrs_sim::imrs_core::Cell;
-use imrs_sim::{Scene, Sim};
+use imrs_core::Cell;
+use imrs_scene::{Scene, World};
 use serde_json::Value;
 
 use crate::error::RecordError;
@@ -116,14 +117,14 @@ impl Recorder {
 
     /// Records every event of `cell` from now on: each on its port's or its module's
     /// channel, with the text of the messages and replies of the ports that show them
-    /// ([`Port::shown`](imrs_sim::imrs_core::imrs_ports::Port::shown)), how long each
+    /// ([`Port::shown`](imrs_core::imrs_ports::Port::shown)), how long each
     /// primitive waited (the recorder turns [`Cell::observe`] on), and the events an
     /// engineer should see also on `/log`.
     pub fn record_cell(&self, cell: &Cell) {
         cell.observe(true);
         let inner = Arc::clone(&self.inner);
         cell.events().subscribe(move |event| {
-            let at = nanos(event.at);
+            let at = nanos(event.at.since_start());
             let (route, message) = cell_message(event);
             inner.json(route, &message, at);
             if let Some(entry) = cell_log(event) {
@@ -133,37 +134,42 @@ impl Recorder {
         });
     }
 
-    /// Records every fact the simulation measures from now on, and its scene: once now,
-    /// then at most every `period` of the clock while something moves.
-    pub fn record_sim(&self, sim: &Sim, period: Duration) {
+    /// Records every fact a simulated world measures from now on, and its scene: once now,
+    /// then at most every `period` of the clock while something moves. The world gives
+    /// both through [`World`] (the chip line's `imrs_sim::Sim` is one).
+    pub fn record_sim(&self, world: &dyn World, period: Duration) {
         let inner = Arc::clone(&self.inner);
-        sim.log().subscribe(move |event| {
-            let at = nanos(event.at);
-            let message = sim_message(event);
+        world.facts(Box::new(move |fact| {
+            let at = nanos(fact.at);
+            let message = sim_message(fact);
             inner.raw(&inner.sim, &message, at);
-            if let Some(entry) = sim_log(event) {
+            if let Some(entry) = sim_log(fact) {
                 inner.log.log_with_time(&entry, at);
                 inner.counted();
             }
-        });
+        }));
         let inner = Arc::clone(&self.inner);
+        let layout = world.layout();
         let (mut moved, mut parts) = (Moved::default(), Parts::default());
         let mut first = true;
-        sim.watch(period, move |scene: &Scene| {
-            let at = nanos(scene.at);
-            if std::mem::take(&mut first) {
-                inner.fixed.log_with_time(&scene::fixed(scene), at);
-                inner.counted();
-            }
-            if let Some(transforms) = moved.since_last(scene) {
-                inner.tf.log_with_time(&transforms, at);
-                inner.counted();
-            }
-            if let Some(update) = parts.since_last(scene) {
-                inner.parts.log_with_time(&update, at);
-                inner.counted();
-            }
-        });
+        world.watch(
+            period,
+            Box::new(move |scene: &Scene| {
+                let at = nanos(scene.at);
+                if std::mem::take(&mut first) {
+                    inner.fixed.log_with_time(&scene::fixed(&layout, scene), at);
+                    inner.counted();
+                }
+                if let Some(transforms) = moved.since_last(scene) {
+                    inner.tf.log_with_time(&transforms, at);
+                    inner.counted();
+                }
+                if let Some(update) = parts.since_last(scene) {
+                    inner.parts.log_with_time(&update, at);
+                    inner.counted();
+                }
+            }),
+        );
     }
 
     /// The file being written.

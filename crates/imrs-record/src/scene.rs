@@ -5,6 +5,10 @@
 //! their cards and chips, the feeders' stock, the zone tinted by who is inside — are
 //! `foxglove.SceneUpdate`s, sent only when they change. A moving cell thus costs a few
 //! transforms per sample, not its whole scene.
+//!
+//! What is drawn comes from the world through [`imrs_scene::World`]: its conveyors, arms,
+//! pallets, feeders and zone, with their names. Nothing here knows one world's layout, so
+//! recording a cell compiles no simulation.
 
 use std::collections::HashMap;
 
@@ -13,22 +17,21 @@ use foxglove::messages::{
     Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate, TextPrimitive, Vector3,
     scene_entity_deletion::Type as Deletion,
 };
-use imrs_sim::layout::{EXIT_X, GATE_X, line_y};
-use imrs_sim::{ArmPose, BoxPose, FeederView, Line, PalletId, PalletPose, Scene};
+use imrs_scene::{BoxPose, Feeder, Layout, Pallet, Scene};
 
 use crate::time::stamp;
 
 /// The frame everything else hangs from.
 pub const WORLD: &str = "world";
 
-/// The frame of a pallet.
-pub fn pallet_frame(pallet: &PalletPose) -> String {
-    format!("{}", pallet.pallet)
+/// The frame of a pallet: its name.
+pub fn pallet_frame(pallet: &Pallet) -> String {
+    pallet.name.clone()
 }
 
-/// The frame of link `index` (0 or 1) of an arm.
-pub fn link_frame(arm: &ArmPose, index: usize) -> String {
-    format!("{}/link{}", arm.robot, index + 1)
+/// The frame of link `index` (from 0, the base's) of the arm named `arm`.
+pub fn link_frame(arm: impl std::fmt::Display, index: usize) -> String {
+    format!("{arm}/link{}", index + 1)
 }
 
 fn vector(v: [f32; 3]) -> Vector3 {
@@ -80,36 +83,32 @@ fn cube(pose: &BoxPose, color: Option<Color>) -> CubePrimitive {
     }
 }
 
-/// The parts that never move, sent once: the conveyors, and each arm link's shape in the
-/// link's own frame (`frame_locked`, so it follows the frame's transforms).
-pub fn fixed(scene: &Scene) -> SceneUpdate {
+/// The parts that never move, sent once: the layout's conveyors, and each arm link's shape
+/// in the link's own frame (`frame_locked`, so it follows the frame's transforms), stamped
+/// with the first `scene`.
+pub fn fixed(layout: &Layout, scene: &Scene) -> SceneUpdate {
     let mut entities = Vec::new();
-    for line in Line::ALL {
-        let y = line_y(line.index());
-        let mut conveyor = entity(scene, WORLD, format!("conveyor-{line:?}"));
-        conveyor.cubes.push(cube(
-            &BoxPose {
-                centre: [(GATE_X + EXIT_X) / 2.0, y, -0.01],
-                half: [(EXIT_X - GATE_X) / 2.0, 0.12, 0.01],
-            },
-            rgba(0.35, 0.35, 0.38, 1.0),
-        ));
+    for line in &layout.conveyors {
+        let mut conveyor = entity(scene, WORLD, format!("conveyor-{}", line.name));
+        conveyor
+            .cubes
+            .push(cube(&line.belt, rgba(0.35, 0.35, 0.38, 1.0)));
         conveyor.texts.push(TextPrimitive {
             pose: Some(Pose {
-                position: Some(vector([GATE_X - 0.3, y, 0.05])),
+                position: Some(vector(line.label_at)),
                 orientation: Some(IDENTITY),
             }),
             billboard: true,
             font_size: 14.0,
             scale_invariant: true,
             color: rgba(1.0, 1.0, 1.0, 1.0),
-            text: format!("line {line:?}"),
+            text: format!("line {}", line.name),
         });
         entities.push(conveyor);
     }
     for arm in &scene.arms {
         for (index, link) in arm.links.iter().enumerate() {
-            let frame = link_frame(arm, index);
+            let frame = link_frame(&arm.name, index);
             let mut shape = entity(scene, &frame, frame.clone());
             shape.frame_locked = true;
             let diameter = f64::from(2.0 * link.radius);
@@ -136,7 +135,7 @@ pub fn fixed(scene: &Scene) -> SceneUpdate {
             });
             shape.metadata.push(KeyValuePair {
                 key: "robot".into(),
-                value: arm.robot.to_string(),
+                value: arm.name.clone(),
             });
             entities.push(shape);
         }
@@ -152,7 +151,7 @@ pub fn fixed(scene: &Scene) -> SceneUpdate {
 #[derive(Debug, Default)]
 pub struct Moved {
     links: Vec<([f32; 3], f32)>,
-    pallets: HashMap<u32, [f32; 3]>,
+    pallets: HashMap<String, [f32; 3]>,
 }
 
 impl Moved {
@@ -177,17 +176,17 @@ impl Moved {
                 moved.push(FrameTransform {
                     timestamp: Some(stamp(scene.at)),
                     parent_frame_id: WORLD.into(),
-                    child_frame_id: link_frame(arm, link_index),
+                    child_frame_id: link_frame(&arm.name, link_index),
                     translation: Some(vector(link.centre)),
                     rotation: Some(yaw(link.yaw)),
                 });
             }
         }
         self.pallets
-            .retain(|id, _| scene.pallets.iter().any(|p| p.pallet.0 == *id));
+            .retain(|name, _| scene.pallets.iter().any(|p| p.name == *name));
         for pallet in &scene.pallets {
             let centre = pallet.pose.centre;
-            if self.pallets.insert(pallet.pallet.0, centre) == Some(centre) {
+            if self.pallets.insert(pallet.name.clone(), centre) == Some(centre) {
                 continue;
             }
             moved.push(FrameTransform {
@@ -208,7 +207,7 @@ impl Moved {
 #[derive(Debug, Default)]
 pub struct Parts {
     sent: bool,
-    pallets: HashMap<u32, (bool, u32)>,
+    pallets: HashMap<String, (bool, u32)>,
     stocks: Vec<u32>,
     inside: Option<usize>,
 }
@@ -220,22 +219,22 @@ impl Parts {
         let first = !std::mem::replace(&mut self.sent, true);
         for pallet in &scene.pallets {
             let state = (pallet.card, pallet.chips);
-            if self.pallets.insert(pallet.pallet.0, state) != Some(state) {
+            if self.pallets.insert(pallet.name.clone(), state) != Some(state) {
                 update.entities.push(pallet_entity(scene, pallet));
             }
         }
-        let gone: Vec<u32> = self
+        let gone: Vec<String> = self
             .pallets
             .keys()
-            .filter(|id| !scene.pallets.iter().any(|p| p.pallet.0 == **id))
-            .copied()
+            .filter(|name| !scene.pallets.iter().any(|p| p.name == **name))
+            .cloned()
             .collect();
-        for id in gone {
-            self.pallets.remove(&id);
+        for name in gone {
+            self.pallets.remove(&name);
             update.deletions.push(SceneEntityDeletion {
                 timestamp: Some(stamp(scene.at)),
                 r#type: Deletion::MatchingId as i32,
-                id: PalletId(id).to_string(),
+                id: name,
             });
         }
         for (index, feeder) in scene.feeders.iter().enumerate() {
@@ -245,16 +244,18 @@ impl Parts {
         }
         self.stocks = scene.feeders.iter().map(|f| f.stock).collect();
         let inside = scene.arms.iter().filter(|arm| arm.in_zone).count();
-        if self.inside != Some(inside) {
+        if let Some(zone) = &scene.zone
+            && self.inside != Some(inside)
+        {
             self.inside = Some(inside);
-            update.entities.push(zone_entity(scene, inside));
+            update.entities.push(zone_entity(scene, zone, inside));
         }
         (first || !update.entities.is_empty() || !update.deletions.is_empty()).then_some(update)
     }
 }
 
 /// A pallet, in its own frame: grey when bare, green with a card, brighter for each chip.
-fn pallet_entity(scene: &Scene, pallet: &PalletPose) -> SceneEntity {
+fn pallet_entity(scene: &Scene, pallet: &Pallet) -> SceneEntity {
     let frame = pallet_frame(pallet);
     let mut shape = entity(scene, &frame, frame.clone());
     shape.frame_locked = true;
@@ -277,8 +278,8 @@ fn pallet_entity(scene: &Scene, pallet: &PalletPose) -> SceneEntity {
 }
 
 /// A feeder, red when empty, with its chip number and stock.
-fn feeder_entity(scene: &Scene, feeder: &FeederView) -> SceneEntity {
-    let mut shape = entity(scene, WORLD, feeder.id.to_string());
+fn feeder_entity(scene: &Scene, feeder: &Feeder) -> SceneEntity {
+    let mut shape = entity(scene, WORLD, feeder.name.clone());
     let empty = feeder.stock == 0;
     shape.cylinders.push(CylinderPrimitive {
         pose: Some(Pose {
@@ -313,14 +314,14 @@ fn feeder_entity(scene: &Scene, feeder: &FeederView) -> SceneEntity {
 }
 
 /// The feeder zone: clear when empty, amber with one robot inside, red with more.
-fn zone_entity(scene: &Scene, inside: usize) -> SceneEntity {
+fn zone_entity(scene: &Scene, zone_box: &BoxPose, inside: usize) -> SceneEntity {
     let mut zone = entity(scene, WORLD, "feeder-zone".into());
     let color = match inside {
         0 => rgba(0.3, 0.6, 1.0, 0.15),
         1 => rgba(1.0, 0.7, 0.1, 0.3),
         _ => rgba(1.0, 0.1, 0.1, 0.5),
     };
-    zone.cubes.push(cube(&scene.zone, color));
+    zone.cubes.push(cube(zone_box, color));
     zone.metadata.push(KeyValuePair {
         key: "robots inside".into(),
         value: inside.to_string(),

@@ -15,8 +15,8 @@ use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_sim::imrs_core::{Cell, EventKind};
-use imrs_sim::{SimEventKind, SimLog};
+use imrs_core::{Cell, EventKind};
+use imrs_scene::{World, ZoneChange};
 use plotters::prelude::*;
 
 use crate::error::RecordError;
@@ -174,16 +174,17 @@ impl Timeline {
         });
     }
 
-    /// Folds every fact of the simulation from now on: who is inside the feeder zone.
-    pub fn record_sim(&self, log: &SimLog) {
+    /// Folds every fact a simulated world measures from now on: who is inside its shared
+    /// (feeder) zone.
+    pub fn record_sim(&self, world: &dyn World) {
         let fold = Arc::clone(&self.fold);
-        log.subscribe(move |event| {
-            let at = event.at.since_start().as_secs_f64();
+        world.facts(Box::new(move |fact| {
+            let at = fact.at.as_secs_f64();
             let mut fold = lock(&fold);
             fold.last = fold.last.max(at);
-            match &event.kind {
-                SimEventKind::ZoneEntered { robot } => {
-                    let robot = robot.to_string();
+            match &fact.zone {
+                Some(ZoneChange::Entered(robot)) => {
+                    let robot = robot.clone();
                     fold.row(&format!("zone: {robot}"));
                     fold.row("feeder zone");
                     fold.inside.insert(robot, at);
@@ -191,8 +192,8 @@ impl Timeline {
                         fold.shared_since = Some(at);
                     }
                 }
-                SimEventKind::ZoneLeft { robot } => {
-                    let robot = robot.to_string();
+                Some(ZoneChange::Left(robot)) => {
+                    let robot = robot.clone();
                     if let Some(since) = fold.inside.remove(&robot) {
                         let row = fold.row(&format!("zone: {robot}"));
                         fold.span(row, since, at, SpanKind::InZone);
@@ -204,9 +205,9 @@ impl Timeline {
                         fold.span(row, since, at, SpanKind::ZoneShared);
                     }
                 }
-                _ => {}
+                None => {}
             }
-        });
+        }));
     }
 
     /// The rows as they would be drawn now: stretches still open end at the last event seen.

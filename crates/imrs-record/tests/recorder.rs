@@ -9,8 +9,8 @@ use std::collections::BTreeMap;
 
 use common::{name, run, temp};
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
+use imrs_core::EventKind;
 use imrs_record::{Recorder, read_summary};
-use imrs_sim::imrs_core::EventKind;
 use prost::Message as _;
 use serde_json::Value;
 
@@ -181,7 +181,7 @@ fn the_scene_decodes_in_foxglove_schemas_and_agrees_with_rapier() {
     }
     for arm in &ran.scene.arms {
         for (index, link) in arm.links.iter().enumerate() {
-            let frame = imrs_record::scene::link_frame(arm, index);
+            let frame = imrs_record::scene::link_frame(arm.robot, index);
             let at = &frames[&frame];
             let recorded = [at.x, at.y, at.z];
             for (axis, value) in recorded.iter().enumerate() {

@@ -1,6 +1,13 @@
 //! The simulated chip-insertion cell: two assembly lines of robots, conveyors, pallets and a
-//! shared feeder zone, in a rapier3d world stepped on the framework clock; and, in
-//! [`hand`], a dextrous hand over a table of objects, for the schemas of seed 004.
+//! shared feeder zone, in a rapier3d world stepped on the framework clock; in `hand`, a
+//! dextrous hand over a table of objects, for the schemas of seed 004; and in `table`, a
+//! table of SCARA arms sharing zones and tools, for the coordination layer.
+//!
+//! Each world is a cargo feature of its own — `chip` (the crate root's items, `layout`,
+//! `profile`), `hand` and `table` (with `scara`, which the chip line's arms share) — all on by
+//! default. The three worlds share nothing but the framework clock, so a user of one does
+//! not compile the others: a schema crate asks for `hand` alone. With no feature the crate
+//! is empty and compiles neither rapier nor nalgebra.
 //!
 //! The seed's Appendix omits its device drivers; this crate stands in for the hardware. It
 //! runs faster than real time on a [`VirtualClock`](imrs_core::imrs_ports::VirtualClock), or
@@ -40,28 +47,52 @@
 //! # }
 //! ```
 
+#[cfg(feature = "chip")]
 mod device;
+#[cfg(feature = "chip")]
+mod drawn;
+#[cfg(feature = "chip")]
 mod error;
+#[cfg(feature = "chip")]
 mod event;
+#[cfg(feature = "chip")]
 mod fault;
+#[cfg(feature = "hand")]
 pub mod hand;
+#[cfg(feature = "chip")]
 mod ids;
+#[cfg(feature = "chip")]
 pub mod layout;
+#[cfg(feature = "chip")]
 pub mod profile;
+#[cfg(any(feature = "chip", feature = "hand"))]
 mod rng;
+#[cfg(any(feature = "chip", feature = "table"))]
 pub mod scara;
+#[cfg(feature = "chip")]
 mod scene;
+#[cfg(feature = "chip")]
 mod sim;
+#[cfg(any(feature = "chip", feature = "hand"))]
+mod step;
+#[cfg(feature = "table")]
 pub mod table;
+#[cfg(feature = "chip")]
 mod world;
 
+#[cfg(feature = "chip")]
 pub use device::{Gate, Relay, Release, Robot};
+#[cfg(feature = "chip")]
 pub use error::DeviceError;
+#[cfg(feature = "chip")]
 pub use event::{SimEvent, SimEventKind, SimLog};
+#[cfg(feature = "chip")]
 pub use fault::{Fault, FaultKind};
+#[cfg(feature = "chip")]
 pub use ids::{FeederId, Line, PalletId, RobotId, Role, Station};
-pub use imrs_core;
-pub use rng::Rng;
+#[cfg(feature = "chip")]
 pub use scene::{ArmPose, BoxPose, FeederView, LinkPose, PalletPose, Scene};
+#[cfg(feature = "chip")]
 pub use sim::{Sim, SimConfig};
+#[cfg(feature = "chip")]
 pub use world::{FEEDER_CHIPS, RobotTimes, Target};

@@ -16,7 +16,8 @@ use crate::fault::Fault;
 use crate::ids::{FeederId, Line, PalletId, RobotId, Station};
 use crate::layout::STEP;
 use crate::scene::Scene;
-use crate::world::{RobotTimes, World, next_step_after};
+use crate::step::next_step_after;
+use crate::world::{RobotTimes, World};
 
 /// How the cell is set up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,7 +2,6 @@
 //! and the parts' arrivals.
 
 use imrs_core::imrs_ports::Name;
-use imrs_sim::Rng;
 
 /// What a robot can do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -180,7 +179,7 @@ impl Arrivals {
     /// within a window that opens every 12 s on average, each at a uniform time within
     /// 30 s of it. Seeded: the same seed, the same arrivals.
     pub fn random(cell: &Workcell, units: usize, seed: u64) -> Self {
-        let mut rng = Rng::new(seed);
+        let mut rng = SplitMix64(seed);
         let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let mut opens = 0.0;
         let at = (0..units)
@@ -190,5 +189,20 @@ impl Arrivals {
             })
             .collect();
         Self { at }
+    }
+}
+
+/// The arrivals' generator: SplitMix64, the simulation's own, here so that the scheduler
+/// needs no simulated world for its randomness and a seed still gives the arrivals it gave.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    /// The next 64 random bits.
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
     }
 }

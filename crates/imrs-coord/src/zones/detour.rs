@@ -3,9 +3,9 @@
 //! robots' links with parry3d and, where it is blocked, computes an alternative that goes
 //! round them ("continue with alternative trajectory").
 
-use rapier3d::parry::query;
-use rapier3d::parry::shape::Capsule;
-use rapier3d::prelude::{Pose, Vector};
+use parry3d::math::{Pose, Vector};
+use parry3d::query;
+use parry3d::shape::Capsule;
 
 /// A stopped robot, as the space its links take: one capsule per link.
 #[derive(Debug, Clone)]

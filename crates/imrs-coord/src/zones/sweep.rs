@@ -4,9 +4,9 @@
 use std::collections::VecDeque;
 
 use imrs_core::imrs_ports::Name;
-use rapier3d::parry::query;
-use rapier3d::parry::shape::Capsule;
-use rapier3d::prelude::{Pose, Vector};
+use parry3d::math::{Pose, Vector};
+use parry3d::query;
+use parry3d::shape::Capsule;
 
 /// The poses of an arm along a trajectory: base, elbow and tool in the working plane.
 pub type Sweep = Vec<[[f32; 2]; 3]>;

@@ -5,9 +5,9 @@ use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::fmt;
 
 use imrs_core::imrs_ports::Name;
-use rapier3d::parry::query::PointQuery;
-use rapier3d::parry::shape::Cuboid;
-use rapier3d::prelude::{Pose, Vector};
+use parry3d::math::{Pose, Vector};
+use parry3d::query::PointQuery;
+use parry3d::shape::Cuboid;
 
 /// How a zone is shared.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -38,16 +38,6 @@ impl ZoneDef {
             shape: Cuboid::new(Vector::new(half[0], half[1], half[2])),
             pose: Pose::translation(centre[0], centre[1], centre[2]),
         }
-    }
-
-    /// The zone the simulation has: its box, as the simulated table's sensor is built.
-    pub fn from_sim(zone: &imrs_sim::table::ZoneSpec) -> Self {
-        let kind = match zone.usage {
-            imrs_sim::table::ZoneUse::Exclusive => ZoneKind::Exclusive,
-            imrs_sim::table::ZoneUse::Shared => ZoneKind::Shared,
-        };
-        let c = zone.centre;
-        Self::boxed(zone.name.clone(), kind, [c.x, c.y, c.z], zone.half)
     }
 
     /// Whether a ball of `radius` at `point` (a gripper) reaches into the zone: its

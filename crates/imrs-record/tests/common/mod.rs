@@ -8,12 +8,12 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
+use imrs_core::Event;
+use imrs_core::imrs_ports::Instant;
+use imrs_core::imrs_ports::Name;
+use imrs_core::prelude::*;
+use imrs_core::time::drive;
 use imrs_record::{Recorder, Timeline};
-use imrs_sim::imrs_core::Event;
-use imrs_sim::imrs_core::imrs_ports::Instant;
-use imrs_sim::imrs_core::imrs_ports::Name;
-use imrs_sim::imrs_core::prelude::*;
-use imrs_sim::imrs_core::time::drive;
 use imrs_sim::{FeederId, Line, RobotId, Role, Scene, Sim, SimConfig, SimEvent, Target};
 
 /// `n` seconds.
@@ -104,7 +104,7 @@ pub fn run(record: Option<&Recorder>, timeline: Option<&Timeline>) -> Ran {
         }
         if let Some(timeline) = timeline {
             timeline.record_cell(&cell);
-            timeline.record_sim(sim.log());
+            timeline.record_sim(&sim);
         }
         sim.spawn();
         let share_feeder: Port<(), i32, usage::Query> = cell

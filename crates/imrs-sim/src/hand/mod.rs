@@ -51,7 +51,7 @@ pub use layout::{
 pub use object::{Detection, Object, SCENE, Shape};
 
 use crate::rng::Rng;
-use crate::world::next_step_after;
+use crate::step::next_step_after;
 use body::HandWorld;
 
 /// How the hand's table is set.

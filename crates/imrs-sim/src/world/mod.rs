@@ -607,11 +607,3 @@ impl World {
         }
     }
 }
-
-/// The step grid: the first multiple of `step` after `now`.
-pub(crate) fn next_step_after(now: Instant, step: Duration) -> Instant {
-    let step = step.as_nanos();
-    let now = now.since_start().as_nanos();
-    let next = (now / step + 1) * step;
-    Instant::from_start(Duration::from_nanos(next as u64))
-}

@@ -7,7 +7,7 @@ use imrs_sim::scara::{Elbow, Scara};
 use imrs_sim::table::{ArmSpec, TableLayout, ZoneSpec, ZoneUse};
 use nalgebra::{Point2, Point3};
 
-use crate::scheduler::{Robot, Skill, TaskSpec, Workcell, Zone};
+use imrs_coord::scheduler::{Robot, Skill, TaskSpec, Workcell, Zone};
 
 /// The exclusive zone: the fixture the unit is assembled on.
 pub const FIXTURE: &str = "FIXTURE";

@@ -3,6 +3,12 @@
 //! screwdriver, under the zone coordinator, fed by the run-time task scheduler — `cargo run
 //! --release --example coord_cell`.
 //!
+//! Why a crate of its own: this is a cell built on the coordination layer (`imrs-coord`),
+//! as `cell-example` is a cell built on the core, and it drives a simulated world
+//! (`imrs-sim`'s `table`). Kept apart, the coordination layer compiles no world and no
+//! physics engine, with no feature to remember, and this cell's tests and example still run
+//! with the workspace's.
+//!
 //! Every module talks through ports: each arm ([`arm`](self) module `ARM_1` … `ARM_4`)
 //! asks the `SCHEDULER` for its next job on `NEXT_JOB`, and the `COORDINATOR` for zones and
 //! the tool on the seed's message set. An arm's trajectory runs through its pipeline: points
@@ -18,12 +24,12 @@
 //! did, deadlocks included.
 //!
 //! ```no_run
-//! use imrs_coord::table_cell::{Assignment, CellConfig, run};
+//! use table_cell::{Assignment, CellConfig, run};
 //!
 //! let report = run(&CellConfig { seed: 1, hours: 1.0, assignment: Assignment::RunTime })?;
 //! assert!(report.measured.collisions.is_empty());
 //! println!("{report}");
-//! # Ok::<(), imrs_coord::table_cell::CellError>(())
+//! # Ok::<(), table_cell::CellError>(())
 //! ```
 
 mod arm;
@@ -36,9 +42,10 @@ use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
+use imrs_coord::zones::ZoneKind;
 use imrs_core::imrs_ports::{Instant, SharedClock, VirtualClock};
 use imrs_core::prelude::*;
-use imrs_sim::table::{Table, TableError};
+use imrs_sim::table::{Table, TableError, ZoneSpec, ZoneUse};
 
 pub use self::layout::{FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell};
 pub use self::report::Report;
@@ -46,9 +53,9 @@ pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
 
 use self::arm::arm_module;
 use self::schedule::{job_port, scheduler};
-use crate::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
-use crate::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
-use crate::zones::{Resources, ZoneDef};
+use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
+use imrs_coord::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
+use imrs_coord::zones::{Resources, ZoneDef};
 
 /// The coordinator module's name.
 pub const COORDINATOR: &str = "COORDINATOR";
@@ -159,7 +166,7 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
     let layout = layout();
     let table = Table::new(layout.clone(), Arc::clone(&shared)).map_err(CellError::Table)?;
     let names: Vec<&str> = layout.arms.iter().map(|arm| arm.name.as_str()).collect();
-    let zones: Arc<Vec<ZoneDef>> = Arc::new(layout.zones.iter().map(ZoneDef::from_sim).collect());
+    let zones: Arc<Vec<ZoneDef>> = Arc::new(layout.zones.iter().map(zone_def).collect());
 
     let plan = workcell();
     // Enough units that parts keep coming for the whole run (a window opens every 12 s on
@@ -224,4 +231,15 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         stats: lock(&stats).clone(),
         wall: Duration::ZERO,
     })
+}
+
+/// The coordinator's zone for a zone of the simulated table: its box, as the table's
+/// sensor is built.
+fn zone_def(zone: &ZoneSpec) -> ZoneDef {
+    let kind = match zone.usage {
+        ZoneUse::Exclusive => ZoneKind::Exclusive,
+        ZoneUse::Shared => ZoneKind::Shared,
+    };
+    let c = zone.centre;
+    ZoneDef::boxed(zone.name.clone(), kind, [c.x, c.y, c.z], zone.half)
 }

@@ -8,7 +8,7 @@ use imrs_core::imrs_ports::{AnyUser, End, Instant, Port, PortSpec, SharedClock, 
 use imrs_core::prelude::*;
 
 use super::lock;
-use crate::scheduler::{Dispatch, Policy};
+use imrs_coord::scheduler::{Dispatch, Policy};
 
 /// The scheduler module's name.
 pub const SCHEDULER: &str = "SCHEDULER";

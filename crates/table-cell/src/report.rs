@@ -7,7 +7,7 @@ use imrs_core::imrs_ports::Name;
 use imrs_sim::table::Measured;
 
 use super::{CellConfig, CellStats};
-use crate::coordinator::CoordinatorLog;
+use imrs_coord::coordinator::CoordinatorLog;
 
 /// A run's report.
 #[derive(Debug, Clone, PartialEq)]

@@ -27,8 +27,8 @@ use super::clearance::{blockers, obstacles};
 use super::layout::{RACK, SCREWDRIVER};
 use super::schedule::{JobAsker, JobPort};
 use super::{CellStats, lock};
-use crate::coordinator::{CoordinatorPorts, Message, Refused, RobotLink};
-use crate::zones::{Answer, Next, Pipeline, ZoneDef, ZoneKind, detour};
+use imrs_coord::coordinator::{CoordinatorPorts, Message, Refused, RobotLink};
+use imrs_coord::zones::{Answer, Next, Pipeline, ZoneDef, ZoneKind, detour};
 
 /// Points of a trajectory, this far apart.
 const SPACING: f32 = 0.02;

@@ -5,7 +5,7 @@
 
 use std::thread;
 
-use imrs_coord::table_cell::{Assignment, CellConfig, CellError, Report, run};
+use table_cell::{Assignment, CellConfig, CellError, Report, run};
 
 fn config(seed: u64, hours: f64, assignment: Assignment) -> CellConfig {
     CellConfig {

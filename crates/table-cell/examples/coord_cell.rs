@@ -9,7 +9,7 @@
 
 use std::process::ExitCode;
 
-use imrs_coord::table_cell::{Assignment, CellConfig, run};
+use table_cell::{Assignment, CellConfig, run};
 
 fn main() -> ExitCode {
     match cell() {

@@ -6,11 +6,11 @@ use imrs_core::imrs_ports::Name;
 use imrs_sim::scara::Scara;
 use imrs_sim::table::LINK_RADIUS;
 use nalgebra::Point2;
-use rapier3d::parry::query;
-use rapier3d::parry::shape::Capsule;
-use rapier3d::prelude::{Pose, Vector};
+use parry3d::math::{Pose, Vector};
+use parry3d::query;
+use parry3d::shape::Capsule;
 
-use crate::zones::Obstacle;
+use imrs_coord::zones::Obstacle;
 
 fn capsules(joints: &[Point2<f32>; 3]) -> [Capsule; 2] {
     let v = |p: &Point2<f32>| Vector::new(p.x, p.y, 0.0);
@@ -50,7 +50,7 @@ pub(crate) fn blockers(
         .collect()
 }
 
-/// The arms in the way as obstacles for [`crate::zones::detour`]: their links, a link's
+/// The arms in the way as obstacles for [`imrs_coord::zones::detour`]: their links, a link's
 /// radius thick.
 pub(crate) fn obstacles(names: &[Name], others: &[(Name, [Point2<f32>; 3])]) -> Vec<Obstacle> {
     others
