@@ -46,10 +46,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use imrs_core::imrs_ports::{AnyUser, End, Port, PortSpec, ProcessType, Shared, usage};
-use imrs_ipc::{
-    FromBytes, Imported, IpcError, Remote, Wire, export, export_send_all, export_send_all_shared,
-    export_shared, import, import_send_all, import_send_all_shared, import_shared,
-};
+use imrs_ipc::{FromBytes, Imported, IpcError, Remote, Wire, export, import};
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 
@@ -437,7 +434,7 @@ fn echo<T: Wire>(
 /// broadcast with itself.
 fn listen<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
     echo_broadcasts(
-        import_send_all::<T, T>(remote, name, "CAMERA", "LISTENER"),
+        import::<Imported<T, T, usage::SendAll>, _>(remote, name, "CAMERA", "LISTENER"),
         "LISTENER",
     )
 }
@@ -450,7 +447,7 @@ fn loaned_listen<T: Wire>(
     module: &str,
 ) -> tokio::task::JoinHandle<()> {
     echo_broadcasts(
-        import_send_all_shared::<T, T>(remote, name, "CAMERA", module),
+        import::<Imported<Shared<T>, Shared<T>, usage::SendAll>, _>(remote, name, "CAMERA", module),
         module,
     )
 }
@@ -475,7 +472,7 @@ fn echo_broadcasts<M: Send + 'static>(
 fn loaned_echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
     let port: Port<Shared<T>, Shared<T>, usage::Receive, AnyUser, 1> =
         Port::declare(PortSpec::new(name, "ECHO"));
-    let exported = export_shared(remote, &port).expect("exported");
+    let exported = export(remote, &port).expect("exported");
     let mut owner = port.owner().expect("the owner's end");
     tokio::spawn(async move {
         let _exported = exported;
@@ -543,12 +540,12 @@ fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [
         pair("PAIR_LARGE"),
     );
     let _exported = [
-        export_send_all(&remote, &small),
-        export_send_all(&remote, &large),
-        export_send_all_shared(&remote, &loaned_small),
-        export_send_all_shared(&remote, &loaned_large),
-        export_send_all_shared(&remote, &pair_small),
-        export_send_all_shared(&remote, &pair_large),
+        export(&remote, &small),
+        export(&remote, &large),
+        export(&remote, &loaned_small),
+        export(&remote, &loaned_large),
+        export(&remote, &pair_small),
+        export(&remote, &pair_large),
     ]
     .map(|exported| exported.expect("exported"));
     let mut child = start_peer(&cell, Peer::Listener("LISTENER"));
@@ -640,7 +637,9 @@ fn loaned_round_trips<T: Wire>(
 
 async fn loaned_round_trips_of<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
     let remote = Remote::new(cell).expect("a cell name");
-    let imported = import_shared::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
+    let imported =
+        import::<Imported<Shared<T>, Shared<T>, usage::Receive>, _>(&remote, port, "ECHO", "ASKER")
+            .expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
     timed!(rounds, {
         let message = asker.loan().expect("a loan");
@@ -660,7 +659,8 @@ fn imrs_round_trips<T: Wire>(
 
 async fn imrs_round_trips_of<T: Wire>(cell: &str, port: &str, rounds: usize) -> Vec<Duration> {
     let remote = Remote::new(cell).expect("a cell name");
-    let imported = import::<T, T>(&remote, port, "ECHO", "ASKER").expect("imported");
+    let imported = import::<Imported<T, T, usage::Receive>, _>(&remote, port, "ECHO", "ASKER")
+        .expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
     timed!(rounds, {
         std::hint::black_box(asker.send(T::default()).await.expect("a round trip"));
@@ -832,16 +832,28 @@ async fn alternating(cell: String, rounds: usize) -> [Vec<Duration>; 5] {
     let (blocking, in_task) = (raw(&format!("small{ONE_ID}")), raw(TASK_PART));
     let socket = readiness(&in_task.listener);
     let remote = Remote::new(&cell).expect("a cell name");
-    let imported = import::<Small, Small>(&remote, "SMALL", "ECHO", "ASKER").expect("imported");
+    let imported =
+        import::<Imported<Small, Small, usage::Receive>, _>(&remote, "SMALL", "ECHO", "ASKER")
+            .expect("imported");
     let mut asker = imported.port().user_named("ASKER").expect("the user's end");
-    let loaned_small =
-        import_shared::<Small, Small>(&remote, "SMALL_LOANED", "ECHO", "ASKER").expect("imported");
+    let loaned_small = import::<Imported<Shared<Small>, Shared<Small>, usage::Receive>, _>(
+        &remote,
+        "SMALL_LOANED",
+        "ECHO",
+        "ASKER",
+    )
+    .expect("imported");
     let mut small_asker = loaned_small
         .port()
         .user_named("ASKER")
         .expect("the user's end");
-    let loaned_large =
-        import_shared::<Large, Large>(&remote, "LARGE_LOANED", "ECHO", "ASKER").expect("imported");
+    let loaned_large = import::<Imported<Shared<Large>, Shared<Large>, usage::Receive>, _>(
+        &remote,
+        "LARGE_LOANED",
+        "ECHO",
+        "ASKER",
+    )
+    .expect("imported");
     let mut large_asker = loaned_large
         .port()
         .user_named("ASKER")

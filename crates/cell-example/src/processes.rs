@@ -33,7 +33,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 use imrs_core::CellErrors;
 use imrs_core::imrs_ports::{Instant, RealClock, SharedClock, usage};
 use imrs_core::prelude::*;
-use imrs_ipc::{Exported, Imported, IpcError, Remote, export, export_query, import, import_query};
+use imrs_ipc::{Exported, Imported, IpcError, Remote, export, import};
 use imrs_sim::{Line, Sim, SimConfig};
 use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
@@ -452,16 +452,25 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
         FeederPolicy::Appendix => Vec::new(),
     };
     for (link, port, keeper) in keeper_ports {
-        let imported =
-            import::<ModuleName, ()>(&remote, port, keeper, &names.chip_it).map_err(ipc(name))?;
+        let imported = import::<Imported<ModuleName, (), usage::Receive>, _>(
+            &remote,
+            port,
+            keeper,
+            &names.chip_it,
+        )
+        .map_err(ipc(name))?;
         cell.declare_imported(imported.port())
             .map_err(CellErrors::from)?;
         *link = ZoneLink::Imported(Arc::new(imported));
     }
     if config.feeder == FeederPolicy::Coordinator {
-        let imported =
-            import::<Reservation, ()>(&remote, ZONE_RESERVE, FEEDER_COORDINATOR, &names.chip_it)
-                .map_err(ipc(name))?;
+        let imported = import::<Imported<Reservation, (), usage::Receive>, _>(
+            &remote,
+            ZONE_RESERVE,
+            FEEDER_COORDINATOR,
+            &names.chip_it,
+        )
+        .map_err(ipc(name))?;
         cell.declare_imported(imported.port())
             .map_err(CellErrors::from)?;
         ports.zone_reserve = ZoneLink::Imported(Arc::new(imported));
@@ -475,8 +484,7 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     // nobody queries them, and the twin's stays a port of this process.
     let mut shared: Option<(Exported, Imported<(), i32, usage::Query>)> = None;
     if config.feeder == FeederPolicy::Appendix {
-        let own =
-            export_query(&remote, &ports.lines[line.index()].share_feeder).map_err(ipc(name))?;
+        let own = export(&remote, &ports.lines[line.index()].share_feeder).map_err(ipc(name))?;
         let imported = import_twin(&remote, &twin.share_feeder, &twin.chip_it, &names.chip_it)
             .await
             .map_err(ipc(name))?;
@@ -534,7 +542,7 @@ async fn import_twin(
 ) -> Result<Imported<(), i32, usage::Query>, IpcError> {
     let deadline = std::time::Instant::now() + PATIENCE;
     loop {
-        match import_query::<(), i32>(remote, port, owner, module) {
+        match import::<Imported<(), i32, usage::Query>, _>(remote, port, owner, module) {
             Err(IpcError::NoOwner { .. }) if std::time::Instant::now() < deadline => {
                 tokio::time::sleep(Duration::from_millis(20)).await;
             }

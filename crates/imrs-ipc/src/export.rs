@@ -147,7 +147,7 @@ impl Drop for Exported {
 /// cell: their modules' sends arrive at its owner's `receive`. Call it within the tokio
 /// runtime the cell runs on: the remote users' sends run there. Refused if another process
 /// already exports the port, or if the processes disagree on its types.
-pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -159,7 +159,7 @@ pub fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// memory, with nothing copied on the way. The owner's reply, built in a loan made for the
 /// request ([`Shared::loan_reply`]), crosses back the same way; one built on the heap is
 /// copied once into its sample.
-pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -169,7 +169,7 @@ pub fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
 /// modules' queries wait for its owner's response handler, which runs when the owner's
 /// order says, as for a query from its own process.
-pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -180,7 +180,7 @@ pub fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// [`export_response`] does a port of values: a remote module's query is read in place by
 /// the owner's response handler, which runs when the owner's order says and can build its
 /// answer in place too ([`Shared::loan_reply`]).
-pub fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Response, L, N>,
 ) -> Result<Exported, IpcError> {

@@ -109,7 +109,7 @@ impl Drop for Relay {
 /// Connects at once: refused with the port's own [`WireError`] if `module` is not on its
 /// user list or the port has no room for it, and with [`IpcError::TypeMismatch`] if the
 /// processes disagree on its types. Call it within the tokio runtime the cell runs on.
-pub fn import<Req: Wire, Rep: Wire>(
+pub(crate) fn import<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -130,7 +130,7 @@ pub fn import<Req: Wire, Rep: Wire>(
 /// message there, and its send hands the sample to the owner's process with nothing copied.
 /// Each reply is read where the owner's process wrote it. A loan is refused, naming the
 /// port, while the module holds as many loans and requests as the port allows at once.
-pub fn import_shared<Req: Wire, Rep: Wire>(
+pub(crate) fn import_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -149,7 +149,7 @@ pub fn import_shared<Req: Wire, Rep: Wire>(
 /// Imports a `RESPONSE` port of another process, as [`import`] does a port its owner
 /// receives on: `module` queries it, and the owner's response handler answers when the
 /// owner's order says.
-pub fn import_response<Req: Wire, Rep: Wire>(
+pub(crate) fn import_response<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -174,7 +174,7 @@ pub fn import_response<Req: Wire, Rep: Wire>(
 /// [`export_response_shared`](crate::export_response_shared), as [`import_shared`] does a
 /// port its owner receives on: `module` loans each query in shared memory
 /// ([`End::loan`]), and reads each answer where the owner's response handler built it.
-pub fn import_response_shared<Req: Wire, Rep: Wire>(
+pub(crate) fn import_response_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,

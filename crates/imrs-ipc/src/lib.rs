@@ -8,7 +8,7 @@
 //!
 //! ```no_run
 //! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
-//! use imrs_ipc::{Remote, export, import};
+//! use imrs_ipc::{Imported, Remote, export, import};
 //!
 //! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
 //! // The owner's process: the port, declared as ever, and exported.
@@ -20,21 +20,23 @@
 //! # Ok(()) }
 //! # async fn user() -> Result<(), Box<dyn std::error::Error>> {
 //! // A user's process: the same port, imported for module "ASKER".
-//! let imported = import::<u64, u64>(&Remote::new("my_cell")?, "DOUBLE", "DOUBLER", "ASKER")?;
+//! let imported: Imported<u64, u64, usage::Receive> =
+//!     import(&Remote::new("my_cell")?, "DOUBLE", "DOUBLER", "ASKER")?;
 //! let mut asker = imported.port().user_named("ASKER")?;
 //! assert_eq!(asker.send(21).await?, 42);
 //! # Ok(()) }
 //! ```
 //!
-//! Ports whose owner receives cross with [`export`] and [`import`]; `RESPONSE` ports, whose
-//! users query them, with [`export_response`] and [`import_response`] — a remote query
-//! waits for the owner's response handler, which runs when the owner's order says. `SENDALL`
-//! ports cross with [`export_send_all`] and [`import_send_all`]: the owner's broadcast
-//! reaches modules in other processes, and their replies come back. `CALLALL` ports cross
-//! with [`export_call_all`] and [`import_call_all`]: the owner's query reaches the response
-//! handlers of modules in other processes, each run when its module's order says; and
-//! `QUERY` ports, whose owner queries its users, with [`export_query`] and [`import_query`].
-//!
+//! Every port crosses with these two calls, [`export`] and [`import`]; the port's type
+//! chooses how (the owner's usage, and values or [`Shared`](imrs_core::imrs_ports::Shared)
+//! messages), and the [`Imported`] a user's process asks for must match it. Ports whose owner
+//! receives carry each send to it. `RESPONSE` ports, whose users query them: a remote query
+//! waits for the owner's response handler, which runs when the owner's order says.
+//! `SENDALL` ports: the owner's broadcast reaches modules in other processes, and their
+//! replies come back. `CALLALL` ports: the owner's query reaches the response handlers of
+//! modules in other processes, each run when its module's order says. And `QUERY` ports,
+//! whose owner queries its users, answered by a remote module's response handler.
+
 //! The bridges are woken by iceoryx2's events through tokio's reactor (the listener's
 //! socket, as an `AsyncFd`), and do their work where they are woken: a remote request goes
 //! into the owner's port in the reactor's thread, which wakes the module; the module's
@@ -85,8 +87,8 @@
 //! A port of values copies each message into shared memory and moves it by value through
 //! the bridges: cheap for small messages, and costly for large ones (tens of KiB),
 //! which in a debug build can also overflow tokio's default 2 MiB worker stack. A port of
-//! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses with [`export_shared`] and
-//! [`import_shared`] instead: the sender loans a sample of shared memory from its end,
+//! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses in shared memory instead,
+//! through the same two calls: the sender loans a sample of shared memory from its end,
 //! builds its message there, and sends it with nothing copied; the owner reads it where it
 //! lies, and builds its reply in a loan made for the request
 //! ([`Shared::loan_reply`](imrs_core::imrs_ports::Shared::loan_reply)), which crosses back
@@ -95,7 +97,7 @@
 //!
 //! ```no_run
 //! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, Shared, usage};
-//! use imrs_ipc::{FromBytes, Remote, ZeroCopySend, export_shared, import_shared};
+//! use imrs_ipc::{FromBytes, Imported, Remote, ZeroCopySend, export, import};
 //!
 //! #[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
 //! #[repr(C)]
@@ -112,7 +114,7 @@
 //! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
 //! let port: Port<Shared<Image>, Shared<u64>, usage::Receive, AnyUser, 1> =
 //!     Port::declare(PortSpec::new("IMAGE", "VISION"));
-//! let _bridge = export_shared(&Remote::new("my_cell")?, &port)?;
+//! let _bridge = export(&Remote::new("my_cell")?, &port)?;
 //! let mut vision = port.owner()?;
 //! let (image, reply) = vision.receive().await?; // read where the camera wrote it
 //! let mut lit = image.loan_reply(); // where the reply will cross back
@@ -120,7 +122,8 @@
 //! reply.reply(lit);
 //! # Ok(()) }
 //! # async fn user() -> Result<(), Box<dyn std::error::Error>> {
-//! let imported = import_shared::<Image, u64>(&Remote::new("my_cell")?, "IMAGE", "VISION", "CAMERA")?;
+//! let imported: Imported<Shared<Image>, Shared<u64>, usage::Receive> =
+//!     import(&Remote::new("my_cell")?, "IMAGE", "VISION", "CAMERA")?;
 //! let mut camera = imported.port().user_named("CAMERA")?;
 //! let mut image = camera.loan()?; // a sample of shared memory, zeroed
 //! image.pixels[..100].fill(255);
@@ -129,14 +132,12 @@
 //! # Ok(()) }
 //! ```
 //!
-//! `RESPONSE` ports of `Shared` messages cross the same way, with [`export_response_shared`]
-//! and [`import_response_shared`]: a query loaned and built in place, read in place by the
-//! owner's response handler, whose answer is built in a reply loan. So do `QUERY` ports,
-//! with [`export_query_shared`] and [`import_query_shared`]: the owner's query, loaned from
+//! `RESPONSE` ports of `Shared` messages cross the same way: a query loaned and built in place, read in place by the
+//! owner's response handler, whose answer is built in a reply loan. So do `QUERY` ports:
+//! the owner's query, loaned from
 //! the user's process, is read in place by the user's response handler, which builds its
-//! answer in a reply loan, read in place by the owner. And `SENDALL` and `CALLALL` ports,
-//! with [`export_send_all_shared`] and [`import_send_all_shared`], [`export_call_all_shared`]
-//! and [`import_call_all_shared`]: the owner's loans are samples of a publish-subscribe
+//! answer in a reply loan, read in place by the owner. And `SENDALL` and `CALLALL` ports:
+//! the owner's loans are samples of a publish-subscribe
 //! service of the port's own, and a broadcast built in one goes out once, when the port
 //! hands it to its users (`Shared`'s `Clone`, which shares a message no one writes rather
 //! than copying it). Every user, in any process, reads that one sample where the owner
@@ -154,6 +155,7 @@ mod bridge;
 mod broadcast;
 mod carry;
 mod dispatch;
+mod entry;
 mod error;
 mod export;
 mod import;
@@ -162,14 +164,10 @@ mod sweep;
 mod turn;
 mod wire;
 
+pub use entry::{Export, Import, export, import};
 pub use error::IpcError;
-pub use export::{Exported, export, export_response, export_response_shared, export_shared};
-pub use import::{Imported, import, import_response, import_response_shared, import_shared};
-pub use send_all::{
-    export_call_all, export_call_all_shared, export_query, export_query_shared, export_send_all,
-    export_send_all_shared, import_call_all, import_call_all_shared, import_query,
-    import_query_shared, import_send_all, import_send_all_shared,
-};
+pub use export::Exported;
+pub use import::Imported;
 pub use wire::{Remote, Wire};
 
 pub use iceoryx2::prelude::ZeroCopySend;

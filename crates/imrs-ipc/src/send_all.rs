@@ -67,7 +67,7 @@ impl<M: Clone + Send + 'static, R: Default + Send + 'static> Forward<M, R>
 /// Exports `port`, a `SENDALL` port, to the other processes of `remote`'s cell: its owner's
 /// broadcasts reach their modules too, each of which answers as a user in this process
 /// would. Call it within the tokio runtime the cell runs on.
-pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -83,7 +83,7 @@ pub fn export_send_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// queries reach their modules too, each answered by that module's response handler when
 /// its order says, as for a user in this process. Call it within the tokio runtime the cell
 /// runs on.
-pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -97,7 +97,7 @@ pub fn export_call_all<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// one sample where it lies (one built on the heap is copied into a sample once).
 /// The user module builds its reply in place ([`Shared::loan_reply`]), which the owner
 /// reads where it lies. The sample is let go when every process has dropped its handles.
-pub fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::SendAll, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -108,7 +108,7 @@ pub fn export_send_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>
 /// [`export_call_all`] does a port of values, and as [`export_send_all_shared`] carries
 /// them: each query sent once, read in place by every remote user's response handler,
 /// whose answer, built in place, the owner reads where it lies.
-pub fn export_call_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_call_all_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::CallAll, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -186,7 +186,7 @@ where
 /// `remote`'s cell: the owner's query to a module there waits for that module's response
 /// handler, which runs when the module's order says. Call it within the tokio runtime the
 /// cell runs on.
-pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Req, Rep, usage::Query, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -200,7 +200,7 @@ pub fn export_query<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
 /// another process is copied once. The user module's response handler, in its own
 /// process, reads the query where it lies and builds its answer in place
 /// ([`Shared::loan_reply`]), which the owner reads where it lies.
-pub fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
+pub(crate) fn export_query_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
     remote: &Remote,
     port: &Port<Shared<Req>, Shared<Rep>, usage::Query, L, N>,
 ) -> Result<Exported, IpcError> {
@@ -274,7 +274,7 @@ where
 /// the same name and types, to which `module` attaches and receives the owner's
 /// broadcasts as in one process. Connects at once, refused as [`crate::import`] is. Call it
 /// within the tokio runtime the cell runs on.
-pub fn import_send_all<Req: Wire, Rep: Wire>(
+pub(crate) fn import_send_all<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -288,7 +288,7 @@ pub fn import_send_all<Req: Wire, Rep: Wire>(
 /// process; the owner's queries wait for it, and it runs when `module`'s order says.
 /// Connects at once, refused as [`crate::import`] is. Call it within the tokio runtime the
 /// cell runs on.
-pub fn import_call_all<Req: Wire, Rep: Wire>(
+pub(crate) fn import_call_all<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -301,7 +301,7 @@ pub fn import_call_all<Req: Wire, Rep: Wire>(
 /// [`export_send_all_shared`], as [`import_send_all`] does a port of values: `module`
 /// receives each broadcast where it lies in shared memory, and builds its reply in place
 /// ([`Shared::loan_reply`]), which crosses back with nothing copied.
-pub fn import_send_all_shared<Req: Wire, Rep: Wire>(
+pub(crate) fn import_send_all_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -313,7 +313,7 @@ pub fn import_send_all_shared<Req: Wire, Rep: Wire>(
 /// Imports a `CALLALL` port of messages built in place ([`Shared`]), exported with
 /// [`export_call_all_shared`], as [`import_call_all`] does a port of values: `module`'s
 /// response handler reads each query where it lies, and builds its answer in place.
-pub fn import_call_all_shared<Req: Wire, Rep: Wire>(
+pub(crate) fn import_call_all_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -326,7 +326,7 @@ pub fn import_call_all_shared<Req: Wire, Rep: Wire>(
 /// answers the owner's queries with its response handler as in one process, when its order
 /// says. Connects at once, refused as [`crate::import`] is. Call it within the tokio
 /// runtime the cell runs on.
-pub fn import_query<Req: Wire, Rep: Wire>(
+pub(crate) fn import_query<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,
@@ -339,7 +339,7 @@ pub fn import_query<Req: Wire, Rep: Wire>(
 /// [`export_query_shared`], as [`import_query`] does a port of values: `module`'s response
 /// handler reads each query where it lies in shared memory, and builds its answer in place
 /// ([`Shared::loan_reply`]), which crosses back with nothing copied.
-pub fn import_query_shared<Req: Wire, Rep: Wire>(
+pub(crate) fn import_query_shared<Req: Wire, Rep: Wire>(
     remote: &Remote,
     port: &str,
     owner: &str,

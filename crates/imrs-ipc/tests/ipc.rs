@@ -10,7 +10,7 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 use imrs_core::imrs_ports::{
     AnyUser, End, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError, usage,
 };
-use imrs_ipc::{FromBytes, IpcError, Remote, ZeroCopySend, export, import, import_shared};
+use imrs_ipc::{FromBytes, Imported, IpcError, Remote, ZeroCopySend, export, import};
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -247,7 +247,10 @@ async fn a_send_crosses_to_the_owners_process_and_its_reply_comes_back() {
     let cell = cell("send");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     // The module's code is what it would be in one process.
     let mut asker = imported.port().user_named("ASKER").unwrap();
     for value in 1..=200 {
@@ -336,7 +339,10 @@ async fn a_send_polled_outside_the_runtime_crosses_and_its_reply_wakes_it() {
     let cell = cell("outside-send");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     let sender = std::thread::spawn(move || {
         (1..=200)
@@ -355,9 +361,11 @@ async fn a_module_not_on_the_user_list_is_refused_by_name() {
     let cell = cell("unlisted");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let error = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "STRANGER")
-        .err()
-        .expect("refused");
+    let error = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "STRANGER",
+    )
+    .err()
+    .expect("refused");
     assert_eq!(
         error,
         IpcError::Refused(WireError::NotOnUserList {
@@ -373,9 +381,10 @@ async fn a_type_the_other_process_does_not_share_is_refused_naming_the_port() {
     let cell = cell("types");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let error = import::<Wide, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER")
-        .err()
-        .expect("refused");
+    let error =
+        import::<Imported<Wide, Number, usage::Receive>, _>(&remote, "DOUBLE", "DOUBLER", "ASKER")
+            .err()
+            .expect("refused");
     assert!(
         matches!(&error, IpcError::TypeMismatch { port, .. } if port == "DOUBLE"),
         "{error:?}"
@@ -387,7 +396,10 @@ async fn an_owner_killed_mid_rendezvous_fails_the_sender_and_its_restart_is_serv
     let cell = cell("kill");
     let mut first = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     assert_eq!(
         within(5, asker.send(Number { value: 1 }))
@@ -414,7 +426,10 @@ async fn two_cells_with_the_same_port_names_never_meet() {
     let _owner_b = owner(&b, "DOUBLE");
     for cell in [&a, &b] {
         let remote = Remote::new(cell).unwrap();
-        let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+        let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+            &remote, "DOUBLE", "DOUBLER", "ASKER",
+        )
+        .unwrap();
         let mut asker = imported.port().user_named("ASKER").unwrap();
         assert_eq!(
             within(5, asker.send(Number { value: 8 }))
@@ -509,7 +524,10 @@ async fn a_malformed_request_is_refused_and_the_owner_keeps_serving() {
     }
     // The owner still serves its real users.
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     assert_eq!(
         within(5, asker.send(Number { value: 4 }))
@@ -525,7 +543,10 @@ async fn a_user_timeout_holds_across_processes_and_the_late_reply_harms_nothing(
     let cell = cell("timeout");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported
         .port()
         .user_named("ASKER")
@@ -563,7 +584,10 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
     let cell = cell("permissions");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     assert_eq!(
         within(5, asker.send(Number { value: 1 }))
@@ -575,10 +599,11 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
     // And a port whose broadcasts go out on a publish-subscribe service of its own.
     let frames: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT"]));
-    let _broadcasts = imrs_ipc::export_send_all_shared(&remote, &frames).unwrap();
-    let listening =
-        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
-            .unwrap();
+    let _broadcasts = imrs_ipc::export(&remote, &frames).unwrap();
+    let listening = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
+        &remote, "FRAMES", "CAMERA", "LEFT",
+    )
+    .unwrap();
     let mut left = listening.port().user_named("LEFT").unwrap();
     let echo = tokio::spawn(async move {
         let (frame, reply) = left.receive().await.unwrap();
@@ -709,8 +734,10 @@ async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
         .expect("the responder speaks");
     assert_eq!(line.trim(), "ready", "the responder failed: {line}");
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_response::<Number, Number>(&remote, "TRIPLE", "TRIPLER", "ASKER").unwrap();
+    let imported = imrs_ipc::import::<Imported<Number, Number, usage::Response>, _>(
+        &remote, "TRIPLE", "TRIPLER", "ASKER",
+    )
+    .unwrap();
     // The module queries, as it would a port of its own process.
     let mut asker = imported.port().user_named("ASKER").unwrap();
     for value in 1..=50 {
@@ -718,9 +745,11 @@ async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
         assert_eq!(answer.value, 3 * value);
     }
     // And the owner's list holds: a module it does not know is refused by name.
-    let error = imrs_ipc::import_response::<Number, Number>(&remote, "TRIPLE", "TRIPLER", "OTHER")
-        .err()
-        .expect("refused");
+    let error = imrs_ipc::import::<Imported<Number, Number, usage::Response>, _>(
+        &remote, "TRIPLE", "TRIPLER", "OTHER",
+    )
+    .err()
+    .expect("refused");
     assert_eq!(
         error,
         IpcError::Refused(WireError::NotOnUserList {
@@ -737,7 +766,7 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
     let cell = cell("send-all");
     let port: Port<Number, Number, usage::SendAll, AnyUser, 2> =
         Port::declare(PortSpec::new("NEWS", "BROADCASTER").user_list(["ASKER", "ASKER_2"]));
-    let _exported = imrs_ipc::export_send_all(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut broadcaster = port.owner().unwrap();
     let listeners: Vec<Peer> = ["ASKER", "ASKER_2"]
         .iter()
@@ -770,10 +799,13 @@ async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
         Port::declare(PortSpec::new("SINGLE", "OWNER"));
     let remote = Remote::new(&cell).unwrap();
     let _exported = imrs_ipc::export(&remote, &port).unwrap();
-    let _first = import::<Number, Number>(&remote, "SINGLE", "OWNER", "FIRST").unwrap();
-    let error = import::<Number, Number>(&remote, "SINGLE", "OWNER", "SECOND")
-        .err()
-        .expect("refused");
+    let _first =
+        import::<Imported<Number, Number, usage::Receive>, _>(&remote, "SINGLE", "OWNER", "FIRST")
+            .unwrap();
+    let error =
+        import::<Imported<Number, Number, usage::Receive>, _>(&remote, "SINGLE", "OWNER", "SECOND")
+            .err()
+            .expect("refused");
     assert_eq!(
         error,
         IpcError::Refused(WireError::TooManyUsers {
@@ -789,7 +821,10 @@ async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() 
     let cell = cell("dropped");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     // The owner takes 1.2 s over 1200; the sender gives up after 200 ms, dropping the send.
     let gave_up = tokio::time::timeout(
@@ -818,14 +853,19 @@ async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceory
     let users: Vec<_> = (0..USERS)
         .map(|n| {
             let module = format!("USER_{n}");
-            import::<Number, Number>(&remote, "MANY", "OWNER", &module)
+            import::<Imported<Number, Number, usage::Receive>, _>(&remote, "MANY", "OWNER", &module)
                 .unwrap_or_else(|error| panic!("{module}: {error}"))
         })
         .collect();
     // One more is refused by the port, naming it, as in one process.
-    let error = import::<Number, Number>(&remote, "MANY", "OWNER", "ONE_TOO_MANY")
-        .err()
-        .expect("refused");
+    let error = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote,
+        "MANY",
+        "OWNER",
+        "ONE_TOO_MANY",
+    )
+    .err()
+    .expect("refused");
     assert_eq!(
         error,
         IpcError::Refused(WireError::TooManyUsers {
@@ -855,9 +895,10 @@ async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceory
 async fn importing_a_port_that_nobody_exports_says_so_at_once() {
     let remote = Remote::new(&cell("nobody")).unwrap();
     let started = std::time::Instant::now();
-    let error = import::<Number, Number>(&remote, "NOBODYS", "OWNER", "USER")
-        .err()
-        .expect("refused");
+    let error =
+        import::<Imported<Number, Number, usage::Receive>, _>(&remote, "NOBODYS", "OWNER", "USER")
+            .err()
+            .expect("refused");
     assert_eq!(
         error,
         IpcError::NoOwner {
@@ -875,7 +916,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
     let cell = cell("call-all");
     let port: Port<Number, Number, usage::CallAll, AnyUser, 3> =
         Port::declare(PortSpec::new("POLL", "CALLER").user_list(["REMOTE_1", "REMOTE_2", "LOCAL"]));
-    let _exported = imrs_ipc::export_call_all(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut caller = port.owner().unwrap();
     // A response handler in this process, beside two in others (which answer with 4 n).
     let mut local = port
@@ -921,7 +962,10 @@ async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_send
     let cell = cell("tight");
     let remote = Remote::new(&cell).unwrap();
     let mut owner = started_owner("tight-owner", &cell, "DOUBLE");
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     // Three deaths, each of a new copy of the owner: whether the spinning sender's own
     // turn or the bridge's task forwarded the last request is a race, and the death must
@@ -948,7 +992,10 @@ async fn a_tight_port_is_served_whether_the_other_side_spins_or_has_parked() {
     let cell = cell("tight-turns");
     let _owner = started_owner("tight-owner", &cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import::<Number, Number>(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &remote, "DOUBLE", "DOUBLER", "ASKER",
+    )
+    .unwrap();
     // The owner declared the port TIGHT: the importing module's waits spin too.
     assert_eq!(imported.port().process_type(), ProcessType::Tight);
     let mut asker = imported.port().user_named("ASKER").unwrap();
@@ -1002,7 +1049,7 @@ async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fai
     // ASK_STATUS(N): USAGE=QUERY, USERLIST=(CHILD): the parent asks its child.
     let port: Port<Number, Number, usage::Query, AnyUser, 1> =
         Port::declare(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
-    let _exported = imrs_ipc::export_query(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
     let child = peer(&["child", &cell, "ASK_STATUS", "CHILD", "10"]);
     until_users(&parent, 1).await;
@@ -1052,7 +1099,10 @@ async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
     let cell = cell("shared");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
+        &remote, "IMAGE", "VISION", "CAMERA",
+    )
+    .unwrap();
     let mut camera = imported.port().user_named("CAMERA").unwrap();
     let mut replies = Vec::new();
     let mut sums = Vec::new();
@@ -1104,7 +1154,10 @@ async fn loans_beyond_what_the_port_allows_are_refused_by_name_and_one_given_bac
     let cell = cell("loans");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
+        &remote, "IMAGE", "VISION", "CAMERA",
+    )
+    .unwrap();
     let mut camera = imported.port().user_named("CAMERA").unwrap();
     let mut loans = Vec::new();
     let refused = loop {
@@ -1140,8 +1193,14 @@ async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served(
     let cell = cell("copied");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
-    let other = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA_2").unwrap();
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
+        &remote, "IMAGE", "VISION", "CAMERA",
+    )
+    .unwrap();
+    let other = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
+        &remote, "IMAGE", "VISION", "CAMERA_2",
+    )
+    .unwrap();
     let mut camera = imported.port().user_named("CAMERA").unwrap();
     let second = other.port().user_named("CAMERA_2").unwrap();
     // A loan of the other module's: sent on this port, it must be copied, not sent through
@@ -1164,9 +1223,13 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
     let cell = cell("shared-query");
     let _inspector = started_owner("inspector", &cell, "INSPECT");
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_response_shared::<Frame, Frame>(&remote, "INSPECT", "INSPECTOR", "ASKER")
-            .unwrap();
+    let imported = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::Response>, _>(
+        &remote,
+        "INSPECT",
+        "INSPECTOR",
+        "ASKER",
+    )
+    .unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
     for seed in 1..=10u64 {
         let mut frame = asker.loan().unwrap();
@@ -1186,7 +1249,7 @@ async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_p
     let cell = cell("shared-owner-query");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Query, AnyUser, 1> =
         Port::declare(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
-    let _exported = imrs_ipc::export_query_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
     let child = peer(&["frame-child", &cell, "ASK_FRAME", "CHILD", "11"]);
     until_users(&parent, 1).await;
@@ -1236,7 +1299,10 @@ async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() 
     let cell = cell("loan-kill");
     let mut first = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
-    let imported = import_shared::<Frame, Frame>(&remote, "IMAGE", "VISION", "CAMERA").unwrap();
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
+        &remote, "IMAGE", "VISION", "CAMERA",
+    )
+    .unwrap();
     let mut camera = imported.port().user_named("CAMERA").unwrap();
     // Two frames built while the owner lives; then kill -9 it.
     let (mut doomed, mut kept) = (camera.loan().unwrap(), camera.loan().unwrap());
@@ -1370,7 +1436,7 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
     let cell = cell("shared-send-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
-    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-listener", &cell, "FRAMES");
     until_users(&camera, 2).await;
@@ -1390,7 +1456,7 @@ async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_proce
     let cell = cell("shared-call-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::CallAll, AnyUser, 2> =
         Port::declare(PortSpec::new("LOOK", "CAMERA").user_list(["LEFT", "RIGHT"]));
-    let _exported = imrs_ipc::export_call_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-answerer", &cell, "LOOK");
     until_users(&camera, 2).await;
@@ -1409,7 +1475,7 @@ async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_ans
     let cell = cell("shared-send-all-kill");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
-    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let mut users = frame_users("frame-listener", &cell, "FRAMES");
     until_users(&camera, 2).await;
@@ -1497,7 +1563,7 @@ async fn read_in_place_here_and_in_two_other_processes(
     let cell = cell(test);
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
-    let _exported = imrs_ipc::export_send_all_shared(&Remote::new(&cell).unwrap(), &port).unwrap();
+    let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     // HERE, a user in the owner's process, answers as the others do, from the heap.
     let mut here = port.user_named("HERE").unwrap();
@@ -1548,8 +1614,9 @@ async fn read_in_place_here_and_in_two_other_processes(
 async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_unlisted_module() {
     let cell = cell("shared-send-all-refused");
     let remote = Remote::new(&cell).unwrap();
-    let nobody =
-        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT");
+    let nobody = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
+        &remote, "FRAMES", "CAMERA", "LEFT",
+    );
     assert_eq!(
         nobody.err(),
         Some(IpcError::NoOwner {
@@ -1558,20 +1625,22 @@ async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_
     );
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
-    let _exported = imrs_ipc::export_send_all_shared(&remote, &port).unwrap();
+    let _exported = imrs_ipc::export(&remote, &port).unwrap();
     // The broadcasts are of frames, not numbers.
-    let error =
-        imrs_ipc::import_send_all_shared::<Number, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
-            .err()
-            .expect("refused");
+    let error = imrs_ipc::import::<Imported<Shared<Number>, Shared<Frame>, usage::SendAll>, _>(
+        &remote, "FRAMES", "CAMERA", "LEFT",
+    )
+    .err()
+    .expect("refused");
     assert!(
         matches!(&error, IpcError::TypeMismatch { port, .. } if port == "FRAMES"),
         "{error:?}"
     );
-    let error =
-        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "STRANGER")
-            .err()
-            .expect("refused");
+    let error = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
+        &remote, "FRAMES", "CAMERA", "STRANGER",
+    )
+    .err()
+    .expect("refused");
     assert_eq!(
         error,
         IpcError::Refused(WireError::NotOnUserList {
@@ -1594,7 +1663,7 @@ async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_pr
     for export in 0..2 {
         // The port, declared and exported anew: nothing of the first export is left here.
         let port = declare();
-        let exported = imrs_ipc::export_send_all_shared(&remote, &port).unwrap();
+        let exported = imrs_ipc::export(&remote, &port).unwrap();
         if export == 0 {
             users = frame_users("frame-listener", &cell, "FRAMES");
         }
@@ -1619,9 +1688,10 @@ async fn an_owner_of_broadcasts_killed_mid_run_and_started_again_reaches_its_use
     let cell = cell("shared-send-all-owner-killed");
     let mut first = started(&["camera", &cell, "FRAMES", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_send_all_shared::<Frame, Frame>(&remote, "FRAMES", "CAMERA", "LEFT")
-            .unwrap();
+    let imported = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
+        &remote, "FRAMES", "CAMERA", "LEFT",
+    )
+    .unwrap();
     let mut left = imported.port().user_named("LEFT").unwrap();
     // LEFT answers as the camera checks: read in place, three times word 4.
     let (seen, mut heard) = tokio::sync::mpsc::unbounded_channel();
@@ -1681,8 +1751,13 @@ async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_a
     let cell = cell("query-owner-killed");
     let first = started(&["parent", &cell, "ASK_STATUS", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_query::<Number, Number>(&remote, "ASK_STATUS", "PARENT", "CHILD").unwrap();
+    let imported = imrs_ipc::import::<Imported<Number, Number, usage::Query>, _>(
+        &remote,
+        "ASK_STATUS",
+        "PARENT",
+        "CHILD",
+    )
+    .unwrap();
     let child = imported.port().answer("CHILD", five_times).unwrap();
     let heard = answering(child);
     answers_an_owner_killed_and_started_again(heard, first, &["parent", &cell, "ASK_STATUS", "3"])
@@ -1694,8 +1769,10 @@ async fn an_owner_of_callalls_killed_mid_run_and_started_again_reaches_its_user_
     let cell = cell("call-all-owner-killed");
     let first = started(&["caller", &cell, "POLL", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_call_all::<Number, Number>(&remote, "POLL", "CALLER", "ANSWERER").unwrap();
+    let imported = imrs_ipc::import::<Imported<Number, Number, usage::CallAll>, _>(
+        &remote, "POLL", "CALLER", "ANSWERER",
+    )
+    .unwrap();
     let answerer = imported.port().answer("ANSWERER", five_times).unwrap();
     let heard = answering(answerer);
     answers_an_owner_killed_and_started_again(heard, first, &["caller", &cell, "POLL", "3"]).await;
@@ -1707,9 +1784,13 @@ async fn an_owner_of_broadcasts_of_numbers_killed_mid_run_and_started_again_reac
     let cell = cell("send-all-owner-killed");
     let first = started(&["announcer", &cell, "NEWS", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
-    let imported =
-        imrs_ipc::import_send_all::<Number, Number>(&remote, "NEWS", "ANNOUNCER", "HEARER")
-            .unwrap();
+    let imported = imrs_ipc::import::<Imported<Number, Number, usage::SendAll>, _>(
+        &remote,
+        "NEWS",
+        "ANNOUNCER",
+        "HEARER",
+    )
+    .unwrap();
     let mut hearer = imported.port().user_named("HEARER").unwrap();
     let (answered, heard) = tokio::sync::mpsc::unbounded_channel();
     tokio::spawn(async move {

@@ -171,7 +171,8 @@ impl RemoteDevices {
         let mut imported = Vec::new();
         for device in Device::of_line(line) {
             let user = device.user();
-            let port = import::<DeviceCall, DeviceAnswer>(remote, &device.port(), WORLD, &user)?;
+            let port: Imported<DeviceCall, DeviceAnswer> =
+                import(remote, &device.port(), WORLD, &user)?;
             let end = port
                 .port()
                 .user_named(user.as_str())

@@ -55,12 +55,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
-use imrs_ipc::{
-    FromBytes, Remote, ZeroCopySend, export, export_call_all, export_query, export_response,
-    export_response_shared, export_send_all, export_send_all_shared, export_shared, import,
-    import_call_all, import_call_all_shared, import_query, import_query_shared, import_send_all,
-    import_send_all_shared,
-};
+use imrs_ipc::{FromBytes, Imported, Remote, ZeroCopySend, export, import};
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -156,7 +151,7 @@ async fn owner(cell: &str, port: &str, process_type: ProcessType) -> Result<(), 
 async fn vision(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Receive, AnyUser, 2> =
         Port::declare(PortSpec::new(port, "VISION").user_list(["CAMERA", "CAMERA_2"]));
-    let _exported = export_shared(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut vision = port.owner()?;
     let sum = |frame: &Frame| {
@@ -188,7 +183,7 @@ async fn vision(cell: &str, port: &str) -> Result<(), Error> {
 async fn inspector(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Response, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "INSPECTOR").user_list(["ASKER"]));
-    let _exported = export_response_shared(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let factor = 5;
     let mut inspector = port.answer(port.owner_module().clone(), inspect)?;
@@ -211,8 +206,12 @@ fn inspect(factor: &u64, mut frame: Shared<Frame>) -> Shared<Frame> {
 }
 
 async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
-    let imported =
-        import_query_shared::<Frame, Frame>(&Remote::new(cell)?, port, "PARENT", module)?;
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Query>, _>(
+        &Remote::new(cell)?,
+        port,
+        "PARENT",
+        module,
+    )?;
     answer(imported.port(), module, inspect, 7, n).await?;
     imported.settled().await;
     Ok(())
@@ -221,7 +220,7 @@ async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<()
 async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "CAMERA").user_list(["LEFT"]));
-    let _exported = export_send_all_shared(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut camera = port.owner()?;
     camera.peer_attached().await;
@@ -240,7 +239,7 @@ async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::Query, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "PARENT").user_list(["CHILD"]));
-    let _exported = export_query(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut parent = port.owner()?;
     parent.peer_attached().await;
@@ -253,7 +252,7 @@ async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::CallAll, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "CALLER").user_list(["ANSWERER"]));
-    let _exported = export_call_all(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut caller = port.owner()?;
     caller.peer_attached().await;
@@ -266,7 +265,7 @@ async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 async fn announcer(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::SendAll, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "ANNOUNCER").user_list(["HEARER"]));
-    let _exported = export_send_all(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut announcer = port.owner()?;
     announcer.peer_attached().await;
@@ -297,8 +296,12 @@ async fn frame_listener(
     n: &str,
     factor: &str,
 ) -> Result<(), Error> {
-    let imported =
-        import_send_all_shared::<Frame, Frame>(&Remote::new(cell)?, port, "CAMERA", module)?;
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
+        &Remote::new(cell)?,
+        port,
+        "CAMERA",
+        module,
+    )?;
     let factor = factor.parse::<u64>()?;
     let mut listening = imported.port().user_named(module)?;
     for _ in 0..n.parse::<u64>()? {
@@ -317,8 +320,12 @@ async fn frame_answerer(
     n: &str,
     factor: &str,
 ) -> Result<(), Error> {
-    let imported =
-        import_call_all_shared::<Frame, Frame>(&Remote::new(cell)?, port, "CAMERA", module)?;
+    let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::CallAll>, _>(
+        &Remote::new(cell)?,
+        port,
+        "CAMERA",
+        module,
+    )?;
     answer(imported.port(), module, inspect, factor.parse()?, n).await?;
     imported.settled().await;
     Ok(())
@@ -327,7 +334,7 @@ async fn frame_answerer(
 async fn responder(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::Response, AnyUser, 1> =
         Port::declare(PortSpec::new(port, "TRIPLER").user_list(["ASKER"]));
-    let _exported = export_response(&Remote::new(cell)?, &port)?;
+    let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     // The module's state: the factor its handler answers with.
     let factor = 3;
@@ -338,8 +345,12 @@ async fn responder(cell: &str, port: &str) -> Result<(), Error> {
 }
 
 async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
-    let imported =
-        import_send_all::<Number, Number>(&Remote::new(cell)?, port, "BROADCASTER", module)?;
+    let imported = import::<Imported<Number, Number, usage::SendAll>, _>(
+        &Remote::new(cell)?,
+        port,
+        "BROADCASTER",
+        module,
+    )?;
     let mut listening = imported.port().user_named(module)?;
     for _ in 0..n.parse::<u64>()? {
         let (number, reply) = listening.receive().await?;
@@ -354,14 +365,24 @@ async fn listener(cell: &str, port: &str, module: &str, n: &str) -> Result<(), E
 }
 
 async fn answerer(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
-    let imported = import_call_all::<Number, Number>(&Remote::new(cell)?, port, "CALLER", module)?;
+    let imported = import::<Imported<Number, Number, usage::CallAll>, _>(
+        &Remote::new(cell)?,
+        port,
+        "CALLER",
+        module,
+    )?;
     answer(imported.port(), module, multiply, 4, n).await?;
     imported.settled().await;
     Ok(())
 }
 
 async fn child(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
-    let imported = import_query::<Number, Number>(&Remote::new(cell)?, port, "PARENT", module)?;
+    let imported = import::<Imported<Number, Number, usage::Query>, _>(
+        &Remote::new(cell)?,
+        port,
+        "PARENT",
+        module,
+    )?;
     answer(imported.port(), module, multiply, 5, n).await?;
     imported.settled().await;
     Ok(())
@@ -396,7 +417,12 @@ where
 }
 
 async fn user(cell: &str, port: &str, module: &str, n: &str) -> Result<(), Error> {
-    let imported = import::<Number, Number>(&Remote::new(cell)?, port, "DOUBLER", module)?;
+    let imported = import::<Imported<Number, Number, usage::Receive>, _>(
+        &Remote::new(cell)?,
+        port,
+        "DOUBLER",
+        module,
+    )?;
     let mut asker = imported.port().user_named(module)?;
     for value in 1..=n.parse::<u64>()? {
         let double = asker.send(Number { value }).await?;
