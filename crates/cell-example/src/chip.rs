@@ -305,30 +305,25 @@ pub fn chip_it(
     let (zone_request, zone_release) = (ports.zone_request.clone(), ports.zone_release.clone());
     let (zone_reserve, zone_free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
     let robot = devices.robot(RobotId::new(line, Role::ChipIt));
-    let name = n.chip_it.clone();
     let background = move |ctx: Ctx<ChipItState>| {
         let (ready_port, share_feeder, frequency) =
             (ready_port.clone(), share_feeder.clone(), frequency.clone());
-        let (zone_request, zone_release, robot, name) = (
-            zone_request.clone(),
-            zone_release.clone(),
-            robot.clone(),
-            name.clone(),
-        );
+        let (zone_request, zone_release, robot) =
+            (zone_request.clone(), zone_release.clone(), robot.clone());
         let (zone_reserve, zone_free) = (zone_reserve.clone(), zone_free.clone());
         let waits = Arc::clone(&waits);
         async move {
             let mut ready_to_chip = ready_port.owner()?;
-            let mut frequency = frequency.user_named(name.clone())?;
+            let mut frequency = ctx.user(frequency.users_side())?;
             let mut access = match policy {
                 FeederPolicy::Appendix => Access::Appendix(share_feeder.owner()?),
                 FeederPolicy::Arbiter => Access::Arbiter {
-                    request: zone_request.user_named(&name)?,
-                    release: zone_release.user_named(&name)?,
+                    request: zone_request.user(&ctx)?,
+                    release: zone_release.user(&ctx)?,
                 },
                 FeederPolicy::Coordinator => Access::Coordinator {
-                    reserve: zone_reserve.user_named(&name)?,
-                    free: zone_free.user_named(&name)?,
+                    reserve: zone_reserve.user(&ctx)?,
+                    free: zone_free.user(&ctx)?,
                 },
             };
             let mut work = work_schedule();
@@ -379,7 +374,7 @@ pub fn chip_it(
         .task("FREEZE_CARD", move |ctx| {
             let (port, relay) = (freeze_port.clone(), relay.clone());
             async move {
-                let mut ready_to_chip = port.user_named("FREEZE_CARD")?;
+                let mut ready_to_chip = ctx.task_user(&port)?;
                 drive_relay(&ctx, &relay, &mut ready_to_chip).await?;
                 Ok(())
             }

@@ -147,7 +147,7 @@ pub fn gate(
         .task("RELEASE", move |ctx| {
             let (port, device, death) = (release_port.clone(), device.clone(), Arc::clone(&death));
             async move {
-                let mut let_1_go = port.user_named("RELEASE")?;
+                let mut let_1_go = ctx.task_user(&port)?;
                 let dies_at = *death.lock().unwrap_or_else(PoisonError::into_inner);
                 loop {
                     let dying = async {

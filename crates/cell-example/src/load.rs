@@ -64,7 +64,7 @@ pub fn load_it(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec<L
                 })?;
                 let mut ask_child1 = ports.ask_child1.owner()?;
                 let mut ask_child2 = ports.ask_child2.owner()?;
-                let mut frequency = ports.frequency.user_named(n.load_it.clone())?;
+                let mut frequency = ctx.user(ports.frequency.users_side())?;
                 loop {
                     ctx.delay(Duration::from_secs(4)).await;
                     // QUERY ASK_CHILD1.STATUS(RC, NUM_LOADED, CYCLE_TIME): is LOAD_CARD ok?
@@ -214,7 +214,7 @@ pub fn load_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec
     .task("FREEZE_PALLET", move |ctx| {
         let (port, relay) = (freeze_port.clone(), relay.clone());
         async move {
-            let mut pallet_in_place = port.user_named("FREEZE_PALLET")?;
+            let mut pallet_in_place = ctx.task_user(&port)?;
             drive_relay(&ctx, &relay, &mut pallet_in_place).await?;
             Ok(())
         }
@@ -257,11 +257,10 @@ pub fn screw_in_card(line: Line, ports: &LinePorts, devices: &Devices) -> Module
         .respond(&ports.ask_child2.handler("STATUS"), |_: &(), ()| 0);
     let port = ports.card_in_place.clone();
     let robot = devices.robot(RobotId::new(line, Role::ScrewInCard));
-    let name = n.screw_in_card.clone();
     spec.task(n.screw_in_card.clone(), move |ctx| {
-        let (port, robot, name) = (port.clone(), robot.clone(), name.clone());
+        let (port, robot) = (port.clone(), robot.clone());
         async move {
-            let mut card_in_place = port.user_named(name)?.with_timeout(Duration::from_secs(30));
+            let mut card_in_place = ctx.user(&port)?.with_timeout(Duration::from_secs(30));
             loop {
                 // {Prepare to screw in next card}
                 insisted(&ctx, "going home", || robot.move_to(Target::Home)).await;

@@ -5,10 +5,10 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::Cell;
 use imrs_core::imrs_ports::{
     AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage,
 };
+use imrs_core::{Cell, Ctx};
 use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
 use imrs_sim::{Line, PalletId};
 
@@ -110,11 +110,15 @@ impl<Req: Send + 'static> fmt::Debug for ZoneLink<Req> {
 }
 
 impl<Req: Send + 'static> ZoneLink<Req> {
-    /// `module`'s end to send on.
-    pub fn user_named(&self, module: &str) -> Result<End<Req, (), usage::Send>, WireError> {
+    /// The end of the task `ctx`'s module to send on: to the port declared here, or
+    /// imported from another process.
+    pub fn user<S: Send + Sync + 'static>(
+        &self,
+        ctx: &Ctx<S>,
+    ) -> Result<End<Req, (), usage::Send>, WireError> {
         match self {
-            ZoneLink::Here(port) => port.user_named(module),
-            ZoneLink::Imported(port) => port.port().user_named(module),
+            ZoneLink::Here(port) => ctx.user(port),
+            ZoneLink::Imported(port) => ctx.user(port.port()),
         }
     }
 

@@ -269,6 +269,23 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         port.user_named(self.module.name.clone())
     }
 
+    /// Attaches a user end of `port` for this task, under the task's own name: for the
+    /// seed's intertask ports, whose user is a task of the owning module (GATE's task RELEASE
+    /// on GATE's LET_1_GO), checked as [`Ctx::user`] checks a module.
+    pub fn task_user<Req, Rep, U, L, const N: usize>(
+        &self,
+        port: &Port<Req, Rep, U, L, N>,
+    ) -> Result<End<Req, Rep, U::Complement>, WireError>
+    where
+        Req: Send + 'static,
+        Rep: Send + 'static,
+        U: Usage,
+        U::Complement: Plain,
+        L: UserList,
+    {
+        port.user_named(self.task.clone())
+    }
+
     /// The cell's clock.
     pub fn clock(&self) -> &SharedClock {
         &self.module.cell.clock
