@@ -45,8 +45,8 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
-use imrs_core::imrs_ports::{AnyUser, End, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{FromBytes, Imported, IpcError, Remote, Wire, export, import};
+use imrs_ports::{AnyUser, End, Port, PortSpec, ProcessType, Shared, usage};
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 

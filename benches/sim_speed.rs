@@ -8,8 +8,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use imrs_core::imrs_ports::{Instant as SimInstant, VirtualClock};
 use imrs_core::time::drive;
+use imrs_ports::{Instant as SimInstant, VirtualClock};
 use imrs_sim::{FeederId, Line, RobotId, Role, Sim, SimConfig, Target};
 
 /// Simulated seconds per iteration.

@@ -5,8 +5,8 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
 use imrs_coord::zones::Reservations;
-use imrs_core::imrs_ports::{End, ReplyHandle, select, usage};
 use imrs_core::prelude::*;
+use imrs_ports::{End, ReplyHandle, select, usage};
 use imrs_sim::layout::LINK_RADIUS;
 use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station, Target};
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::{Duration, UNIX_EPOCH};
 
 use clap::Parser;
-use imrs_core::imrs_ports::RealClock;
+use imrs_ports::RealClock;
 use imrs_sim::Line;
 
 use crate::chip::FeederPolicy;

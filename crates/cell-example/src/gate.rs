@@ -4,8 +4,8 @@
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{BoundedBuffer, Instant};
 use imrs_core::prelude::*;
+use imrs_ports::{BoundedBuffer, Instant};
 use imrs_sim::Line;
 
 use crate::devices::Devices;

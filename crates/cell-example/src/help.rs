@@ -4,7 +4,7 @@ use std::future::Future;
 use std::time::Duration;
 
 use imrs_core::Ctx;
-use imrs_core::imrs_ports::{End, usage};
+use imrs_ports::{End, usage};
 use imrs_sim::{DeviceError, PalletId};
 
 use crate::alarms::{AlarmKind, alarm};

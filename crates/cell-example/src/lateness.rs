@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn the_shortest_timeout_is_that_of_the_cells_ports() {
-        use imrs_core::imrs_ports::{SharedClock, VirtualClock};
+        use imrs_ports::{SharedClock, VirtualClock};
         use imrs_sim::Line;
 
         use crate::ports::LinePorts;

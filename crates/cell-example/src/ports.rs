@@ -5,11 +5,9 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{
-    AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage,
-};
 use imrs_core::{Cell, Ctx};
 use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
+use imrs_ports::{AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage};
 use imrs_sim::{Line, PalletId};
 
 use crate::chip::FeederPolicy;

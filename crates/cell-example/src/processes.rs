@@ -31,9 +31,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_core::CellErrors;
-use imrs_core::imrs_ports::{Instant, RealClock, SharedClock, usage};
 use imrs_core::prelude::*;
 use imrs_ipc::{Exported, Imported, IpcError, Remote, export, import};
+use imrs_ports::{Instant, RealClock, SharedClock, usage};
 use imrs_sim::{Line, Sim, SimConfig};
 use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};

@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_core::prelude::*;
 use imrs_core::{CellError, CellErrors, Log, ModuleDecl, ModuleTree, time::drive};
+use imrs_ports::{Instant, RealClock, SharedClock, VirtualClock};
 use imrs_record::{RecordError, Recorder, Timeline};
 use imrs_sim::{
     Fault, FaultKind, FeederId, Line, PalletId, RobotId, RobotTimes, Role, Sim, SimConfig,

@@ -4,8 +4,8 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use imrs_core::imrs_ports::Name;
 use imrs_core::{Event, EventKind};
+use imrs_ports::Name;
 use imrs_sim::{Line, PalletId, RobotId, SimEvent, SimEventKind, Station};
 
 use crate::alarms::AlarmKind;

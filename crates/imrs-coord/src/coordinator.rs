@@ -14,8 +14,8 @@
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
-use imrs_core::imrs_ports::{AnyUser, End, Name, Port, PortSpec, SharedClock, select, usage};
 use imrs_core::prelude::*;
+use imrs_ports::{AnyUser, End, Name, Port, PortSpec, SharedClock, select, usage};
 
 use crate::zones::{Answer, Resources, ZoneError};
 
@@ -78,9 +78,9 @@ impl CoordinatorPorts {
     }
 
     /// Robot `robot`'s ends of the ports.
-    pub fn link(&self, robot: &str) -> Result<RobotLink, imrs_core::imrs_ports::WireError> {
+    pub fn link(&self, robot: &str) -> Result<RobotLink, imrs_ports::WireError> {
         let wake = self.wake.get(&Name::from(robot)).ok_or_else(|| {
-            imrs_core::imrs_ports::WireError::NotOnUserList {
+            imrs_ports::WireError::NotOnUserList {
                 port: format!("WAKE_{robot}").into(),
                 module: robot.into(),
             }
@@ -204,7 +204,7 @@ pub fn coordinator(
                     Message(
                         Name,
                         Message,
-                        imrs_core::imrs_ports::ReplyHandle<Result<Answer, String>>,
+                        imrs_ports::ReplyHandle<Result<Answer, String>>,
                     ),
                 }
                 let event = select()

@@ -316,10 +316,7 @@ fn reservations_grant_sweeps_that_keep_clear_and_queue_the_others() {
     );
     // D is clear of A and B but would block C, which asked first: it waits its turn.
     assert!(!space.request("ARM_D", &reach(0.1)));
-    assert_eq!(
-        space.release("ARM_B"),
-        Vec::<imrs_core::imrs_ports::Name>::new()
-    );
+    assert_eq!(space.release("ARM_B"), Vec::<imrs_ports::Name>::new());
     assert_eq!(space.release("ARM_A"), ["ARM_C"]);
     assert_eq!(space.release("ARM_C"), ["ARM_D"]);
     assert_eq!(space.holders(), ["ARM_D"]);

@@ -159,7 +159,7 @@ pub use cell::{Cell, Declare, ModuleHandle, ModuleOutcome};
 pub use check::{CellError, CellErrors};
 pub use event::{Event, EventKind, EventLog, Observed, Primitive};
 pub use exception::Exception;
-pub use imrs_ports;
+
 pub use log::{Log, Record};
 pub use module::ctx::{Ctx, PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
 pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult};

@@ -9,8 +9,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use counting_alloc::allocations;
-use imrs_core::imrs_ports::RealClock;
 use imrs_core::prelude::*;
+use imrs_ports::RealClock;
 
 const WARM_UP: u32 = 2_000;
 const MEASURED: u32 = 1_000;

@@ -7,7 +7,7 @@ mod counting_alloc;
 
 use counting_alloc::allocations;
 use imrs_core::Processor;
-use imrs_core::imrs_ports::{Port, PortSpec, usage};
+use imrs_ports::{Port, PortSpec, usage};
 
 #[test]
 fn a_rendezvous_on_one_processor_in_steady_state_allocates_nothing() {

@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::task::{Context, Poll};
 
-use imrs_core::imrs_ports::Priority;
 use imrs_core::prelude::*;
+use imrs_ports::Priority;
 
 /// One step of busy work: wakes itself and yields once, so that the processor chooses again.
 struct Step(bool);

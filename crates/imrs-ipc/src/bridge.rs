@@ -10,7 +10,7 @@ use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::{event, request_response};
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 

@@ -10,7 +10,7 @@
 //! which a broadcast makes for each user): the owner's own subscription then holds the
 //! sample, so the owner's handles read it where it lies too. A message built anywhere else
 //! (the heap) is copied into a sample once, when the port hands the broadcast over
-//! ([`Port::broadcast_with`](imrs_core::imrs_ports::transport::PortTransport::broadcast_with)), and goes out
+//! ([`Port::broadcast_with`](imrs_ports::transport::PortTransport::broadcast_with)), and goes out
 //! as one built in a loan does.
 
 use std::any::Any;
@@ -29,8 +29,8 @@ use iceoryx2::sample::Sample;
 use iceoryx2::sample_mut::SampleMut;
 use iceoryx2::service::port_factory::PortFactory as _;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
-use imrs_core::imrs_ports::shared::Buffer;
-use imrs_core::imrs_ports::{LoanError, Name, ReplyHandle, Shared};
+use imrs_ports::shared::Buffer;
+use imrs_ports::{LoanError, Name, ReplyHandle, Shared};
 use zerocopy::FromBytes;
 
 use crate::bridge::{MAX_PENDING, Svc, node, refusal, transport};

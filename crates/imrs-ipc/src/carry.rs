@@ -15,8 +15,8 @@ use iceoryx2::request_mut_uninit::RequestMutUninit;
 use iceoryx2::response::Response;
 use iceoryx2::response_mut::ResponseMut;
 use iceoryx2::response_mut_uninit::ResponseMutUninit;
-use imrs_core::imrs_ports::shared::Buffer;
-use imrs_core::imrs_ports::{LoanError, Name, Shared};
+use imrs_ports::shared::Buffer;
+use imrs_ports::{LoanError, Name, Shared};
 
 use crate::Wire;
 use crate::bridge::Svc;

@@ -6,7 +6,7 @@
 //! its `Port`, and a user's process imports an [`Imported`] of the same usage and message
 //! kind. A port of a usage or a message kind that cannot cross does not compile.
 
-use imrs_core::imrs_ports::{Port, Shared, UserList, usage};
+use imrs_ports::{Port, Shared, UserList, usage};
 
 use crate::export::Exported;
 use crate::import::Imported;
@@ -52,7 +52,7 @@ pub fn export<P: Export<W>, W>(remote: &Remote, port: &P) -> Result<Exported, Ip
 ///
 /// ```no_run
 /// # use imrs_ipc::{Imported, Remote};
-/// # use imrs_core::imrs_ports::usage;
+/// # use imrs_ports::usage;
 /// # fn main() -> Result<(), imrs_ipc::IpcError> {
 /// let remote = Remote::new("CELL")?;
 /// // STATUS, a RESPONSE port of ROBOT's process, queried by this process's ASKER.

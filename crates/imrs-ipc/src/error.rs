@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use imrs_core::imrs_ports::{Name, WireError};
+use imrs_ports::{Name, WireError};
 
 /// Why a port could not cross processes.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -5,7 +5,7 @@
 //! in the reactor's thread as the request comes, in the module's as it answers. On a TIGHT
 //! port the owner's spinning receive does the same in its turns.
 
-use imrs_core::imrs_ports::transport::{EndTransport as _, PortTransport as _};
+use imrs_ports::transport::{EndTransport as _, PortTransport as _};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 use std::pin::Pin;
@@ -15,8 +15,8 @@ use std::task::{Context, Poll, Wake, Waker};
 use std::thread::JoinHandle;
 
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::usage::{Plain, Usage};
-use imrs_core::imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
+use imrs_ports::usage::{Plain, Usage};
+use imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Active, Carry, Held, Server, lock};
@@ -629,7 +629,7 @@ fn notify(notifier: &Mutex<Notifier<Svc>>) {
 mod tests {
     use std::pin::pin;
 
-    use imrs_core::imrs_ports::{AnyUser, PortSpec};
+    use imrs_ports::{AnyUser, PortSpec};
 
     use super::*;
     use crate::import::connect;

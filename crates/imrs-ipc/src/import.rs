@@ -4,7 +4,7 @@
 //! ([`crate::dispatch`]): in the module's thread as it sends, in the reactor's as the reply
 //! comes. On a TIGHT port the user's spinning send does the same in its turns.
 
-use imrs_core::imrs_ports::transport::{EndTransport as _, PortTransport as _};
+use imrs_ports::transport::{EndTransport as _, PortTransport as _};
 use std::marker::PhantomData;
 use std::sync::{Arc, Mutex, Weak};
 use std::task::{Context, Poll, Waker};
@@ -12,8 +12,8 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
-use imrs_core::imrs_ports::usage::Usage;
-use imrs_core::imrs_ports::{
+use imrs_ports::usage::Usage;
+use imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ProcessType, ReplyHandle, ResponseEnd, Shared, WireError,
     usage,
 };

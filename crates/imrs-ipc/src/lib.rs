@@ -7,7 +7,7 @@
 //! ports cross is decided where the cell is wired, not in the modules.
 //!
 //! ```no_run
-//! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+//! use imrs_ports::{AnyUser, Port, PortSpec, usage};
 //! use imrs_ipc::{Imported, Remote, export, import};
 //!
 //! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
@@ -28,7 +28,7 @@
 //! ```
 //!
 //! Every port crosses with these two calls, [`export`] and [`import`]; the port's type
-//! chooses how (the owner's usage, and values or [`Shared`](imrs_core::imrs_ports::Shared)
+//! chooses how (the owner's usage, and values or [`Shared`](imrs_ports::Shared)
 //! messages), and the [`Imported`] a user's process asks for must match it. Ports whose owner
 //! receives carry each send to it. `RESPONSE` ports, whose users query them: a remote query
 //! waits for the owner's response handler, which runs when the owner's order says.
@@ -49,7 +49,7 @@
 //! functions from within a runtime whose I/O driver is enabled (`enable_all`).
 //!
 //! A TIGHT port's modules spin on both sides, and the bridges' work is done in their turns
-//! ([`Pump`](imrs_core::imrs_ports::transport::Pump)): the user's spinning send puts its request into
+//! ([`Pump`](imrs_ports::transport::Pump)): the user's spinning send puts its request into
 //! shared memory and reads the reply there itself, and the owner's spinning receive takes
 //! the request from shared memory and sends the reply itself, so that a round trip wakes
 //! no task and no thread. The importing process learns that the port is TIGHT when it
@@ -57,7 +57,7 @@
 //! other process while the other may be spinning too, and sends it once a message has
 //! waited a few tens of turns, or when its own wait parks, or when its bridge's task next
 //! runs; so a side that has parked is woken as on any port. The bridges'
-//! own ends park at once ([`End::park_waits`](imrs_core::imrs_ports::transport::EndTransport::park_waits)).
+//! own ends park at once ([`End::park_waits`](imrs_ports::transport::EndTransport::park_waits)).
 //!
 //! What crosses is a [`Wire`] type: `#[repr(C)]`, self-contained, `ZeroCopySend`. Both
 //! processes must agree on it — iceoryx2 compares its name, size and alignment when the
@@ -65,9 +65,9 @@
 //!
 //! The restrictions hold across processes: an importing module not on the port's user
 //! list, or beyond its number of users, is refused when it connects, with the port's own
-//! [`WireError`](imrs_core::imrs_ports::WireError). A process that dies does not hang its
+//! [`WireError`](imrs_ports::WireError). A process that dies does not hang its
 //! peers: a user's pending sends to a dead owner fail with
-//! [`SendError::NoReply`](imrs_core::imrs_ports::SendError::NoReply), and a new copy of
+//! [`SendError::NoReply`](imrs_ports::SendError::NoReply), and a new copy of
 //! the owner that exports the port again is served. The owner of a `SENDALL`, `CALLALL`
 //! or `QUERY` port hears nothing from its users once they connect, so their processes
 //! connect again every half second, and a new copy of the owner reaches them from then on. A process that answers requests from
@@ -82,21 +82,21 @@
 //! import of a port nobody exports fails at once with [`IpcError::NoOwner`]. Across
 //! processes the ports run on the wall clock: each process has its own clock, and processes
 //! that must agree on one time build it from one epoch
-//! ([`RealClock::from_epoch`](imrs_core::imrs_ports::RealClock::from_epoch)).
+//! ([`RealClock::from_epoch`](imrs_ports::RealClock::from_epoch)).
 //!
 //! A port of values copies each message into shared memory and moves it by value through
 //! the bridges: cheap for small messages, and costly for large ones (tens of KiB),
 //! which in a debug build can also overflow tokio's default 2 MiB worker stack. A port of
-//! [`Shared`](imrs_core::imrs_ports::Shared) messages crosses in shared memory instead,
+//! [`Shared`](imrs_ports::Shared) messages crosses in shared memory instead,
 //! through the same two calls: the sender loans a sample of shared memory from its end,
 //! builds its message there, and sends it with nothing copied; the owner reads it where it
 //! lies, and builds its reply in a loan made for the request
-//! ([`Shared::loan_reply`](imrs_core::imrs_ports::Shared::loan_reply)), which crosses back
+//! ([`Shared::loan_reply`](imrs_ports::Shared::loan_reply)), which crosses back
 //! the same way (a reply built on the heap is copied once), to be read where it lies. The
 //! module's code is the one it would run in a single process, where a loan is on the heap:
 //!
 //! ```no_run
-//! use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, Shared, usage};
+//! use imrs_ports::{AnyUser, Port, PortSpec, Shared, usage};
 //! use imrs_ipc::{FromBytes, Imported, Remote, ZeroCopySend, export, import};
 //!
 //! #[derive(Debug, Clone, Copy, ZeroCopySend, FromBytes)]
@@ -143,7 +143,7 @@
 //! than copying it). Every user, in any process, reads that one sample where the owner
 //! built it, and it is let go when the last handle is dropped. A broadcast built on the
 //! heap is copied into a sample once, as the port hands it over
-//! ([`Port::broadcast_with`](imrs_core::imrs_ports::transport::PortTransport::broadcast_with)), and goes out
+//! ([`Port::broadcast_with`](imrs_ports::transport::PortTransport::broadcast_with)), and goes out
 //! the same way. The user module builds its answer in a reply loan, read in place by the
 //! owner.
 //!

@@ -4,12 +4,12 @@
 //! owner's process relays to it whatever that module's end of the real port receives — a
 //! message to reply to, or a query its response handler would answer.
 
-use imrs_core::imrs_ports::transport::PortTransport as _;
-use imrs_core::imrs_ports::{
+use imrs_ports::transport::PortTransport as _;
+use imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ResponseEnd, Shared, UserList, WireError, usage,
 };
 
-use imrs_core::imrs_ports::usage::{Plain, Usage};
+use imrs_ports::usage::{Plain, Usage};
 
 use std::sync::{Arc, Mutex};
 

@@ -15,7 +15,7 @@
 
 use std::sync::{Mutex, Weak};
 
-use imrs_core::imrs_ports::transport::Pump;
+use imrs_ports::transport::Pump;
 
 use crate::carry::lock;
 

@@ -7,10 +7,10 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-use imrs_core::imrs_ports::{
+use imrs_ipc::{FromBytes, Imported, IpcError, Remote, ZeroCopySend, export, import};
+use imrs_ports::{
     AnyUser, End, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError, usage,
 };
-use imrs_ipc::{FromBytes, Imported, IpcError, Remote, ZeroCopySend, export, import};
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -169,11 +169,11 @@ async fn each_doubled(users: Vec<Peer>, n: u64) {
 }
 
 /// Waits (10 s at most) until `n` users are attached to `end`'s port.
-async fn until_users<Req, Rep, U>(end: &imrs_core::imrs_ports::End<Req, Rep, U>, n: usize)
+async fn until_users<Req, Rep, U>(end: &imrs_ports::End<Req, Rep, U>, n: usize)
 where
     Req: Send + 'static,
     Rep: Send + 'static,
-    U: imrs_core::imrs_ports::usage::Usage,
+    U: imrs_ports::usage::Usage,
 {
     within(10, async {
         while end.peers().len() < n {
@@ -656,7 +656,7 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, select, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, select, usage};
 
     let cell = cell("select");
     // This process owns both: DOUBLE, used from another process, and LOCAL, from here.
@@ -698,7 +698,7 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     let cell = cell("user-killed");
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
@@ -761,7 +761,7 @@ async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_back() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     let cell = cell("send-all");
     let port: Port<Number, Number, usage::SendAll, AnyUser, 2> =
@@ -791,7 +791,7 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     let cell = cell("full");
     // Room for one user, whoever it is.
@@ -841,7 +841,7 @@ async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() 
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceoryx2s_default() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     let cell = cell("many");
     // Three times iceoryx2's default of 8 clients to a service.
@@ -911,7 +911,7 @@ async fn importing_a_port_that_nobody_exports_says_so_at_once() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_this_one() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     let cell = cell("call-all");
     let port: Port<Number, Number, usage::CallAll, AnyUser, 3> =
@@ -1023,7 +1023,7 @@ async fn a_tight_port_is_served_whether_the_other_side_spins_or_has_parked() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_does() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, usage};
 
     // The port keeps the bridge's turns, and the bridge keeps the port: dropping the export
     // must still let the bridge go, with its hold on the port.
@@ -1043,7 +1043,7 @@ async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_do
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fails_it() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, QueryError, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, QueryError, usage};
 
     let cell = cell("query");
     // ASK_STATUS(N): USAGE=QUERY, USERLIST=(CHILD): the parent asks its child.
@@ -1072,7 +1072,7 @@ async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fai
 
 #[test]
 fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
-    use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+    use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
     // The bridges wait on tokio's reactor: a runtime built without it cannot carry a port.
     let runtime = tokio::runtime::Builder::new_current_thread()
@@ -1394,7 +1394,7 @@ fn factor_of(module: &str) -> u64 {
 /// Checks the answers to broadcast `seed`, first and later, one from each of LEFT and
 /// RIGHT: each read the frame in place, and built its answer in place, read here in place.
 async fn assert_each_inspected<Req>(
-    mut broadcast: imrs_core::imrs_ports::Broadcast<'_, Req, Shared<Frame>>,
+    mut broadcast: imrs_ports::Broadcast<'_, Req, Shared<Frame>>,
     seed: u64,
 ) {
     let first = std::mem::take(&mut broadcast.first);
@@ -1556,9 +1556,7 @@ async fn a_broadcast_built_on_the_heap_is_copied_once_and_read_there_by_a_user_h
 /// where it lies in shared memory, read-only, and answers.
 async fn read_in_place_here_and_in_two_other_processes(
     test: &str,
-    build: impl Fn(
-        &mut imrs_core::imrs_ports::End<Shared<Frame>, Shared<Frame>, usage::SendAll>,
-    ) -> Shared<Frame>,
+    build: impl Fn(&mut imrs_ports::End<Shared<Frame>, Shared<Frame>, usage::SendAll>) -> Shared<Frame>,
 ) {
     let cell = cell(test);
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
@@ -1806,7 +1804,7 @@ async fn an_owner_of_broadcasts_of_numbers_killed_mid_run_and_started_again_reac
 
 /// Serves `handler` without end; says each time it has answered.
 fn answering(
-    mut handler: imrs_core::imrs_ports::ResponseEnd<Number, Number, ()>,
+    mut handler: imrs_ports::ResponseEnd<Number, Number, ()>,
 ) -> tokio::sync::mpsc::UnboundedReceiver<()> {
     let (answered, heard) = tokio::sync::mpsc::unbounded_channel();
     tokio::spawn(async move {

@@ -8,7 +8,8 @@
 //! use std::sync::Arc;
 //! use std::time::Duration;
 //! use imrs_record::{Recorder, Timeline, read_summary};
-//! use imrs_core::{Cell, imrs_ports::Instant, time::drive};
+//! use imrs_core::{Cell, time::drive};
+//! use imrs_ports::Instant;
 //! use imrs_sim::{FeederId, Line, Role, RobotId, Sim, SimConfig, Target};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -117,7 +117,7 @@ impl Recorder {
 
     /// Records every event of `cell` from now on: each on its port's or its module's
     /// channel, with the text of the messages and replies of the ports that show them
-    /// ([`Port::shown`](imrs_core::imrs_ports::Port::shown)), how long each
+    /// ([`Port::shown`](imrs_ports::Port::shown)), how long each
     /// primitive waited (the recorder turns [`Cell::observe`] on), and the events an
     /// engineer should see also on `/log`.
     pub fn record_cell(&self, cell: &Cell) {

@@ -3,8 +3,8 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::synchronous::{AnyPort, Input, Output, connect, connect_any};
-use imrs_core::imrs_ports::{Instant, Name, SharedClock};
+use imrs_ports::synchronous::{AnyPort, Input, Output, connect, connect_any};
+use imrs_ports::{Instant, Name, SharedClock};
 
 use crate::error::SchemaError;
 use crate::instance::{Si, find, forall, instantiate};
@@ -85,7 +85,7 @@ impl Cx {
     ///
     /// ```
     /// # use std::sync::Arc;
-    /// # use imrs_core::imrs_ports::VirtualClock;
+    /// # use imrs_ports::VirtualClock;
     /// # use imrs_schema::{Couplet, Network, seed::TClosejoint, special::Jmotor};
     /// # use imrs_sim::hand::{Hand, HandConfig};
     /// # fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -3,8 +3,8 @@
 
 use std::fmt;
 
-use imrs_core::imrs_ports::Name;
-use imrs_core::imrs_ports::synchronous::{ConnectError, ReadError, WriteError};
+use imrs_ports::Name;
+use imrs_ports::synchronous::{ConnectError, ReadError, WriteError};
 use imrs_sim::hand::HandError;
 
 /// Why an instantiation, a connection or a behaviour failed.

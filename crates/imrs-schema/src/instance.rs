@@ -4,8 +4,8 @@ use std::any::Any;
 use std::fmt;
 use std::sync::Arc;
 
-use imrs_core::imrs_ports::Name;
-use imrs_core::imrs_ports::synchronous::AnyPort;
+use imrs_ports::Name;
+use imrs_ports::synchronous::AnyPort;
 
 use crate::cx::Cx;
 use crate::error::SchemaError;

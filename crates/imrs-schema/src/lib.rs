@@ -1,6 +1,6 @@
 //! Schemas, assemblages and task-units: the port-automata model of Lyons & Arbib (seed
 //! 004), on the synchronous ports of
-//! [`imrs_ports::synchronous`](imrs_core::imrs_ports::synchronous), with the special
+//! [`imrs_ports::synchronous`], with the special
 //! schemas of a simulated dextrous hand.
 //!
 //! Why a crate of its own: the model is a second way of programming a cell, beside
@@ -35,7 +35,7 @@
 //! ```
 //! use std::sync::Arc;
 //! use std::time::Duration;
-//! use imrs_core::imrs_ports::{Instant, VirtualClock};
+//! use imrs_ports::{Instant, VirtualClock};
 //! use imrs_schema::{Network, seed::{Grip, Reach}, special::Vision};
 //! use imrs_sim::hand::{FINGERS, Hand, HandConfig, Touch, finger_joints};
 //!
@@ -78,8 +78,8 @@ pub mod special;
 
 pub use cx::{Couplet, Cx};
 pub use error::SchemaError;
-pub use imrs_core::imrs_ports::Name;
-pub use imrs_core::imrs_ports::synchronous::{AnyPort, Input, Output, ReadError, WriteError};
+pub use imrs_ports::Name;
+pub use imrs_ports::synchronous::{AnyPort, Input, Output, ReadError, WriteError};
 pub use instance::Si;
 pub use network::{Ending, Network, TraceEntry};
 pub use ports::{Declare, Ports};

@@ -4,8 +4,8 @@
 use std::fmt;
 use std::sync::Arc;
 
-use imrs_core::imrs_ports::{Instant, Name, SharedClock};
 use imrs_core::{Log, Processor, Record};
+use imrs_ports::{Instant, Name, SharedClock};
 
 use crate::cx::Cx;
 use crate::error::SchemaError;

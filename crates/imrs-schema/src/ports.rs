@@ -1,7 +1,7 @@
 //! A schema's ports, `(ip)` and `(op)` of the seed's `[N (ip) (op) (v) (b)]`.
 
-use imrs_core::imrs_ports::Name;
-use imrs_core::imrs_ports::synchronous::AnyPort;
+use imrs_ports::Name;
+use imrs_ports::synchronous::AnyPort;
 
 /// The ports of a schema or an assemblage, listed by the names they are known by here, so
 /// that a connection map given by name can find them.

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use tokio::sync::Notify;
 
 use crate::error::SchemaError;

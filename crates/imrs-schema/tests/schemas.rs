@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Clock, VirtualClock};
+use imrs_ports::{Clock, VirtualClock};
 use imrs_schema::special::{Jmotor, Sef, Vision};
 use imrs_schema::{Behavior, Cx, Declare, Ending, Flow, Kind, Network, Schema, SchemaError, ports};
 use imrs_sim::hand::{Hand, HandConfig, finger_joints};

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Clock, VirtualClock};
+use imrs_ports::{Clock, VirtualClock};
 use imrs_schema::seed::{Desired, Grasp, Grip, ObjectQ, Reach, Vf};
 use imrs_schema::special::Vision;
 use imrs_schema::{Ending, Network, Si};

@@ -2,8 +2,8 @@
 
 use std::fmt;
 
-use imrs_core::imrs_ports::Instant;
 use imrs_core::{Log, Record};
+use imrs_ports::Instant;
 
 use crate::fault::FaultKind;
 use crate::ids::{Line, PalletId, RobotId, Station};

@@ -1,6 +1,6 @@
 //! Faults a test or an operator's flag injects into the hardware.
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 
 use crate::ids::{FeederId, Line, RobotId, Station};
 

@@ -10,7 +10,7 @@
 //! is empty and compiles neither rapier nor nalgebra.
 //!
 //! The seed's Appendix omits its device drivers; this crate stands in for the hardware. It
-//! runs faster than real time on a [`VirtualClock`](imrs_core::imrs_ports::VirtualClock), or
+//! runs faster than real time on a [`VirtualClock`](imrs_ports::VirtualClock), or
 //! on the wall clock, and the physical facts of a run — who was inside the feeder zone and
 //! when, which robots touched, where the pallets are — are measured by rapier, never taken
 //! from the bookkeeping of the modules under test.
@@ -20,7 +20,7 @@
 //! ```
 //! use std::sync::Arc;
 //! use std::time::Duration;
-//! use imrs_core::imrs_ports::{Instant, VirtualClock};
+//! use imrs_ports::{Instant, VirtualClock};
 //! use imrs_sim::{FeederId, Line, Role, RobotId, Sim, SimConfig, Target};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {

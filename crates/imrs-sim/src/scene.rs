@@ -1,7 +1,7 @@
 //! What the cell looks like at one moment, read from the rapier world: for whoever draws it
 //! (a recorder, a viewer), never for deciding what the modules do.
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 
 use crate::ids::{FeederId, Line, PalletId, RobotId};
 

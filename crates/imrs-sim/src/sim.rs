@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, SharedClock};
+use imrs_ports::{Instant, SharedClock};
 use tokio::sync::Notify;
 use tokio::sync::futures::Notified;
 

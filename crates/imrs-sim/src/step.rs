@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 
 /// The step grid: the first multiple of `step` after `now`.
 pub(crate) fn next_step_after(now: Instant, step: Duration) -> Instant {

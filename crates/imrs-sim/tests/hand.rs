@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, VirtualClock};
+use imrs_ports::{Instant, VirtualClock};
 use imrs_sim::hand::{Hand, HandConfig, HandError, Shape, Touch, finger_joints};
 
 fn at(seconds: f64) -> Instant {

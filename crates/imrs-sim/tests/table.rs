@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, VirtualClock};
+use imrs_ports::{Instant, VirtualClock};
 use imrs_sim::scara::{Elbow, Scara};
 use imrs_sim::table::{ArmSpec, Table, TableArm, TableError, TableLayout, ZoneSpec, ZoneUse};
 use nalgebra::{Point2, Point3};
@@ -165,7 +165,7 @@ fn a_tool_another_arm_holds_cannot_be_grasped_and_the_attempt_is_counted() {
 
 #[test]
 fn what_cannot_be_is_refused_by_name() {
-    let clock: imrs_core::imrs_ports::SharedClock = Arc::new(VirtualClock::new());
+    let clock: imrs_ports::SharedClock = Arc::new(VirtualClock::new());
     let mut twins = layout(ZoneUse::Shared);
     twins.arms[1].name = "LEFT".into();
     let error = Table::new(twins, Arc::clone(&clock)).err().unwrap();

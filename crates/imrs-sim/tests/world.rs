@@ -3,8 +3,8 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Clock, Instant, VirtualClock};
 use imrs_core::time::drive;
+use imrs_ports::{Clock, Instant, VirtualClock};
 use imrs_sim::layout::{
     CONVEYOR_SPEED, GATE_X, LOAD_X, RELEASE_TIME, STEP, TOOL_ACCEL, TOOL_SPEED, ZONE_CENTRE,
     ZONE_HALF,

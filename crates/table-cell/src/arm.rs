@@ -17,8 +17,8 @@
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Name;
 use imrs_core::prelude::*;
+use imrs_ports::Name;
 use imrs_sim::scara::Scara;
 use imrs_sim::table::{GRIPPER_RADIUS, Table, TableArm, WORK_Z};
 use nalgebra::Point2;

@@ -2,7 +2,7 @@
 //! trajectory, against where the other arms' links are now (as the table senses them), by
 //! parry3d distances. A stopped arm in the way is the seed's geometric deadlock.
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use imrs_sim::scara::Scara;
 use imrs_sim::table::LINK_RADIUS;
 use nalgebra::Point2;

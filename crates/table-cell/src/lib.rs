@@ -43,8 +43,8 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
 use imrs_coord::zones::ZoneKind;
-use imrs_core::imrs_ports::{Instant, SharedClock, VirtualClock};
 use imrs_core::prelude::*;
+use imrs_ports::{Instant, SharedClock, VirtualClock};
 use imrs_sim::table::{Table, TableError, ZoneSpec, ZoneUse};
 
 pub use self::layout::{FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell};

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use imrs_sim::table::Measured;
 
 use super::{CellConfig, CellStats};

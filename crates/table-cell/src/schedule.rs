@@ -4,8 +4,8 @@
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{AnyUser, End, Instant, Port, PortSpec, SharedClock, usage};
 use imrs_core::prelude::*;
+use imrs_ports::{AnyUser, End, Instant, Port, PortSpec, SharedClock, usage};
 
 use super::lock;
 use imrs_coord::scheduler::{Dispatch, Policy};

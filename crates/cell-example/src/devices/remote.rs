@@ -4,8 +4,8 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
-use imrs_core::imrs_ports::{End, usage};
 use imrs_ipc::{Imported, IpcError, Remote, import};
+use imrs_ports::{End, usage};
 use imrs_sim::{DeviceError, Line, RobotId, Role, Station, Target};
 use tokio::sync::Mutex;
 

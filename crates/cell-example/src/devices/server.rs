@@ -1,8 +1,8 @@
 //! The world's side: a module that owns a port per device and carries out each call on the
 //! simulation, for the lines' modules in other processes.
 
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, SharedClock, usage};
 use imrs_core::prelude::*;
+use imrs_ports::{AnyUser, Port, PortSpec, SharedClock, usage};
 use imrs_sim::{Line, Sim};
 
 use super::remote::Device;

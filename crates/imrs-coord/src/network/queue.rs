@@ -3,7 +3,7 @@
 use std::collections::VecDeque;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Priority;
+use imrs_ports::Priority;
 
 /// Packets waiting to go on the bus, the most urgent first (FIFO within a priority) —
 /// except that the packet at the head may already be partly read into the coprocessor's

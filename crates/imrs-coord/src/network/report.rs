@@ -4,7 +4,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Name, PortInfo};
+use imrs_ports::{Name, PortInfo};
 
 use super::Bus;
 

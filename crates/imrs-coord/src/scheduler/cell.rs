@@ -1,7 +1,7 @@
 //! The cell the scheduler works in: robots, the elementary tasks of a unit, a shared zone,
 //! and the parts' arrivals.
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 
 /// What a robot can do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 
 use super::{Resources, ZoneError};
 

@@ -3,7 +3,7 @@
 
 use std::collections::{BTreeSet, VecDeque};
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 
 use super::{Answer, Resources, ZoneError};
 

@@ -3,7 +3,7 @@
 
 use std::collections::VecDeque;
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use parry3d::math::{Pose, Vector};
 use parry3d::query;
 use parry3d::shape::Capsule;

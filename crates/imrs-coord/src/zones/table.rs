@@ -4,7 +4,7 @@
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::fmt;
 
-use imrs_core::imrs_ports::Name;
+use imrs_ports::Name;
 use parry3d::math::{Pose, Vector};
 use parry3d::query::PointQuery;
 use parry3d::shape::Cuboid;

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 
 /// `n` seconds.
 pub fn secs(n: u64) -> Duration {

@@ -54,8 +54,8 @@
 use std::process::ExitCode;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 use imrs_ipc::{FromBytes, Imported, Remote, ZeroCopySend, export, import};
+use imrs_ports::{AnyUser, Port, PortSpec, ProcessType, Shared, usage};
 
 /// The tests' message: the same type, by name, size and alignment, as theirs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]

@@ -1,4 +1,4 @@
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_ipc::{Remote, ZeroCopySend, export};
 
 // Self-contained and ZeroCopySend, but a peer could write 2 into the bool: not every bit

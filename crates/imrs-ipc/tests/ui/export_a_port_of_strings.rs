@@ -1,4 +1,4 @@
-use imrs_core::imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_ipc::{Remote, export};
 
 fn main() {

@@ -9,10 +9,10 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
 use imrs_core::Event;
-use imrs_core::imrs_ports::Instant;
-use imrs_core::imrs_ports::Name;
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
+use imrs_ports::Instant;
+use imrs_ports::Name;
 use imrs_record::{Recorder, Timeline};
 use imrs_sim::{FeederId, Line, RobotId, Role, Scene, Sim, SimConfig, SimEvent, Target};
 

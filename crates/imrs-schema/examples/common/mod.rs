@@ -7,7 +7,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Clock, VirtualClock};
+use imrs_ports::{Clock, VirtualClock};
 use imrs_schema::seed::Reach;
 use imrs_schema::special::Vision;
 use imrs_schema::{Network, Si};

@@ -28,7 +28,7 @@ pub use sensor::{Jposition, JpositionPorts, Tactile, TactilePorts};
 pub use vision::Vision;
 pub use wrist::{Gather, GatherPorts, MoveWrist, OrientWrist, Split, SplitPorts, WristPorts};
 
-use imrs_core::imrs_ports::synchronous::Write;
+use imrs_ports::synchronous::Write;
 use imrs_sim::hand::{Hand, HandError};
 
 use crate::race::{Either, race};

@@ -28,7 +28,7 @@ impl Robot {
     }
 
     /// The time now, on the simulation's clock.
-    pub fn now(&self) -> imrs_core::imrs_ports::Instant {
+    pub fn now(&self) -> imrs_ports::Instant {
         self.sim.now()
     }
 
@@ -221,7 +221,7 @@ impl Robot {
         effect: impl FnOnce(
             &mut World,
             crate::ids::Line,
-            imrs_core::imrs_ports::Instant,
+            imrs_ports::Instant,
         ) -> Result<SimEvent, DeviceError>,
     ) -> Result<(), DeviceError> {
         debug_assert_eq!(World::station_of(self.id), station);

@@ -11,7 +11,7 @@
 //! ```
 //! use std::sync::Arc;
 //! use std::time::Duration;
-//! use imrs_core::imrs_ports::{Instant, VirtualClock};
+//! use imrs_ports::{Instant, VirtualClock};
 //! use imrs_sim::hand::{Hand, HandConfig, finger_joints};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -38,7 +38,7 @@ use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use imrs_core::imrs_ports::{Instant, SharedClock};
+use imrs_ports::{Instant, SharedClock};
 use nalgebra::{Isometry3, Point3};
 use tokio::sync::Notify;
 use tokio::sync::futures::Notified;

@@ -11,7 +11,7 @@
 //! ```
 //! use std::sync::Arc;
 //! use std::time::Duration;
-//! use imrs_core::imrs_ports::{Instant, VirtualClock};
+//! use imrs_ports::{Instant, VirtualClock};
 //! use imrs_sim::scara::{Elbow, Scara};
 //! use imrs_sim::table::{ArmSpec, Table, TableLayout, ZoneSpec, ZoneUse};
 //! use nalgebra::{Point2, Point3};
@@ -61,7 +61,7 @@ use std::fmt;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, Name, SharedClock};
+use imrs_ports::{Instant, Name, SharedClock};
 use nalgebra::{Point2, Point3};
 use tokio::sync::Notify;
 

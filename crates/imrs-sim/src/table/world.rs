@@ -3,7 +3,7 @@
 use std::collections::BTreeSet;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::{Instant, Name};
+use imrs_ports::{Instant, Name};
 use nalgebra::Point2;
 use rapier3d::prelude::ColliderHandle;
 

@@ -2,7 +2,7 @@
 
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 use rapier3d::prelude::ColliderHandle;
 
 use super::physics::Physics;

@@ -1,7 +1,7 @@
 //! One line's roller conveyor: pallets moving at the conveyor's speed, stopped by the
 //! stations' freeze relays and by the pallet ahead.
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 use rapier3d::prelude::ColliderHandle;
 
 use super::physics::Physics;

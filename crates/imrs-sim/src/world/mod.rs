@@ -8,7 +8,7 @@ mod physics;
 use std::collections::BTreeSet;
 use std::time::Duration;
 
-use imrs_core::imrs_ports::Instant;
+use imrs_ports::Instant;
 
 use self::arm::{Arm, distance};
 use self::conveyor::{Conveyor, PalletState};
