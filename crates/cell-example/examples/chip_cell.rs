@@ -70,7 +70,7 @@ fn main() -> ExitCode {
     }
     let mut out = io::stdout().lock();
     let printed = match tree {
-        Some(tree) => writeln!(out, "module tree (seed 000 §2):\n{tree}"),
+        Some(tree) => writeln!(out, "module tree (Shin 1985, §2):\n{tree}"),
         None => Ok(()),
     };
     match printed.and_then(|()| print_all(&mut out, &config, &report)) {

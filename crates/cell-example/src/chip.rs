@@ -28,7 +28,7 @@ pub enum FeederPolicy {
     Appendix,
     /// A monitor task that hands the zone to one robot at a time.
     Arbiter,
-    /// A coordinator (seed 003) that reserves for each robot the space its trajectory will
+    /// A coordinator (Jiménez et al. 1992) that reserves for each robot the space its trajectory will
     /// sweep, and lets both robots into the zone where their trajectories do not meet.
     Coordinator,
 }

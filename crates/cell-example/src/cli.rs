@@ -27,13 +27,13 @@ struct Flags {
     seed: u64,
     /// How the chip robots share the feeder zone: the Appendix's query/order scheme, an
     /// arbiter module that holds the zone for one robot's round trip, or a coordinator that
-    /// reserves the space each trajectory sweeps (seed 003).
+    /// reserves the space each trajectory sweeps (Jiménez et al. 1992).
     #[arg(long, value_enum, default_value_t = FeederPolicy::Arbiter)]
     feeder: FeederPolicy,
     /// Run on the wall clock instead of virtual time.
     #[arg(long)]
     realtime: bool,
-    /// Print the module tree (seed 000 §2) before the report.
+    /// Print the module tree (Shin 1985, §2) before the report.
     #[arg(long)]
     tree: bool,
     /// Inject a fault: KIND one of release, robot, feeder, jam; WHICH a line A or B, or a

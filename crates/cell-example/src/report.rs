@@ -21,7 +21,7 @@ pub struct LineFigures {
     pub completed: u32,
     /// Of them, cards with every chip of the work schedule.
     pub good: u32,
-    /// Of them, cards that left with a chip missing (a step failed: seed 000, note 5).
+    /// Of them, cards that left with a chip missing (a step failed: Shin 1985, note 5).
     pub short: u32,
     /// Pallets still on the conveyor at the end.
     pub in_progress: u32,

@@ -40,7 +40,7 @@ pub struct CellConfig {
     pub faults: Vec<CellFault>,
     /// Show a progress bar on a terminal.
     pub progress: bool,
-    /// Print the module tree (seed 000 §2) before the report.
+    /// Print the module tree (Shin 1985, §2) before the report.
     pub show_tree: bool,
     /// How many of the most recent events each log keeps in memory for the record (the
     /// report is folded from every event as it comes, whatever this is).

@@ -1,4 +1,4 @@
-//! The zone coordinator as a module (seed 003, centralized loose coordination), speaking
+//! The zone coordinator as a module (Jiménez et al. 1992, centralized loose coordination), speaking
 //! the seed's message set over typed ports.
 //!
 //! | seed | port | from → to |

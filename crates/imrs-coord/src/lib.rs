@@ -1,6 +1,6 @@
-//! The coordination layer of a multiple-arm cell, after Basañez, Suárez et al. (seed 003):
-//! arms that share space and tools, a coordinator, and the network that carries their
-//! messages.
+//! The coordination layer of a multiple-arm cell, after Jiménez, Sevillano, Civit-Balcells,
+//! Díaz and Civit-Breu, *RISC-based architectures for multiple robot systems* (1992): arms
+//! that share space and tools, a coordinator, and the network that carries their messages.
 //!
 //! Built so far:
 //! - [`network`]: the worst-case delay of a deterministic CSMA/DCR bus for a given cell

@@ -1,4 +1,4 @@
-//! Zones and tools as resources, as the coordinator of seed 003 shares them: exclusive and
+//! Zones and tools as resources, as the coordinator of Jiménez et al. 1992 shares them: exclusive and
 //! shared zones, tools, the active-zone grant, deadlocks found and resolved, and the arm's
 //! pipeline stopping before a zone it may not enter.
 

@@ -220,7 +220,7 @@ impl Cell {
         Ok(port)
     }
 
-    /// `PORT ...` with a filter task spliced in (seed 000, restriction 5): makes a
+    /// `PORT ...` with a filter task spliced in (Shin 1985, restriction 5): makes a
     /// [`FilteredPort`] on the cell's clock and declares both its sides, as [`Cell::port`]
     /// does for a plain port.
     // The type is the filtered port's own, with every parameter the caller chose.

@@ -1,4 +1,4 @@
-//! The load-time check (seed 000, §3 and §5.1): everything the types could not show, for a
+//! The load-time check (Shin 1985, §3 and §5.1): everything the types could not show, for a
 //! whole cell at once, each problem naming its module and port.
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -1,4 +1,4 @@
-//! Exceptions (seed 000, §5.1): `PORT.TIMEOUT` and friends, handled at their order rank.
+//! Exceptions (Shin 1985, §5.1): `PORT.TIMEOUT` and friends, handled at their order rank.
 
 use std::fmt;
 

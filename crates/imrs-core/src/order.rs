@@ -1,4 +1,4 @@
-//! The `order` statement (seed 000, §5.1): a module's ranking of its sections.
+//! The `order` statement (Shin 1985, §5.1): a module's ranking of its sections.
 
 use std::fmt;
 

@@ -1,4 +1,4 @@
-//! The module tree of seed 000 §2: a module is the child of the module that created it, and
+//! The module tree of Shin 1985, §2: a module is the child of the module that created it, and
 //! the traffic on a port is *vertical* between a module and one of its descendants,
 //! *horizontal* otherwise.
 

@@ -1,4 +1,4 @@
-//! `waitfor` and `getmess` (seed 000, §4.2 and §5.2): an n-way rendezvous of named tasks.
+//! `waitfor` and `getmess` (Shin 1985, §4.2 and §5.2): an n-way rendezvous of named tasks.
 //!
 //! Each named task calls [`WaitFor::waitfor`] with a message. It blocks until every named
 //! task has called it; then each runs its own combining function over all pooled messages,

@@ -1,4 +1,4 @@
-//! Work schedules (seed 000, §5.1): `perform`, `more`, `reinstate`.
+//! Work schedules (Shin 1985, §5.1): `perform`, `more`, `reinstate`.
 //!
 //! The statements that change the process environment, gathered in one place: each step has
 //! a priority (1 first), `perform` runs the highest-priority step not yet done, and a step

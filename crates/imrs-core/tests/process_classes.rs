@@ -1,4 +1,4 @@
-//! One small cell per process class of seed 000, section 2.
+//! One small cell per process class of Shin 1985, section 2.
 
 mod common;
 

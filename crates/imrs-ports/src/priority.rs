@@ -1,4 +1,4 @@
-//! Port priorities (seed 000, restriction 7).
+//! Port priorities (Shin 1985, restriction 7).
 
 use std::cmp::Ordering;
 use std::fmt;

@@ -1,4 +1,4 @@
-//! `select` over guarded alternatives (seed 000, §4.2): of the open alternatives that are
+//! `select` over guarded alternatives (Shin 1985, §4.2): of the open alternatives that are
 //! ready, take the one on the port of highest priority, FIFO within a port — never at random.
 //!
 //! ```

@@ -1,4 +1,4 @@
-//! Port usages (seed 000, restriction 2): which primitive an end may use.
+//! Port usages (Shin 1985, restriction 2): which primitive an end may use.
 //!
 //! Each usage is a zero-sized marker. An end has only the methods of its usage, so a wrong
 //! primitive does not compile, and a user end always gets the complement of the owner's

@@ -1,4 +1,4 @@
-//! User lists (seed 000, restriction 3), checked at compile time where users are types.
+//! User lists (Shin 1985, restriction 3), checked at compile time where users are types.
 
 use crate::meta::Named;
 

@@ -1,4 +1,4 @@
-//! Synchronous ports (seed 004 §4.2): fan-out, fan-in, late connections, withdrawal and
+//! Synchronous ports (Lyons & Arbib 1985, §4.2): fan-out, fan-in, late connections, withdrawal and
 //! closed ends, as a schema network uses them.
 
 use std::future::Future;

@@ -1,4 +1,4 @@
-//! Synchronous ports against a model of seed 004's rule, over random networks and random
+//! Synchronous ports against a model of Lyons & Arbib 1985's rule, over random networks and random
 //! interleavings of writes, reads, withdrawals and late connections: no value is lost, none
 //! is read twice by one reader, and a writer is released exactly when one connected reader
 //! has read its value.

@@ -5,7 +5,7 @@
 //! A module's other tasks (device drivers such as a freeze relay's, which wait on their own
 //! module by design) get a row of their own, `MODULE/TASK`, when they wait: on the module's
 //! row they would hide the waits that matter, such as the two chip robots querying each
-//! other in the deadlock of seed 000's note 6.
+//! other in the deadlock of Shin 1985's note 6.
 //!
 //! Folded from the event streams as they come, keeping only what falls inside the window,
 //! so that its memory does not grow with the run's length. Drawn with plotters' SVG backend.

@@ -1,5 +1,5 @@
 //! The timeline of a window of a run: sections, waits on peers, zone occupancy measured by
-//! rapier, and the deadlock of seed 000's note 6 where a reader sees it at a glance.
+//! rapier, and the deadlock of Shin 1985's note 6 where a reader sees it at a glance.
 
 mod common;
 

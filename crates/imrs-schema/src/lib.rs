@@ -11,7 +11,7 @@
 //!
 //! # The notation, in Rust
 //!
-//! | seed 004 | here |
+//! | Lyons & Arbib 1985 | here |
 //! |---|---|
 //! | `[N (ip) (op) (v) (b)]` | a type implementing [`Schema`]: `NAME`, `Ports` (declared with [`ports!`]), its fields are `(v)`, [`Schema::behavior`] is one pass of `(b)` |
 //! | `[N (ip) (op) (s) (ib) (p) (n)]` | a [`Schema`] of [`Kind::Assemblage`]: [`Schema::set_up`] instantiates and connects the components (`s`, `ib`, `n`) and returns the component ports that are its own (`p`) |

@@ -1,4 +1,4 @@
-//! The four examples of seed 004 §5, judged by their physical outcome in rapier: contact
+//! The four examples of Lyons & Arbib 1985, §5, judged by their physical outcome in rapier: contact
 //! reached and fingers stopped; the wrist at the object; the matching object chosen; the
 //! virtual finger's fingers moved and no other.
 

@@ -1,6 +1,6 @@
 //! The simulated chip-insertion cell: two assembly lines of robots, conveyors, pallets and a
 //! shared feeder zone, in a rapier3d world stepped on the framework clock; in `hand`, a
-//! dextrous hand over a table of objects, for the schemas of seed 004; and in `table`, a
+//! dextrous hand over a table of objects, for the schemas of Lyons & Arbib 1985; and in `table`, a
 //! table of SCARA arms sharing zones and tools, for the coordination layer.
 //!
 //! Each world is a cargo feature of its own — `chip` (the crate root's items, `layout`,

@@ -1,4 +1,4 @@
-//! The network bound of seed 003 ("Communications"): a deterministic CSMA/DCR bus (the
+//! The network bound of Jiménez et al. 1992 ("Communications"): a deterministic CSMA/DCR bus (the
 //! Intel i82596's deterministic collision resolution) bounds every message's delay.
 //!
 //! After a collision, each of the `N` stations transmits once, in its own slot; in the worst

@@ -1,4 +1,4 @@
-//! The run-time task scheduler of seed 003 ("Programming/user interface"): robot-independent
+//! The run-time task scheduler of Jiménez et al. 1992 ("Programming/user interface"): robot-independent
 //! elementary tasks with task and part prerequisites, parts that come in random order at
 //! random times, and tasks assigned to robots as the cell runs — by capability, speed, and a
 //! score for the zone conflicts each assignment would meet, its entry points computed

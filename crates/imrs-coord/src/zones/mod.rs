@@ -1,4 +1,4 @@
-//! Zones and tools as shared resources, the coordinator's bookkeeping of them (seed 003,
+//! Zones and tools as shared resources, the coordinator's bookkeeping of them (Jiménez et al. 1992,
 //! "Coordination": centralized loose coordination), deadlock detection among exclusive
 //! resources, and the arm controller's pipeline of points checked ahead.
 //!

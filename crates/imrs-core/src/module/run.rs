@@ -2,7 +2,7 @@
 //!
 //! A module is one future, polled by one tokio task. Inside it, this scheduler polls the
 //! module's threads — its tasks, and the exception handlers that are running — and decides
-//! when pending handlers may start. The rule (seed 000, §4.2 and §5.1):
+//! when pending handlers may start. The rule (Shin 1985, §4.2 and §5.1):
 //!
 //! - A pending handler (a query for a response handler, a raised exception) starts when its
 //!   rank outranks the section of the thread it interrupts (the least urgent live thread)

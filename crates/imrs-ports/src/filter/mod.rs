@@ -1,4 +1,4 @@
-//! Port filters (seed 000, restriction 5): a task spliced into a port.
+//! Port filters (Shin 1985, restriction 5): a task spliced into a port.
 //!
 //! A filtered port is cut in two. On one side the users talk to the filter as if it were
 //! the owner; on the other the filter talks to the owner through the predefined port

@@ -1,4 +1,4 @@
-//! Synchronous ports: the port-automata communication of seed 004 (Lyons & Arbib, §4).
+//! Synchronous ports: the port-automata communication of Lyons & Arbib 1985 (Lyons & Arbib, §4).
 //!
 //! An [`Output`] and an [`Input`] are connected by [`connect`] (or [`connect_any`] when the
 //! connection is made by name at run time), as a schema instance's *connection map* connects

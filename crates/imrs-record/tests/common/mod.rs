@@ -1,5 +1,5 @@
 //! A small cell for the recorder's and the timeline's tests: two chip robots of the
-//! simulation that query each other for the feeders (the deadlock of seed 000's note 6,
+//! simulation that query each other for the feeders (the deadlock of Shin 1985's note 6,
 //! broken by asymmetric timeouts), then each reach into the feeder zone, grasp a chip,
 //! and insert it.
 #![allow(dead_code, unreachable_pub)]

@@ -1,4 +1,4 @@
-//! The four test examples of seed 004 §5, written in this crate's API, on the simulated
+//! The four test examples of Lyons & Arbib 1985, §5, written in this crate's API, on the simulated
 //! hand. The examples `guarded_move`, `reach`, `object_search` and `virtual_fingers` run
 //! them; the tests check their physical outcome in rapier.
 //!

@@ -5,7 +5,7 @@ use imrs_sim::hand::Hand;
 use super::{Jmotor, Jposition};
 use crate::{AnyPort, Cx, Input, Kind, Output, Ports, Schema, SchemaError};
 
-/// `Joint_i = [Jposition_i - Jmotor_i]` (seed 004 (7)): a task-unit whose linking process
+/// `Joint_i = [Jposition_i - Jmotor_i]` (Lyons & Arbib 1985 (7)): a task-unit whose linking process
 /// is left implicit, so an assemblage of `Jposition_i` and `Jmotor_i` whose ports are theirs.
 #[derive(Debug)]
 pub struct Joint {

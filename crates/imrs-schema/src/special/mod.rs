@@ -1,4 +1,4 @@
-//! The special schemas of seed 004 §4.3, bound to the simulated hand of
+//! The special schemas of Lyons & Arbib 1985, §4.3, bound to the simulated hand of
 //! [`imrs_sim::hand`]: the mechanism's joints and senses, seen as schemas.
 //!
 //! | seed | here | ports |

@@ -3,7 +3,7 @@
 //! objects of different shapes and sizes resting on a table. It steps on the framework
 //! clock, as the chip cell does, so a run on virtual time is reproducible.
 //!
-//! The hand is driven the way seed 004 drives its mechanism: each joint is driven to the
+//! The hand is driven the way Lyons & Arbib 1985 drives its mechanism: each joint is driven to the
 //! mean of the commands given to it ([`Hand::command`], one per source), and its sensors
 //! report joint positions ([`Hand::position`]), fingertip contact ([`Hand::touch`]) and, as
 //! a camera would, the objects' features with no identity attached ([`Hand::see`]).

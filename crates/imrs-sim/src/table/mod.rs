@@ -1,5 +1,5 @@
 //! A table of SCARA arms sharing zones and a tool, in a rapier3d world stepped on the
-//! framework clock: the physical side of a coordinated cell (seed 003).
+//! framework clock: the physical side of a coordinated cell (Jiménez et al. 1992).
 //!
 //! Each arm moves its tool in straight lines at its own speed; its links are placed by its
 //! kinematics ([`Scara`], on nalgebra) at every step. Rapier measures what the coordination
