@@ -1,71 +1,24 @@
 //! A cell: the clock, the event log, the wiring, and the modules running in it.
 
-use std::collections::BTreeMap;
-use std::collections::btree_map::Entry;
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
 use imrs_ports::usage::{Plain, Usage};
 use imrs_ports::{
     End, FilteredPort, Instant, Name, Port, PortSpec, SharedClock, UserList, VirtualClock,
-    WireError, Wiring,
+    WireError,
 };
 
-use imrs_ports::transport::Presence;
-
-use crate::check::{CellError, CellErrors, check, check_module};
-use crate::deadlock::WaitGraph;
-use crate::event::{Event, EventKind, EventLog};
-use crate::module::run::{KillSwitch, ModuleExit, ModuleRun};
-use crate::module::spec::{ModuleDecl, ModuleSpec};
-use crate::outcome::{Outcome, Teller};
+use crate::check::{CellErrors, check};
+use crate::decl::ModuleDecl;
+use crate::event::EventLog;
+use crate::launch::{Factory, spawn_module, supervisor};
+use crate::module::spec::ModuleSpec;
 use crate::processor::Processor;
+use crate::shared::{CellShared, ModuleHandle, lock};
 use crate::supervision::RestartPolicy;
-use crate::tree::{ModuleTree, Placement};
-
-pub(crate) struct CellShared {
-    pub(crate) clock: SharedClock,
-    pub(crate) events: EventLog,
-    /// Whether the primitives' events say how long each waited and carry the text of the
-    /// values of the ports that show them.
-    pub(crate) observe: AtomicBool,
-    waits: Mutex<WaitGraph>,
-    wiring: Mutex<Wiring>,
-    modules: Mutex<BTreeMap<Name, Member>>,
-}
-
-/// A running module: its switch, and where it sits in the tree.
-struct Member {
-    switch: Arc<KillSwitch>,
-    placement: Placement,
-}
-
-impl CellShared {
-    pub(crate) fn kill(&self, module: &str) -> bool {
-        let switch = self.switch(module);
-        switch.inspect(|switch| switch.kill()).is_some()
-    }
-
-    fn switch(&self, module: &str) -> Option<Arc<KillSwitch>> {
-        lock(&self.modules)
-            .get(&Name::from(module))
-            .map(|member| Arc::clone(&member.switch))
-    }
-
-    pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
-        lock(&self.waits)
-    }
-
-    fn record(&self, module: &Name, kind: EventKind) {
-        self.events.record(Event {
-            at: self.clock.now(),
-            module: module.clone(),
-            task: None,
-            kind,
-        });
-    }
-}
+use crate::tree::ModuleTree;
 
 /// Whether two handles name the same clock: the same object, not only the same kind.
 fn same_clock(a: &SharedClock, b: &SharedClock) -> bool {
@@ -132,11 +85,6 @@ where
     }
 }
 
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    // Each critical section is one map operation: a panic cannot leave it half-done.
-    mutex.lock().unwrap_or_else(PoisonError::into_inner)
-}
-
 /// A work cell: its clock, its event log, its ports by name, and its modules.
 ///
 /// Modules run as tokio tasks, in parallel on a multi-thread runtime, or one at a time on a
@@ -152,14 +100,7 @@ impl Cell {
     /// A cell on `clock`.
     pub fn new(clock: SharedClock) -> Self {
         Self {
-            shared: Arc::new(CellShared {
-                clock,
-                events: EventLog::new(),
-                observe: AtomicBool::new(false),
-                waits: Mutex::default(),
-                wiring: Mutex::default(),
-                modules: Mutex::default(),
-            }),
+            shared: Arc::new(CellShared::new(clock)),
         }
     }
 
@@ -432,209 +373,5 @@ impl fmt::Debug for Cell {
                 &lock(&self.shared.modules).keys().collect::<Vec<_>>(),
             )
             .finish_non_exhaustive()
-    }
-}
-
-/// How a module ended for good.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum ModuleOutcome {
-    /// Every task finished.
-    Finished,
-    /// It failed, and its restart policy was spent.
-    Failed(String),
-    /// It was stopped, or killed with no restart left.
-    Killed,
-}
-
-/// A running module, seen from outside.
-#[derive(Debug, Clone)]
-pub struct ModuleHandle {
-    name: Name,
-    kill: Arc<KillSwitch>,
-    done: Arc<Outcome>,
-}
-
-impl ModuleHandle {
-    /// The module's name.
-    pub fn name(&self) -> &Name {
-        &self.name
-    }
-
-    /// Kills the running copy; a supervised module gets a new one.
-    pub fn kill(&self) {
-        self.kill.kill();
-    }
-
-    /// Stops the module for good.
-    pub fn stop(&self) {
-        self.kill.stop();
-    }
-
-    /// How the module ended, if it has.
-    pub fn outcome(&self) -> Option<ModuleOutcome> {
-        self.done.get()
-    }
-
-    /// Waits until the module has ended for good.
-    pub async fn finished(&mut self) -> ModuleOutcome {
-        // A supervisor dropped without a word (its runtime shut down) tells `Killed`.
-        self.done.wait().await
-    }
-}
-
-type Factory<S> = Box<dyn FnMut() -> ModuleSpec<S> + Send>;
-
-/// Spawns the supervisor of one module as a tokio task of its own.
-pub(crate) fn spawn_module<S: Send + Sync + 'static>(
-    cell: Arc<CellShared>,
-    parent: Option<Name>,
-    policy: RestartPolicy,
-    first: ModuleSpec<S>,
-    factory: Option<Factory<S>>,
-) -> Result<ModuleHandle, CellErrors> {
-    let (handle, supervisor) = supervisor(cell, (parent, None), policy, first, factory)?;
-    tokio::spawn(supervisor);
-    Ok(handle)
-}
-
-/// The supervisor of one module: it runs copies of the module until one finishes, or the
-/// policy is spent, or the module is stopped. The caller places it on a task. Each copy's
-/// costarted children are stopped, and waited for, when the copy ends: a child belongs to
-/// the copy of its parent that started it.
-fn supervisor<S: Send + Sync + 'static>(
-    cell: Arc<CellShared>,
-    (parent, processor): (Option<Name>, Option<Name>),
-    policy: RestartPolicy,
-    first: ModuleSpec<S>,
-    mut factory: Option<Factory<S>>,
-) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellErrors> {
-    let name = first.name.clone();
-    check_module(&lock(&cell.wiring), &first.declaration())?;
-    let kill = Arc::new(KillSwitch::default());
-    match lock(&cell.modules).entry(name.clone()) {
-        Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }.into()),
-        Entry::Vacant(vacant) => vacant.insert(Member {
-            switch: Arc::clone(&kill),
-            placement: first.placement(parent.clone(), processor, &lock(&cell.wiring)),
-        }),
-    };
-    let presence = Presence::new(name.clone());
-    let done = Arc::new(Outcome::default());
-    let report = Teller::new(&done);
-    let handle = ModuleHandle {
-        name: name.clone(),
-        kill: Arc::clone(&kill),
-        done,
-    };
-    cell.record(
-        &name,
-        EventKind::ModuleStarted {
-            parent: parent.clone(),
-        },
-    );
-    // Boxed: what an async block captures stays in its task for the task's whole life, and
-    // a spec is large beside a running module's needs.
-    let first = Box::new(first);
-    let supervisor = async move {
-        let mut next = Some(first);
-        let mut attempt = 0;
-        let outcome = loop {
-            // In one statement, so that the emptied box is freed before the copy runs.
-            let spec = *next.take().expect("a copy is made before every run");
-            let children = Children::default();
-            let copy = ModuleRun::new(
-                spec,
-                Arc::clone(&cell),
-                parent.clone(),
-                Arc::clone(&kill),
-                children.clone(),
-                Arc::clone(&presence),
-            );
-            let exit = copy.await;
-            // The kill that ended this copy is spent; one that comes later is for the next.
-            // (Rearming before a copy starts would lose a kill made before its first poll.)
-            kill.rearm();
-            // Boxed, as the restart delay below: awaited once per copy, they would otherwise
-            // take room in every idle module's task for its whole life.
-            Box::pin(children.stop_all()).await;
-            let outcome = match exit {
-                ModuleExit::Finished => {
-                    cell.record(&name, EventKind::ModuleFinished);
-                    break ModuleOutcome::Finished;
-                }
-                ModuleExit::Killed => {
-                    cell.record(&name, EventKind::ModuleKilled);
-                    ModuleOutcome::Killed
-                }
-                ModuleExit::Failed(reason) => {
-                    cell.record(
-                        &name,
-                        EventKind::ModuleFailed {
-                            reason: reason.clone(),
-                        },
-                    );
-                    ModuleOutcome::Failed(reason)
-                }
-            };
-            attempt += 1;
-            let (Some(delay), Some(factory)) = (policy.delay_before(attempt), factory.as_mut())
-            else {
-                break outcome;
-            };
-            if kill.is_stopped() {
-                break outcome;
-            }
-            Box::pin(cell.clock.sleep(delay)).await;
-            if kill.is_stopped() {
-                break outcome;
-            }
-            let copy = factory();
-            let wired = check_module(&lock(&cell.wiring), &copy.declaration());
-            if let Err(problems) = wired {
-                // The new copy cannot even be wired (say, its response end is taken).
-                let reason = format!("a new copy cannot be wired: {problems}");
-                cell.record(
-                    &name,
-                    EventKind::ModuleFailed {
-                        reason: reason.clone(),
-                    },
-                );
-                break ModuleOutcome::Failed(reason);
-            }
-            next = Some(Box::new(copy));
-            cell.record(&name, EventKind::ModuleRestarted { attempt });
-        };
-        lock(&cell.modules).remove(&name);
-        cell.waits().forget(&name);
-        // Gone for good: whoever waits on a port the module held fails now (PeerGone).
-        presence.set_gone();
-        report.tell(outcome);
-    };
-    Ok((handle, supervisor))
-}
-
-/// The modules one copy of a module costarted.
-#[derive(Clone, Default)]
-pub(crate) struct Children(Arc<Mutex<Vec<ModuleHandle>>>);
-
-impl Children {
-    /// Adds `child`, forgetting the children that have ended, so that a parent that
-    /// costarts children all its life keeps only the live ones.
-    pub(crate) fn adopt(&self, child: &ModuleHandle) {
-        let mut children = lock(&self.0);
-        children.retain(|known| known.outcome().is_none());
-        children.push(child.clone());
-    }
-
-    /// Stops every child for good and waits until each has ended (and, in turn, its own
-    /// children), so that a new copy of the parent can start children of the same names.
-    async fn stop_all(&self) {
-        let children = std::mem::take(&mut *lock(&self.0));
-        for child in &children {
-            child.stop();
-        }
-        for mut child in children {
-            child.finished().await;
-        }
     }
 }

@@ -6,8 +6,8 @@ use std::fmt;
 
 use imrs_ports::{Name, UsageKind, WireError, Wiring};
 
+use crate::decl::{ModuleDecl, owned_by};
 use crate::exception::Exception;
-use crate::module::spec::{ModuleDecl, owned_by};
 
 /// One wiring problem of a cell.
 #[derive(Debug, Clone, PartialEq, Eq)]

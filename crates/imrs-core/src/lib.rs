@@ -142,27 +142,34 @@
 mod cell;
 mod check;
 mod deadlock;
+mod decl;
 mod event;
 mod exception;
+mod kill;
+mod launch;
 mod log;
 mod module;
 mod order;
 mod outcome;
 mod processor;
+mod shared;
 mod supervision;
 pub mod time;
 mod tree;
 mod waitfor;
 mod work;
 
-pub use cell::{Cell, Declare, ModuleHandle, ModuleOutcome};
+pub use cell::{Cell, Declare};
 pub use check::{CellError, CellErrors};
+pub use decl::ModuleDecl;
 pub use event::{Event, EventKind, EventLog, Observed, Primitive};
 pub use exception::Exception;
+pub use outcome::ModuleOutcome;
+pub use shared::ModuleHandle;
 
 pub use log::{Log, Record};
 pub use module::ctx::{Ctx, PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
-pub use module::spec::{ModuleDecl, ModuleSpec, StateView, TaskError, TaskResult};
+pub use module::spec::{ModuleSpec, StateView, TaskError, TaskResult};
 pub use order::{Order, Rank, Section};
 pub use processor::{JobHandle, JobLost, Processor};
 pub use supervision::RestartPolicy;

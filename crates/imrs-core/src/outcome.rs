@@ -9,8 +9,6 @@ use std::sync::{Arc, Mutex, PoisonError};
 
 use tokio::sync::Notify;
 
-use crate::cell::ModuleOutcome;
-
 /// The outcome cell shared by a module's supervisor and its handles.
 #[derive(Debug, Default)]
 pub(crate) struct Outcome {
@@ -75,4 +73,15 @@ impl Drop for Teller {
             cell.tell(ModuleOutcome::Killed);
         }
     }
+}
+
+/// How a module ended for good.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ModuleOutcome {
+    /// Every task finished.
+    Finished,
+    /// It failed, and its restart policy was spent.
+    Failed(String),
+    /// It was stopped, or killed with no restart left.
+    Killed,
 }

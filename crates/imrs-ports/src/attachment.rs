@@ -4,7 +4,8 @@ use std::sync::Arc;
 use std::task::{Context, Poll};
 use std::time::Duration;
 
-use crate::core::{Core, Gone, SlotId, hold};
+use crate::core::{Core, SlotId, hold};
+use crate::error::Gone;
 use crate::loom::Ordering;
 use crate::meta::Name;
 use crate::presence::Presence;
@@ -176,27 +177,5 @@ impl<Req, Rep> Drop for Attachment<Req, Rep> {
             SlotId::Owner => self.core.detach_owner(),
             SlotId::User(index) => self.core.detach_user(index),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::{Port, PortSpec, ProcessType, usage};
-
-    #[test]
-    fn a_tight_port_whose_waits_are_parked_spins_no_more_on_any_end() {
-        let port = Port::<u32, u32, usage::Receive>::declare(
-            PortSpec::new("TIGHT", "OWNER").process_type(ProcessType::Tight),
-        );
-        let owner = port.owner().unwrap();
-        assert!(owner.attachment.spins() > 0);
-        // Set through another handle: it holds for every end, attached before or after.
-        crate::transport::PortTransport::park_waits(&port.clone());
-        let user = port.user_named("USER").unwrap();
-        assert_eq!(owner.attachment.spins(), 0);
-        assert_eq!(user.attachment.spins(), 0);
-        // Ports of other process types never spun.
-        let loose = Port::<u32, u32, usage::Receive>::declare(PortSpec::new("LOOSE", "OWNER"));
-        assert_eq!(loose.owner().unwrap().attachment.spins(), 0);
     }
 }

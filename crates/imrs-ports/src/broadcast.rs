@@ -55,10 +55,6 @@ impl<'a, Req, Rep> Broadcasting<'a, Req, Rep> {
     }
 }
 
-/// How a port's transport takes a broadcast before it is cloned for each user
-/// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
-pub(crate) type Handing<Req> = Box<dyn Fn(Req) -> Req + Send + Sync>;
-
 /// The first answer to a broadcast, and the way to read the later ones.
 ///
 /// While it lives the owner end stays borrowed, so no new broadcast can overwrite answers

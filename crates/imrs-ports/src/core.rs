@@ -7,8 +7,8 @@
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 use std::task::Waker;
 
-use crate::broadcast::Handing;
 use crate::clock::SharedClock;
+use crate::error::Gone;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
@@ -42,14 +42,9 @@ impl Holder {
     }
 }
 
-/// Why nobody can serve or answer a waiter any more.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) enum Gone {
-    /// No end is attached on the other side and no declaration is left to attach one.
-    Closed,
-    /// The module that held the other side has ended for good.
-    Peer(Name),
-}
+/// How a port's transport takes a broadcast before it is cloned for each user
+/// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
+pub(crate) type Handing<Req> = Box<dyn Fn(Req) -> Req + Send + Sync>;
 
 /// Which slot of a port: the owner's, or a user's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,9 +4,17 @@
 use std::error::Error;
 use std::fmt;
 
-use crate::core::Gone;
-use crate::meta::Name;
+use crate::name::Name;
 use crate::usage::UsageKind;
+
+/// Why nobody can serve or answer a waiter any more.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Gone {
+    /// No end is attached on the other side and no declaration is left to attach one.
+    Closed,
+    /// The module that held the other side has ended for good.
+    Peer(Name),
+}
 
 /// Why a [`send`](crate::End::send) failed.
 pub enum SendError<T> {

@@ -9,7 +9,7 @@ use pin_project_lite::pin_project;
 
 use crate::attachment::Attachment;
 use crate::clock::{Sleep, deadline_passed};
-use crate::core::Gone;
+use crate::error::Gone;
 use crate::error::{QueryError, SendError};
 use crate::meta::Name;
 use crate::slot::{Answer, Withdrawn};

@@ -18,7 +18,7 @@ use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, Weak};
 
-use crate::meta::Name;
+use crate::name::Name;
 
 thread_local! {
     /// The presence of the module being polled on this thread, if any.

@@ -127,3 +127,26 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> EndTransport for End<Re
         self.set_parked();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::PortTransport;
+    use crate::{Port, PortSpec, ProcessType, usage};
+
+    #[test]
+    fn a_tight_port_whose_waits_are_parked_spins_no_more_on_any_end() {
+        let port = Port::<u32, u32, usage::Receive>::declare(
+            PortSpec::new("TIGHT", "OWNER").process_type(ProcessType::Tight),
+        );
+        let owner = port.owner().unwrap();
+        assert!(owner.attachment.spins() > 0);
+        // Set through another handle: it holds for every end, attached before or after.
+        port.clone().park_waits();
+        let user = port.user_named("USER").unwrap();
+        assert_eq!(owner.attachment.spins(), 0);
+        assert_eq!(user.attachment.spins(), 0);
+        // Ports of other process types never spun.
+        let loose = Port::<u32, u32, usage::Receive>::declare(PortSpec::new("LOOSE", "OWNER"));
+        assert_eq!(loose.owner().unwrap().attachment.spins(), 0);
+    }
+}

@@ -19,13 +19,10 @@ use imrs_ports::{
 };
 use tracing::Instrument;
 
-use super::spec::ModuleSpec;
-use crate::cell::{CellShared, Children, ModuleHandle, spawn_module};
-use crate::check::CellErrors;
 use crate::event::{Event, EventKind, Observed, Primitive};
 use crate::exception::Exception;
 use crate::order::{Order, Rank, Section};
-use crate::supervision::RestartPolicy;
+use crate::shared::{CellShared, Children};
 use crate::waitfor::{Pool, WaitFor, WaitForError};
 use crate::work::{Performed, WorkSchedule};
 
@@ -81,7 +78,7 @@ pub(crate) struct ModuleShared<S> {
     pub(crate) order: Order,
     pub(crate) cell: Arc<CellShared>,
     /// The modules this copy costarted, stopped when it ends.
-    children: Children,
+    pub(crate) children: Children,
     raised: Mutex<VecDeque<Exception>>,
     restarts: Mutex<Vec<Name>>,
     /// Set while `raised` or `restarts` may hold something, so that the scheduler, which
@@ -524,37 +521,9 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         self.module.cell.kill(module)
     }
 
-    /// `COSTART`: starts `child` as a child module of this one. The child belongs to this
-    /// copy of the module: when the copy ends (finished, failed, killed), the child is
-    /// stopped. Refused if a module of the child's name runs in the cell.
-    pub fn costart<C: Send + Sync + 'static>(
-        &self,
-        child: ModuleSpec<C>,
-    ) -> Result<ModuleHandle, CellErrors> {
-        let cell = Arc::clone(&self.module.cell);
-        let parent = Some(self.module.name.clone());
-        let handle = spawn_module(cell, parent, RestartPolicy::NEVER, child, None)?;
-        self.module.children.adopt(&handle);
-        Ok(handle)
-    }
-
-    /// As [`Ctx::costart`], with a factory that makes a new copy of the child after a
-    /// failure, as `policy` allows.
-    pub fn costart_supervised<C, F>(
-        &self,
-        policy: RestartPolicy,
-        mut factory: F,
-    ) -> Result<ModuleHandle, CellErrors>
-    where
-        C: Send + Sync + 'static,
-        F: FnMut() -> ModuleSpec<C> + Send + 'static,
-    {
-        let cell = Arc::clone(&self.module.cell);
-        let parent = Some(self.module.name.clone());
-        let first = factory();
-        let handle = spawn_module(cell, parent, policy, first, Some(Box::new(factory)))?;
-        self.module.children.adopt(&handle);
-        Ok(handle)
+    /// What the module's tasks and handlers share.
+    pub(crate) fn module_shared(&self) -> &Arc<ModuleShared<S>> {
+        &self.module
     }
 
     pub(crate) fn event(&self, kind: EventKind) {

@@ -13,6 +13,7 @@ use imrs_ports::{
 };
 
 use super::ctx::Ctx;
+use crate::decl::{ModuleDecl, owned_by};
 use crate::exception::Exception;
 use crate::supervision::RestartPolicy;
 use crate::tree::{Placement, TreeModule};
@@ -301,43 +302,6 @@ impl<S> fmt::Debug for ModuleSpec<S> {
             )
             .finish_non_exhaustive()
     }
-}
-
-/// A module's declarations, for the wiring check: the seed's module specification.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ModuleDecl {
-    /// The module.
-    pub name: Name,
-    /// Its order.
-    pub order: Vec<Name>,
-    /// The ports it uses, with its usage.
-    pub uses: Vec<(Name, UsageKind)>,
-    /// The ports it filters, with the filter's usage toward the users.
-    pub filters: Vec<(Name, UsageKind)>,
-    /// Its response handlers (`PORT.resp`), each with the port its end answers.
-    pub responses: Vec<(Name, Name)>,
-    /// Its exception handlers.
-    pub exceptions: Vec<Name>,
-    /// Its tasks.
-    pub tasks: Vec<Name>,
-    /// The exceptions it declares it raises itself ([`ModuleSpec::raises`]).
-    pub raises: Vec<Name>,
-    /// The ends it could not attach when it was declared ([`ModuleSpec::respond`]).
-    /// (The ports it owns are those declared with it as their owner.)
-    pub problems: Vec<WireError>,
-}
-
-/// The ports declared to `wiring` whose owner is `module`.
-pub(crate) fn owned_by(wiring: &Wiring, module: &Name) -> Vec<Name> {
-    wiring
-        .port_names()
-        .filter(|port| {
-            wiring
-                .port_info(port.as_str())
-                .is_some_and(|info| info.owner == *module)
-        })
-        .cloned()
-        .collect()
 }
 
 /// A module's state seen from outside; see [`ModuleSpec::view`].

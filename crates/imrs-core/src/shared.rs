@@ -1,0 +1,136 @@
+//! What a cell's modules share with it and with each other: the clock, the event log, the
+//! wiring, the modules running (each with its kill switch), and the handles that watch a
+//! module from outside. The cell and the supervisors that run modules both build on it.
+
+use std::collections::BTreeMap;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+
+use imrs_ports::{Name, SharedClock, Wiring};
+
+use crate::deadlock::WaitGraph;
+use crate::event::{Event, EventKind, EventLog};
+use crate::kill::KillSwitch;
+use crate::outcome::{ModuleOutcome, Outcome};
+use crate::tree::Placement;
+
+pub(crate) struct CellShared {
+    pub(crate) clock: SharedClock,
+    pub(crate) events: EventLog,
+    /// Whether the primitives' events say how long each waited and carry the text of the
+    /// values of the ports that show them.
+    pub(crate) observe: AtomicBool,
+    pub(crate) waits: Mutex<WaitGraph>,
+    pub(crate) wiring: Mutex<Wiring>,
+    pub(crate) modules: Mutex<BTreeMap<Name, Member>>,
+}
+
+/// A running module: its switch, and where it sits in the tree.
+pub(crate) struct Member {
+    pub(crate) switch: Arc<KillSwitch>,
+    pub(crate) placement: Placement,
+}
+
+impl CellShared {
+    pub(crate) fn new(clock: SharedClock) -> Self {
+        Self {
+            clock,
+            events: EventLog::new(),
+            observe: AtomicBool::new(false),
+            waits: Mutex::default(),
+            wiring: Mutex::default(),
+            modules: Mutex::default(),
+        }
+    }
+
+    pub(crate) fn kill(&self, module: &str) -> bool {
+        let switch = self.switch(module);
+        switch.inspect(|switch| switch.kill()).is_some()
+    }
+
+    pub(crate) fn switch(&self, module: &str) -> Option<Arc<KillSwitch>> {
+        lock(&self.modules)
+            .get(&Name::from(module))
+            .map(|member| Arc::clone(&member.switch))
+    }
+
+    pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
+        lock(&self.waits)
+    }
+
+    pub(crate) fn record(&self, module: &Name, kind: EventKind) {
+        self.events.record(Event {
+            at: self.clock.now(),
+            module: module.clone(),
+            task: None,
+            kind,
+        });
+    }
+}
+
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Each critical section is one map operation: a panic cannot leave it half-done.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// A running module, seen from outside.
+#[derive(Debug, Clone)]
+pub struct ModuleHandle {
+    pub(crate) name: Name,
+    pub(crate) kill: Arc<KillSwitch>,
+    pub(crate) done: Arc<Outcome>,
+}
+
+impl ModuleHandle {
+    /// The module's name.
+    pub fn name(&self) -> &Name {
+        &self.name
+    }
+
+    /// Kills the running copy; a supervised module gets a new one.
+    pub fn kill(&self) {
+        self.kill.kill();
+    }
+
+    /// Stops the module for good.
+    pub fn stop(&self) {
+        self.kill.stop();
+    }
+
+    /// How the module ended, if it has.
+    pub fn outcome(&self) -> Option<ModuleOutcome> {
+        self.done.get()
+    }
+
+    /// Waits until the module has ended for good.
+    pub async fn finished(&mut self) -> ModuleOutcome {
+        // A supervisor dropped without a word (its runtime shut down) tells `Killed`.
+        self.done.wait().await
+    }
+}
+
+/// The modules one copy of a module costarted.
+#[derive(Clone, Default)]
+pub(crate) struct Children(Arc<Mutex<Vec<ModuleHandle>>>);
+
+impl Children {
+    /// Adds `child`, forgetting the children that have ended, so that a parent that
+    /// costarts children all its life keeps only the live ones.
+    pub(crate) fn adopt(&self, child: &ModuleHandle) {
+        let mut children = lock(&self.0);
+        children.retain(|known| known.outcome().is_none());
+        children.push(child.clone());
+    }
+
+    /// Stops every child for good and waits until each has ended (and, in turn, its own
+    /// children), so that a new copy of the parent can start children of the same names.
+    pub(crate) async fn stop_all(&self) {
+        let children = std::mem::take(&mut *lock(&self.0));
+        for child in &children {
+            child.stop();
+        }
+        for mut child in children {
+            child.finished().await;
+        }
+    }
+}
