@@ -95,19 +95,21 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! # let runtime = tokio::runtime::Builder::new_current_thread().enable_all().start_paused(true).build()?;
 //! # runtime.block_on(async {
+//! const LOAD_IT: Module = Module::new("LOAD_IT");
+//! const LOAD_CARD: Module = Module::new("LOAD_CARD");
 //! const LOAD: Section = Section::new("LOAD");
 //! let (cell, clock) = Cell::virtual_clock();
 //! // ASK_CHILD1(RC, NUM_DONE), owned by LOAD_IT: USAGE=QUERY, its query bounded by 5 s.
 //! let ask_child1: Port<(), (i32, u32), usage::Query> =
-//!     cell.port(PortSpec::new("ASK_CHILD1", "LOAD_IT").owner_timeout(Duration::from_secs(5)))?;
+//!     cell.port(PortSpec::new("ASK_CHILD1", LOAD_IT).owner_timeout(Duration::from_secs(5)))?;
 //! let status = ask_child1.handler("STATUS");
 //!
 //! #[derive(Default)]
 //! struct LoadCard { num_loaded: u32 }
-//! let load_card = ModuleSpec::new("LOAD_CARD", LoadCard::default())
+//! let load_card = ModuleSpec::new(LOAD_CARD, LoadCard::default())
 //!     .order([LOAD.name(), status.name()]) // STATUS is never answered mid-load
 //!     .respond(&status, |s: &LoadCard, ()| (0, s.num_loaded))
-//!     .task("LOAD_CARD", |ctx| async move {
+//!     .task(LOAD_CARD, |ctx| async move {
 //!         loop {
 //!             ctx.section(&LOAD, ctx.delay(Duration::from_secs(8))).await; // load a card
 //!             ctx.state().update(|s| s.num_loaded += 1);
@@ -116,7 +118,7 @@
 //!     });
 //! let loaded = load_card.view();
 //!
-//! let load_it = ModuleSpec::new("LOAD_IT", ()).task("LOAD_IT", move |ctx| {
+//! let load_it = ModuleSpec::new(LOAD_IT, ()).task(LOAD_IT, move |ctx| {
 //!     // Each copy of the task attaches anew: a restarted copy re-attaches to the same port.
 //!     let ask_child1 = ctx.owner(&ask_child1);
 //!     async move {

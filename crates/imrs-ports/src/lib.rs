@@ -55,6 +55,7 @@ mod error;
 pub mod filter;
 mod loom;
 mod meta;
+mod module_name;
 mod name;
 mod port;
 pub mod post;
@@ -81,6 +82,7 @@ pub use end::End;
 pub use error::{BroadcastError, QueryError, ReceiveError, SendError, WireError};
 pub use filter::{BoundedBuffer, BoundedBufferPort, FilterEnds, FilteredPort};
 pub use meta::{Name, Named};
+pub use module_name::Module;
 pub use port::{Handler, Port, PortSpec};
 pub use priority::Priority;
 pub use process_type::ProcessType;
@@ -96,8 +98,8 @@ pub use wiring::{PortInfo, WireErrors, Wiring};
 /// Everything a module author needs, in one import.
 pub mod prelude {
     pub use crate::{
-        AnyUser, BoundedBuffer, BoundedBufferPort, Clock, End, FilteredPort, ModuleState, Named,
-        Port, PortSpec, Priority, ProcessType, ReplyHandle, ResponseEnd, VirtualClock, select,
-        usage, user_list, when,
+        AnyUser, BoundedBuffer, BoundedBufferPort, Clock, End, FilteredPort, Module, ModuleState,
+        Named, Port, PortSpec, Priority, ProcessType, ReplyHandle, ResponseEnd, VirtualClock,
+        select, usage, user_list, when,
     };
 }
