@@ -28,7 +28,7 @@ fn ctx_multi_thread(iters: u64) -> Duration {
 
 /// The raw `End` round trip: two futures that hold the ends themselves.
 fn raw_ends(iters: u64) -> (impl Future<Output = ()>, impl Future<Output = Duration>) {
-    let feed = Port::<[u8; 8], u64, usage::Receive>::declare(PortSpec::new("FEED", "SERVER"));
+    let feed = Port::<[u8; 8], u64, usage::Receive>::new(PortSpec::new("FEED", "SERVER"));
     let mut server = feed.owner().unwrap();
     let mut client = feed.user_named("CLIENT").unwrap();
     let serving = async move {

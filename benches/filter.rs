@@ -22,7 +22,7 @@ type Frequency = BoundedBufferPort<(i32, f64), AnyUser, 1>;
 /// the user and the owner, as modules that talk at every message would be placed.
 fn through_filter(iters: u64, processor: bool) -> Duration {
     current_thread().block_on(async move {
-        let port = Frequency::declare(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
+        let port = Frequency::new(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
         let mut gate = port.owner().unwrap();
         let mut user = port.user_named("LOAD_IT").unwrap();
         let filter = BoundedBuffer::<(i32, f64), 20>::new().run(port.filter().unwrap());

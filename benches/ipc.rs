@@ -419,7 +419,7 @@ fn echo<T: Wire>(
     process_type: ProcessType,
 ) -> tokio::task::JoinHandle<()> {
     let port: Port<T, T, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new(name, "ECHO").process_type(process_type));
+        Port::new(PortSpec::new(name, "ECHO").process_type(process_type));
     let exported = export(remote, &port).expect("exported");
     let mut owner = port.owner().expect("the owner's end");
     tokio::spawn(async move {
@@ -471,7 +471,7 @@ fn echo_broadcasts<M: Send + 'static>(
 /// with itself, copied once into the reply's sample.
 fn loaned_echo<T: Wire>(remote: &Remote, name: &str) -> tokio::task::JoinHandle<()> {
     let port: Port<Shared<T>, Shared<T>, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new(name, "ECHO"));
+        Port::new(PortSpec::new(name, "ECHO"));
     let exported = export(remote, &port).expect("exported");
     let mut owner = port.owner().expect("the owner's end");
     tokio::spawn(async move {
@@ -518,27 +518,25 @@ fn broadcasts(runtime: &tokio::runtime::Runtime, cell: &str, rounds: usize) -> [
     let cell = format!("{cell}-news");
     let remote = Remote::new(&cell).expect("a cell name");
     let _entered = runtime.enter();
-    let small = Port::<Small, Small, usage::SendAll, AnyUser, 1>::declare(PortSpec::new(
+    let small = Port::<Small, Small, usage::SendAll, AnyUser, 1>::new(PortSpec::new(
         "NEWS_SMALL",
         "CAMERA",
     ));
-    let large = Port::<Large, Large, usage::SendAll, AnyUser, 1>::declare(PortSpec::new(
+    let large = Port::<Large, Large, usage::SendAll, AnyUser, 1>::new(PortSpec::new(
         "NEWS_LARGE",
         "CAMERA",
     ));
-    let loaned_small = Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 1>::declare(
+    let loaned_small = Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 1>::new(
         PortSpec::new("NEWS_SMALL_LOANED", "CAMERA"),
     );
-    let loaned_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 1>::declare(
+    let loaned_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 1>::new(
         PortSpec::new("NEWS_LARGE_LOANED", "CAMERA"),
     );
     let pair = |name: &str| PortSpec::new(name, "CAMERA").user_list(["LISTENER", "LISTENER_2"]);
-    let pair_small = Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 2>::declare(
-        pair("PAIR_SMALL"),
-    );
-    let pair_large = Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 2>::declare(
-        pair("PAIR_LARGE"),
-    );
+    let pair_small =
+        Port::<Shared<Small>, Shared<Small>, usage::SendAll, AnyUser, 2>::new(pair("PAIR_SMALL"));
+    let pair_large =
+        Port::<Shared<Large>, Shared<Large>, usage::SendAll, AnyUser, 2>::new(pair("PAIR_LARGE"));
     let _exported = [
         export(&remote, &small),
         export(&remote, &large),

@@ -57,7 +57,7 @@ fn query(iters: u64, busy: bool) -> Duration {
 /// The same-thread rendezvous, for the ratio.
 fn rendezvous(iters: u64) -> Duration {
     current_thread().block_on(async move {
-        let port = Port::<u64, u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let port = Port::<u64, u64, usage::Receive>::new(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
         let processor = Processor::new("CPU1");

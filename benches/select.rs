@@ -16,7 +16,7 @@ type Inbox = Port<u32, (), usage::Receive>;
 fn selects(iters: u64, ready: usize) -> Duration {
     current_thread().block_on(async move {
         let ports: Vec<Inbox> = (0..8u32)
-            .map(|n| Inbox::declare(PortSpec::new(format!("P{n}"), "OWNER").priority(n + 1)))
+            .map(|n| Inbox::new(PortSpec::new(format!("P{n}"), "OWNER").priority(n + 1)))
             .collect();
         let mut owners: Vec<End<u32, (), usage::Receive>> =
             ports.iter().map(|p| p.owner().unwrap()).collect();

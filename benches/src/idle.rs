@@ -27,7 +27,7 @@ pub async fn idle_modules(count: usize) -> (IdleModules, Duration) {
     let mut ports = Vec::with_capacity(count);
     let mut handles = Vec::with_capacity(count);
     for i in 0..count {
-        let port = Port::<u64, u64, usage::Receive>::declare(PortSpec::new(
+        let port = Port::<u64, u64, usage::Receive>::new(PortSpec::new(
             format!("IDLE{i}"),
             format!("M{i}"),
         ));

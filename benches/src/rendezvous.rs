@@ -64,7 +64,7 @@ pub fn imrs_on_processor<const N: usize>(
             spec = spec.priority(1);
             (server_priority, client_priority) = (Priority::declared(3), Priority::declared(2));
         }
-        let port = Port::<[u8; N], u64, usage::Receive>::declare(spec);
+        let port = Port::<[u8; N], u64, usage::Receive>::new(spec);
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
         let serving = processor.spawn_with_priority(server_priority, async move {
@@ -95,7 +95,7 @@ pub fn imrs_on_processor<const N: usize>(
 /// imrs, each end a tokio task of its own on one current-thread runtime.
 pub fn imrs_same_thread_tasks<const N: usize>(iters: u64, tail: Option<&mut Tail>) -> Duration {
     current_thread().block_on(async move {
-        let port = Port::<[u8; N], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let port = Port::<[u8; N], u64, usage::Receive>::new(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().unwrap();
         let mut client = port.user_named("CLIENT").unwrap();
         let serving = tokio::spawn(async move {
@@ -116,7 +116,7 @@ pub fn imrs_cross_thread<const N: usize>(
     process_type: ProcessType,
     tail: Option<&mut Tail>,
 ) -> Duration {
-    let port = Port::<[u8; N], u64, usage::Receive>::declare(
+    let port = Port::<[u8; N], u64, usage::Receive>::new(
         PortSpec::new("P", "SERVER").process_type(process_type),
     );
     let mut server = port.owner().unwrap();

@@ -37,7 +37,7 @@ fn queries(round_trips: u64) {
     current_thread().block_on(async move {
         let cell = Cell::new(std::sync::Arc::new(RealClock::new()));
         let processor = Processor::new("CPU1");
-        let port = Port::<u64, u64, usage::Query>::declare(PortSpec::new("STATUS", "ASKER"));
+        let port = Port::<u64, u64, usage::Query>::new(PortSpec::new("STATUS", "ASKER"));
         let responder = ModuleSpec::new("ROBOT", 7u64)
             .order(["STATUS.STATE", "ROBOT"])
             .respond(&port.handler("STATE"), |s: &u64, q: u64| s + q)
@@ -59,7 +59,7 @@ fn queries(round_trips: u64) {
 fn rendezvous(round_trips: u64) {
     current_thread().block_on(async move {
         let processor = Processor::new("CPU1");
-        let port = Port::<[u8; 8], u64, usage::Receive>::declare(PortSpec::new("P", "SERVER"));
+        let port = Port::<[u8; 8], u64, usage::Receive>::new(PortSpec::new("P", "SERVER"));
         let mut server = port.owner().expect("a new port has no owner yet");
         let mut client = port
             .user_named("CLIENT")

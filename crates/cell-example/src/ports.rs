@@ -192,41 +192,40 @@ impl LinePorts {
         let n = LineNames::of(line);
         let twin = LineNames::of(line.other());
         Self {
-            frequency: Frequency::declare(
+            frequency: Frequency::new(
                 spec(&n.frequency, &n.gate, clock)
                     .user_list([n.load_it.clone(), n.chip_it.clone()]),
                 "BOUNDED_BUFFER",
             )
             .shown(),
-            let_1_go: Let1Go::declare(spec(&n.let_1_go, &n.gate, clock).owner_timeout(secs(2)))
-                .shown(),
-            ask_child1: AskChild1::declare(
+            let_1_go: Let1Go::new(spec(&n.let_1_go, &n.gate, clock).owner_timeout(secs(2))).shown(),
+            ask_child1: AskChild1::new(
                 spec(&n.ask_child1, &n.load_it, clock)
                     .user_list([n.load_card.clone()])
                     .owner_timeout(secs(2)),
             )
             .shown(),
-            ask_child2: AskChild2::declare(
+            ask_child2: AskChild2::new(
                 spec(&n.ask_child2, &n.load_it, clock)
                     .user_list([n.screw_in_card.clone()])
                     .owner_timeout(secs(2)),
             )
             .shown(),
-            pallet_in_place: PalletInPlace::declare(
+            pallet_in_place: PalletInPlace::new(
                 spec(&n.pallet_in_place, &n.load_card, clock).owner_timeout(secs(30)),
             )
             .shown(),
-            card_in_place: CardInPlace::declare(
+            card_in_place: CardInPlace::new(
                 spec(&n.card_in_place, &n.load_card, clock)
                     .user_list([n.screw_in_card.clone()])
                     .owner_timeout(secs(30)),
             )
             .shown(),
-            ready_to_chip: ReadyToChip::declare(
+            ready_to_chip: ReadyToChip::new(
                 spec(&n.ready_to_chip, &n.chip_it, clock).owner_timeout(secs(60)),
             )
             .shown(),
-            share_feeder: ShareFeeder::declare(
+            share_feeder: ShareFeeder::new(
                 spec(&n.share_feeder, &n.chip_it, clock)
                     .user_list([twin.chip_it.clone()])
                     .owner_timeout(secs(3)),
@@ -259,16 +258,16 @@ impl CellPorts {
                 LinePorts::new(Line::B, clock),
             ],
             zone_request: ZoneLink::Here(
-                ZonePort::declare(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
+                ZonePort::new(spec(ZONE_REQUEST, FEEDER_MONITOR, clock)).shown(),
             ),
             zone_release: ZoneLink::Here(
-                ZonePort::declare(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
+                ZonePort::new(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
             ),
             zone_reserve: ZoneLink::Here(
-                ReservePort::declare(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)).shown(),
+                ReservePort::new(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)).shown(),
             ),
             zone_free: ZoneLink::Here(
-                ZonePort::declare(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
+                ZonePort::new(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
             ),
         }
     }

@@ -64,13 +64,13 @@ impl CoordinatorPorts {
     pub fn new(name: &str, robots: &[&str], clock: &SharedClock) -> Self {
         let spec = |port: String| PortSpec::new(port, name).clock(clock.clone());
         Self {
-            to_coordinator: Port::declare(spec("TO_COORDINATOR".into()).priority(2)),
-            alarm: Port::declare(spec("ALARM".into()).priority(1)),
-            emergency: Port::declare(spec("EMERGENCY".into()).priority(1)),
+            to_coordinator: Port::new(spec("TO_COORDINATOR".into()).priority(2)),
+            alarm: Port::new(spec("ALARM".into()).priority(1)),
+            emergency: Port::new(spec("EMERGENCY".into()).priority(1)),
             wake: robots
                 .iter()
                 .map(|&robot| {
-                    let port = Port::declare(spec(format!("WAKE_{robot}")).user_list([robot]));
+                    let port = Port::new(spec(format!("WAKE_{robot}")).user_list([robot]));
                     (Name::from(robot), port)
                 })
                 .collect(),

@@ -156,7 +156,7 @@ impl Cell {
                 port: spec.name().clone(),
             });
         }
-        let port = Port::declare(spec.clock(Arc::clone(&self.shared.clock)));
+        let port = Port::new(spec.clock(Arc::clone(&self.shared.clock)));
         self.declare(&port)?;
         Ok(port)
     }
@@ -189,7 +189,7 @@ impl Cell {
                 port: spec.name().clone(),
             });
         }
-        let port = FilteredPort::declare(spec.clock(Arc::clone(&self.shared.clock)), filter_task);
+        let port = FilteredPort::new(spec.clock(Arc::clone(&self.shared.clock)), filter_task);
         self.declare(&port)?;
         Ok(port)
     }

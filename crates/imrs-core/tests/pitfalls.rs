@@ -67,7 +67,7 @@ fn a_response_handler_left_out_of_the_order_refuses_the_module_at_start() {
 fn a_port_on_another_clock_is_refused_by_name() {
     let (cell, _clock) = Cell::virtual_clock();
     // Made outside the cell: it runs on a wall clock of its own.
-    let stray = Port::<(), (), usage::Send>::declare(PortSpec::new("STRAY", "GATE"));
+    let stray = Port::<(), (), usage::Send>::new(PortSpec::new("STRAY", "GATE"));
     assert_eq!(
         cell.declare(&stray),
         Err(WireError::OtherClock {
@@ -124,7 +124,7 @@ fn a_port_the_cell_makes_times_out_on_the_cells_virtual_clock() {
 fn a_module_using_a_port_the_cell_never_declared_is_refused_at_start() {
     paused_runtime().block_on(async {
         let (cell, _clock) = Cell::virtual_clock();
-        let undeclared = Port::<(), (), usage::Send>::declare(
+        let undeclared = Port::<(), (), usage::Send>::new(
             PortSpec::new("PLACE", "PALLETIZER").clock(cell.clock().clone()),
         );
         let spec = ModuleSpec::new("GRIPPER", ())

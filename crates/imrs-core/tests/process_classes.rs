@@ -159,7 +159,7 @@ fn tightly_coupled_a_parent_directs_its_child_through_a_tight_port() {
     runtime.block_on(async {
         let cell = Cell::new(Arc::new(RealClock::new()));
         // DIRECT: owned by the child's parent ARM, USAGE=SEND, process type TIGHT.
-        let direct = Port::<u32, u32, usage::Send>::declare(
+        let direct = Port::<u32, u32, usage::Send>::new(
             PortSpec::new("DIRECT", "ARM").process_type(ProcessType::Tight),
         );
         let arm = ModuleSpec::new("ARM", ()).task("ARM", {

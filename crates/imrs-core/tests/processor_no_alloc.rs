@@ -22,7 +22,7 @@ fn a_rendezvous_on_one_processor_in_steady_state_allocates_nothing() {
         .unwrap();
     let allocated = runtime.block_on(async {
         let processor = Processor::new("CPU1");
-        let port = Port::<[u8; 64], u64, usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<[u8; 64], u64, usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         let serving = processor.spawn(async move {

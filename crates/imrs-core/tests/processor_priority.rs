@@ -259,8 +259,8 @@ fn served_after_wakes_from_another_thread(estop: PortSpec) -> Vec<&'static str> 
     paused_runtime().block_on(async move {
         let processor = Processor::new("CPU1");
         let routine_in =
-            Port::<u8, (), usage::Receive>::declare(PortSpec::new("ROUTINE_IN", "ROUTINE"));
-        let estop = Port::<u8, (), usage::Receive>::declare(estop);
+            Port::<u8, (), usage::Receive>::new(PortSpec::new("ROUTINE_IN", "ROUTINE"));
+        let estop = Port::<u8, (), usage::Receive>::new(estop);
         let served: Arc<Mutex<Vec<&'static str>>> = Arc::default();
         let mut jobs = Vec::new();
         for (name, priority, port) in [("ROUTINE", 2, &routine_in), ("SAFETY", 4, &estop)] {

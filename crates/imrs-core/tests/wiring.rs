@@ -149,9 +149,8 @@ fn two_modules_of_one_name_are_refused() {
 fn a_port_owned_in_another_process_needs_no_owner_here_but_its_users_are_still_checked() {
     let cell = cell();
     // As a transport imports it: the owner, ARBITER, runs in another process.
-    let imported = Port::<u32, (), usage::Receive>::declare(
-        PortSpec::new("ZONE", "ARBITER").user_list(["ROBOT"]),
-    );
+    let imported =
+        Port::<u32, (), usage::Receive>::new(PortSpec::new("ZONE", "ARBITER").user_list(["ROBOT"]));
     cell.declare_imported(&imported).unwrap();
     // A port of this process that nobody owns is still a problem.
     let _: Port<u32, (), usage::Receive> = cell.port(PortSpec::new("ORPHAN", "GHOST")).unwrap();

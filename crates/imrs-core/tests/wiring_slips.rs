@@ -89,7 +89,7 @@ impl Named for WelderB {
 #[test]
 fn a_port_with_a_typed_and_a_named_user_list_is_refused_everywhere() {
     let (cell, _clock) = Cell::virtual_clock();
-    let status = Port::<(), u32, usage::Query, Welders>::declare(
+    let status = Port::<(), u32, usage::Query, Welders>::new(
         PortSpec::new("B_STATUS", "WELD_CELL")
             .user_list(["WELDER_A"])
             .clock(cell.clock().clone()),

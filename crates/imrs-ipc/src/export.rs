@@ -659,7 +659,7 @@ mod tests {
         runtime.block_on(async {
             let remote = Remote::new(&format!("unit-turns-{}", std::process::id())).unwrap();
             let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-                Port::declare(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
+                Port::new(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
             let _exported = export(&remote, &port).unwrap();
             let mut owner = port.owner().unwrap();
             // The handshake waits for the bridge's task, which runs on this thread meanwhile.

@@ -270,7 +270,7 @@ where
     } else {
         ProcessType::default()
     };
-    let local: Port<M, R, U, AnyUser, 1> = Port::declare(
+    let local: Port<M, R, U, AnyUser, 1> = Port::new(
         PortSpec::new(name.clone(), owner)
             .user_list([module])
             .process_type(process_type),

@@ -12,7 +12,7 @@
 //!
 //! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
 //! // The owner's process: the port, declared as ever, and exported.
-//! let port: Port<u64, u64, usage::Receive, AnyUser, 4> = Port::declare(PortSpec::new("DOUBLE", "DOUBLER"));
+//! let port: Port<u64, u64, usage::Receive, AnyUser, 4> = Port::new(PortSpec::new("DOUBLE", "DOUBLER"));
 //! let _bridge = export(&Remote::new("my_cell")?, &port)?;
 //! let mut owner = port.owner()?;
 //! let (n, reply) = owner.receive().await?;
@@ -113,7 +113,7 @@
 //!
 //! # async fn owner() -> Result<(), Box<dyn std::error::Error>> {
 //! let port: Port<Shared<Image>, Shared<u64>, usage::Receive, AnyUser, 1> =
-//!     Port::declare(PortSpec::new("IMAGE", "VISION"));
+//!     Port::new(PortSpec::new("IMAGE", "VISION"));
 //! let _bridge = export(&Remote::new("my_cell")?, &port)?;
 //! let mut vision = port.owner()?;
 //! let (image, reply) = vision.receive().await?; // read where the camera wrote it

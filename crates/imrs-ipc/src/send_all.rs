@@ -371,7 +371,7 @@ where
 {
     let name = Name::from(port);
     let local: Port<M, R, U, AnyUser, 1> =
-        Port::declare(PortSpec::new(name.clone(), owner).user_list([module]));
+        Port::new(PortSpec::new(name.clone(), owner).user_list([module]));
     // First the service the owner's process will relay to, so that it is there when the
     // owner answers the connection by relaying.
     let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());

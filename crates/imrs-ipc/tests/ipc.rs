@@ -280,7 +280,7 @@ async fn replies_given_outside_the_runtime_cross_while_requests_keep_coming() {
     let remote = Remote::new(&cell).unwrap();
     let modules = ["ASKER", "ASKER_2", "ASKER_3", "ASKER_4"];
     let port: Port<Number, Number, usage::Receive, AnyUser, 4> =
-        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").user_list(modules));
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(modules));
     let _exported = export(&remote, &port).unwrap();
     let mut owner = port.owner().unwrap();
     let (handles, replier) = std::sync::mpsc::channel::<(Number, ReplyHandle<Number>)>();
@@ -598,7 +598,7 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
     );
     // And a port whose broadcasts go out on a publish-subscribe service of its own.
     let frames: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT"]));
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT"]));
     let _broadcasts = imrs_ipc::export(&remote, &frames).unwrap();
     let listening = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
         &remote, "FRAMES", "CAMERA", "LEFT",
@@ -660,13 +660,13 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
 
     let cell = cell("select");
     // This process owns both: DOUBLE, used from another process, and LOCAL, from here.
-    let remote_port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::declare(
+    let remote_port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::new(
         PortSpec::new("DOUBLE", "DOUBLER")
             .user_list(["ASKER"])
             .priority(2),
     );
     let local_port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new("LOCAL", "DOUBLER").priority(1));
+        Port::new(PortSpec::new("LOCAL", "DOUBLER").priority(1));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &remote_port).unwrap();
     let asking = user(&cell, "ASKER", "50");
     let mut local = local_port.user_named("HERE").unwrap();
@@ -702,7 +702,7 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
 
     let cell = cell("user-killed");
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut owner = port.owner().unwrap();
     // The user's first request is here; kill -9 it before the reply.
@@ -765,7 +765,7 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
 
     let cell = cell("send-all");
     let port: Port<Number, Number, usage::SendAll, AnyUser, 2> =
-        Port::declare(PortSpec::new("NEWS", "BROADCASTER").user_list(["ASKER", "ASKER_2"]));
+        Port::new(PortSpec::new("NEWS", "BROADCASTER").user_list(["ASKER", "ASKER_2"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut broadcaster = port.owner().unwrap();
     let listeners: Vec<Peer> = ["ASKER", "ASKER_2"]
@@ -796,7 +796,7 @@ async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
     let cell = cell("full");
     // Room for one user, whoever it is.
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new("SINGLE", "OWNER"));
+        Port::new(PortSpec::new("SINGLE", "OWNER"));
     let remote = Remote::new(&cell).unwrap();
     let _exported = imrs_ipc::export(&remote, &port).unwrap();
     let _first =
@@ -847,7 +847,7 @@ async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceory
     // Three times iceoryx2's default of 8 clients to a service.
     const USERS: usize = 24;
     let port: Port<Number, Number, usage::Receive, AnyUser, USERS> =
-        Port::declare(PortSpec::new("MANY", "OWNER"));
+        Port::new(PortSpec::new("MANY", "OWNER"));
     let remote = Remote::new(&cell).unwrap();
     let _exported = imrs_ipc::export(&remote, &port).unwrap();
     let users: Vec<_> = (0..USERS)
@@ -915,7 +915,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
 
     let cell = cell("call-all");
     let port: Port<Number, Number, usage::CallAll, AnyUser, 3> =
-        Port::declare(PortSpec::new("POLL", "CALLER").user_list(["REMOTE_1", "REMOTE_2", "LOCAL"]));
+        Port::new(PortSpec::new("POLL", "CALLER").user_list(["REMOTE_1", "REMOTE_2", "LOCAL"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut caller = port.owner().unwrap();
     // A response handler in this process, beside two in others (which answer with 4 n).
@@ -1029,7 +1029,7 @@ async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_do
     // must still let the bridge go, with its hold on the port.
     let cell = cell("tight-dropped");
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
     let exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut owner = port.owner().unwrap();
     drop(exported);
@@ -1048,7 +1048,7 @@ async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fai
     let cell = cell("query");
     // ASK_STATUS(N): USAGE=QUERY, USERLIST=(CHILD): the parent asks its child.
     let port: Port<Number, Number, usage::Query, AnyUser, 1> =
-        Port::declare(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
+        Port::new(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
     let child = peer(&["child", &cell, "ASK_STATUS", "CHILD", "10"]);
@@ -1082,7 +1082,7 @@ fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
     let cell = cell("no-io");
     runtime.block_on(async {
         let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-            Port::declare(PortSpec::new("QUIET", "OWNER"));
+            Port::new(PortSpec::new("QUIET", "OWNER"));
         let error = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port)
             .err()
             .expect("refused");
@@ -1248,7 +1248,7 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
 async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_process() {
     let cell = cell("shared-owner-query");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Query, AnyUser, 1> =
-        Port::declare(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
+        Port::new(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut parent = port.owner().unwrap();
     let child = peer(&["frame-child", &cell, "ASK_FRAME", "CHILD", "11"]);
@@ -1435,7 +1435,7 @@ async fn answered_every_frame(users: Vec<Peer>) {
 async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes() {
     let cell = cell("shared-send-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-listener", &cell, "FRAMES");
@@ -1455,7 +1455,7 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
 async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_processes() {
     let cell = cell("shared-call-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::CallAll, AnyUser, 2> =
-        Port::declare(PortSpec::new("LOOK", "CAMERA").user_list(["LEFT", "RIGHT"]));
+        Port::new(PortSpec::new("LOOK", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let users = frame_users("frame-answerer", &cell, "LOOK");
@@ -1474,7 +1474,7 @@ async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_ans
  {
     let cell = cell("shared-send-all-kill");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     let mut users = frame_users("frame-listener", &cell, "FRAMES");
@@ -1560,7 +1560,7 @@ async fn read_in_place_here_and_in_two_other_processes(
 ) {
     let cell = cell(test);
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
     let mut camera = port.owner().unwrap();
     // HERE, a user in the owner's process, answers as the others do, from the heap.
@@ -1622,7 +1622,7 @@ async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_
         })
     );
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&remote, &port).unwrap();
     // The broadcasts are of frames, not numbers.
     let error = imrs_ipc::import::<Imported<Shared<Number>, Shared<Frame>, usage::SendAll>, _>(
@@ -1653,7 +1653,7 @@ async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_pr
     let cell = cell("shared-send-all-again");
     let remote = Remote::new(&cell).unwrap();
     let declare = || -> Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> {
-        Port::declare(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]))
+        Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]))
     };
     let half = BROADCAST_FRAMES / 2;
     let mut seeds = 1..=BROADCAST_FRAMES;

@@ -25,7 +25,7 @@
 //! # let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
 //! # runtime.block_on(async {
 //! // CARD_IN_PLACE, owned by LOAD_CARD: it sends, SCREW_IN_CARD receives and replies.
-//! let port = Port::<u32, i32, usage::Send>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+//! let port = Port::<u32, i32, usage::Send>::new(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
 //! let mut load_card = port.owner()?;
 //! let mut screw_in_card = port.user_named("SCREW_IN_CARD")?;
 //!

@@ -147,7 +147,9 @@ where
     U: Usage,
     L: UserList,
 {
-    /// Declares the port.
+    /// `PORT ...`: makes the port, outside any cell (on the wall clock unless `spec` names
+    /// another). In a cell, `Cell::port` makes it on the cell's clock and declares it to
+    /// the cell.
     ///
     /// A port whose user list is both a type (`L`) and names ([`PortSpec::user_list`]) is
     /// refused at every attach and by the [`Wiring`](crate::Wiring) with
@@ -156,7 +158,7 @@ where
     /// `N = 0` is refused when the port is built (`cargo build`, `cargo test`): the check is a
     /// constant evaluated for each `N`, which `cargo check` does not evaluate, since stable
     /// Rust cannot bound a const generic in a `where` clause.
-    pub fn declare(spec: PortSpec) -> Self {
+    pub fn new(spec: PortSpec) -> Self {
         const {
             assert!(
                 N > 0,

@@ -24,7 +24,7 @@
 //!         Self { pixels: [0; 65536] }
 //!     }
 //! }
-//! let port = Port::<Shared<Image>, Shared<u64>, usage::Receive>::declare(PortSpec::new("IMAGE", "VISION"));
+//! let port = Port::<Shared<Image>, Shared<u64>, usage::Receive>::new(PortSpec::new("IMAGE", "VISION"));
 //! let mut vision = port.owner()?;
 //! let mut camera = port.user_named("CAMERA")?;
 //!

@@ -135,7 +135,7 @@ mod tests {
 
     #[test]
     fn a_tight_port_whose_waits_are_parked_spins_no_more_on_any_end() {
-        let port = Port::<u32, u32, usage::Receive>::declare(
+        let port = Port::<u32, u32, usage::Receive>::new(
             PortSpec::new("TIGHT", "OWNER").process_type(ProcessType::Tight),
         );
         let owner = port.owner().unwrap();
@@ -146,7 +146,7 @@ mod tests {
         assert_eq!(owner.attachment.spins(), 0);
         assert_eq!(user.attachment.spins(), 0);
         // Ports of other process types never spun.
-        let loose = Port::<u32, u32, usage::Receive>::declare(PortSpec::new("LOOSE", "OWNER"));
+        let loose = Port::<u32, u32, usage::Receive>::new(PortSpec::new("LOOSE", "OWNER"));
         assert_eq!(loose.owner().unwrap().attachment.spins(), 0);
     }
 }

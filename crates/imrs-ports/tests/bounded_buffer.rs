@@ -29,7 +29,7 @@ type Frequency = BoundedBufferPort<(i32, f64), FrequencyUsers, 2>;
 #[test]
 fn users_sends_return_at_once_and_gate_reads_them_in_order() {
     on_both_runtimes(|| async {
-        let frequency = Frequency::declare(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
+        let frequency = Frequency::new(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
         let mut gate = frequency.owner().unwrap();
         let mut load_it = frequency.user::<LoadIt>().unwrap();
         let mut chip_it = frequency.user::<ChipIt>().unwrap();
@@ -53,7 +53,7 @@ fn users_sends_return_at_once_and_gate_reads_them_in_order() {
 fn a_full_buffer_holds_the_sender_back_and_loses_nothing() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
-        let frequency = Frequency::declare(
+        let frequency = Frequency::new(
             PortSpec::new("FREQUENCY", "GATE").clock(shared),
             "BOUNDED_BUFFER",
         );
@@ -92,7 +92,7 @@ fn a_full_buffer_holds_the_sender_back_and_loses_nothing() {
 
 #[test]
 fn a_shown_filtered_port_shows_both_sides() {
-    let port = BoundedBufferPort::<(i32, f64), AnyUser, 2>::declare(
+    let port = BoundedBufferPort::<(i32, f64), AnyUser, 2>::new(
         PortSpec::new("FREQUENCY", "GATE").user_list(["LOAD_IT", "CHIP_IT"]),
         "BOUNDED_BUFFER",
     )

@@ -23,7 +23,7 @@ fn allocations_per_round_trips(
         .build()
         .unwrap();
     runtime.block_on(async move {
-        let port = Port::<[u8; 64], u64, usage::Receive>::declare(spec);
+        let port = Port::<[u8; 64], u64, usage::Receive>::new(spec);
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         if let Some(timeout) = user_timeout {

@@ -14,7 +14,7 @@ use imrs_ports::{End, Port, PortSpec, ProcessType, usage};
 type Doubler = Port<u64, u64, usage::Receive>;
 
 fn tight() -> Doubler {
-    Doubler::declare(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight))
+    Doubler::new(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight))
 }
 
 /// Counts the turns and the parkings it is given.
@@ -84,7 +84,7 @@ fn waits_that_park_at_once_give_no_turn() {
     assert!(poll_once(user.send(1)).is_pending());
 
     // A port that is not TIGHT never spins.
-    let loose = Doubler::declare(PortSpec::new("LOOSE", "DOUBLER"));
+    let loose = Doubler::new(PortSpec::new("LOOSE", "DOUBLER"));
     loose.pump_with(Counting(Arc::clone(&counted)));
     let mut owner = loose.owner().unwrap();
     assert!(poll_once(owner.receive()).is_pending());

@@ -34,9 +34,10 @@ fn status(state: &LoadCardState, (): ()) -> (i32, u32, f64) {
 fn a_parent_queries_its_child_and_the_handler_reads_the_childs_state() {
     on_both_runtimes(|| async {
         // ASK_CHILD1: owned by LOAD_IT, USAGE=QUERY, USERLIST=(LOAD_CARD).
-        let port = Port::<(), (i32, u32, f64), usage::Query, AskChild1Users>::declare(
-            PortSpec::new("ASK_CHILD1", "LOAD_IT"),
-        );
+        let port = Port::<(), (i32, u32, f64), usage::Query, AskChild1Users>::new(PortSpec::new(
+            "ASK_CHILD1",
+            "LOAD_IT",
+        ));
         let mut load_it = port.owner().unwrap();
         let mut ask_child1 = port.answer(LoadCard::NAME, status).unwrap();
         let child = tokio::spawn(async move {
@@ -75,7 +76,7 @@ fn a_parent_queries_its_child_and_the_handler_reads_the_childs_state() {
 #[test]
 fn the_default_hook_runs_handlers_once_the_background_is_suspended() {
     on_both_runtimes(|| async {
-        let port = Port::<(), u32, usage::Response>::declare(PortSpec::new("PEEK", "ROBOT"));
+        let port = Port::<(), u32, usage::Response>::new(PortSpec::new("PEEK", "ROBOT"));
         let mut peek = port
             .answer(port.owner_module().clone(), |state: &u32, ()| *state)
             .unwrap();
@@ -100,7 +101,7 @@ fn the_default_hook_runs_handlers_once_the_background_is_suspended() {
 #[test]
 fn a_panicking_handler_fails_the_query_instead_of_hanging_it() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, u8, usage::Response>::declare(PortSpec::new("FRAGILE", "OWNER"));
+        let port = Port::<u8, u8, usage::Response>::new(PortSpec::new("FRAGILE", "OWNER"));
         let mut fragile = port
             .answer(port.owner_module().clone(), |_: &(), n: u8| {
                 if n == 0 { panic!("no zero") } else { n }
@@ -122,7 +123,7 @@ fn a_query_times_out_and_hands_the_query_back() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
         // SHARE_FEEDER: USAGE=QUERY, USERLIST=(CHIP_IT2), TIMEOUT=3 SEC.
-        let port = Port::<u8, i32, usage::Query>::declare(
+        let port = Port::<u8, i32, usage::Query>::new(
             PortSpec::new("SHARE_FEEDER", "CHIP_IT")
                 .user_list(["CHIP_IT2"])
                 .owner_timeout(Duration::from_secs(3))
@@ -148,9 +149,10 @@ fn a_query_times_out_and_hands_the_query_back() {
 #[test]
 fn call_all_returns_the_first_answer_and_keeps_the_later_ones() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, String, usage::CallAll, imrs_ports::AnyUser, 3>::declare(
-            PortSpec::new("STATUS_ALL", "LINE"),
-        );
+        let port = Port::<u8, String, usage::CallAll, imrs_ports::AnyUser, 3>::new(PortSpec::new(
+            "STATUS_ALL",
+            "LINE",
+        ));
         let mut line = port.owner().unwrap();
         let mut cells = Vec::new();
         for name in ["GATE", "LOAD_IT", "CHIP_IT"] {
@@ -189,7 +191,7 @@ fn call_all_returns_the_first_answer_and_keeps_the_later_ones() {
 fn a_transport_takes_a_query_and_answers_it_later_or_fails_the_querier_by_dropping_it() {
     on_both_runtimes(|| async {
         // A RESPONSE port whose answers come from elsewhere: its handler never runs.
-        let port = Port::<u32, u32, usage::Response>::declare(PortSpec::new("REMOTE", "BRIDGE"));
+        let port = Port::<u32, u32, usage::Response>::new(PortSpec::new("REMOTE", "BRIDGE"));
         let mut bridge = port
             .answer(port.owner_module().clone(), |_: &(), _: u32| {
                 unreachable!("the bridge takes every query")

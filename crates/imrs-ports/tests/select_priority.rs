@@ -13,9 +13,9 @@ type Inbox = Port<u32, (), usage::Receive, AnyUser, 20>;
 /// Declares three ports of priorities 1, 2 and default, with room for twenty users each.
 fn three_ports() -> [Inbox; 3] {
     [
-        Inbox::declare(PortSpec::new("URGENT", "OWNER").priority(1)),
-        Inbox::declare(PortSpec::new("NORMAL", "OWNER").priority(2)),
-        Inbox::declare(PortSpec::new("DEFAULT", "OWNER")),
+        Inbox::new(PortSpec::new("URGENT", "OWNER").priority(1)),
+        Inbox::new(PortSpec::new("NORMAL", "OWNER").priority(2)),
+        Inbox::new(PortSpec::new("DEFAULT", "OWNER")),
     ]
 }
 

@@ -12,7 +12,7 @@ type Stop = Port<&'static str, u32, usage::SendAll, AnyUser, 3>;
 #[test]
 fn send_all_unblocks_at_the_first_reply_and_the_later_ones_stay_readable() {
     on_both_runtimes(|| async {
-        let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+        let port = Stop::new(PortSpec::new("STOP", "SUPERVISOR"));
         let mut supervisor = port.owner().unwrap();
         let mut first = port.user_named("ROBOT1").unwrap();
         let mut second = port.user_named("ROBOT2").unwrap();
@@ -47,7 +47,7 @@ fn send_all_unblocks_at_the_first_reply_and_the_later_ones_stay_readable() {
 #[test]
 fn send_all_with_no_users_hands_the_message_back() {
     on_both_runtimes(|| async {
-        let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+        let port = Stop::new(PortSpec::new("STOP", "SUPERVISOR"));
         let mut supervisor = port.owner().unwrap();
         match supervisor.send_all("halt").await {
             Err(BroadcastError::NoUsers { port, message }) => {
@@ -63,7 +63,7 @@ fn send_all_with_no_users_hands_the_message_back() {
 fn send_all_times_out_when_nobody_answers() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
-        let port = Stop::declare(
+        let port = Stop::new(
             PortSpec::new("STOP", "SUPERVISOR")
                 .owner_timeout(Duration::from_secs(1))
                 .clock(shared),
@@ -92,7 +92,7 @@ fn send_all_times_out_when_nobody_answers() {
 #[test]
 fn send_all_does_not_wait_for_a_user_that_detached_before_taking_the_message() {
     on_both_runtimes(|| async {
-        let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+        let port = Stop::new(PortSpec::new("STOP", "SUPERVISOR"));
         let mut supervisor = port.owner().unwrap();
         let mut answering = port.user_named("ROBOT1").unwrap();
         let leaving = port.user_named("ROBOT2").unwrap();
@@ -126,7 +126,7 @@ fn an_owner_waiting_for_its_first_user_is_woken_when_one_attaches_from_another_t
         }
     }
 
-    let port = Stop::declare(PortSpec::new("STOP", "SUPERVISOR"));
+    let port = Stop::new(PortSpec::new("STOP", "SUPERVISOR"));
     let supervisor = port.owner().unwrap();
     let flag = Arc::new(Flag(AtomicBool::new(false)));
     let waker = Waker::from(Arc::clone(&flag));

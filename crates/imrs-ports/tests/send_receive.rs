@@ -12,7 +12,7 @@ use imrs_ports::{
 #[test]
 fn send_waits_for_the_reply_and_returns_it() {
     on_both_runtimes(|| async {
-        let port = Port::<u32, u32, usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<u32, u32, usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         let sender = tokio::spawn(async move { user.send(20).await.unwrap() });
@@ -27,7 +27,7 @@ fn send_waits_for_the_reply_and_returns_it() {
 fn the_owner_may_send_and_a_user_receive() {
     on_both_runtimes(|| async {
         // LET_1_GO: GATE sends, RELEASE receives and answers with a return code.
-        let port = Port::<(), i32, usage::Send>::declare(PortSpec::new("LET_1_GO", "GATE"));
+        let port = Port::<(), i32, usage::Send>::new(PortSpec::new("LET_1_GO", "GATE"));
         let mut gate = port.owner().unwrap();
         let mut release = port.user_named("RELEASE").unwrap();
         let releasing = tokio::spawn(async move {
@@ -42,9 +42,9 @@ fn the_owner_may_send_and_a_user_receive() {
 #[test]
 fn receives_come_in_arrival_order_and_replies_in_any_order() {
     on_both_runtimes(|| async {
-        let port = Port::<u32, u32, usage::Receive, imrs_ports::AnyUser, 3>::declare(
-            PortSpec::new("P", "OWNER"),
-        );
+        let port = Port::<u32, u32, usage::Receive, imrs_ports::AnyUser, 3>::new(PortSpec::new(
+            "P", "OWNER",
+        ));
         let mut owner = port.owner().unwrap();
         let mut senders = Vec::new();
         for n in 0..3u32 {
@@ -77,7 +77,7 @@ fn receives_come_in_arrival_order_and_replies_in_any_order() {
 #[test]
 fn a_reply_handle_dropped_unanswered_fails_the_sender_at_once() {
     on_both_runtimes(|| async {
-        let port = Port::<&str, (), usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<&str, (), usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         let sender = tokio::spawn(async move { user.send("card").await });
@@ -95,7 +95,7 @@ fn a_send_times_out_on_the_virtual_clock_and_hands_the_message_back() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
         // LET_1_GO with TIMEOUT=2 sec, and nobody receiving.
-        let port = Port::<&str, i32, usage::Send>::declare(
+        let port = Port::<&str, i32, usage::Send>::new(
             PortSpec::new("LET_1_GO", "GATE")
                 .owner_timeout(Duration::from_secs(2))
                 .clock(shared),
@@ -129,8 +129,7 @@ fn a_send_times_out_on_the_virtual_clock_and_hands_the_message_back() {
 fn a_send_not_replied_in_time_fails_and_the_late_reply_is_dropped() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
-        let port =
-            Port::<u8, u8, usage::Receive>::declare(PortSpec::new("P", "OWNER").clock(shared));
+        let port = Port::<u8, u8, usage::Receive>::new(PortSpec::new("P", "OWNER").clock(shared));
         let mut owner = port.owner().unwrap();
         let mut user = port
             .user_named("USER")
@@ -163,7 +162,7 @@ fn a_receive_times_out() {
     on_both_runtimes(|| async {
         let (clock, shared) = virtual_clock();
         // PALLET_IN_PLACE: TIMEOUT=30 SEC, USAGE=RECEIVE, #USERS=1.
-        let port = Port::<(), (), usage::Receive>::declare(
+        let port = Port::<(), (), usage::Receive>::new(
             PortSpec::new("PALLET_IN_PLACE", "LOAD_CARD")
                 .owner_timeout(Duration::from_secs(30))
                 .clock(shared),
@@ -185,7 +184,7 @@ fn a_receive_times_out() {
 #[test]
 fn a_dropped_send_withdraws_its_message() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, u8, usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<u8, u8, usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let mut owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         {
@@ -210,7 +209,7 @@ fn futures_poll_once<F: std::future::Future>(
 #[test]
 fn a_port_nobody_can_receive_on_fails_its_senders() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, u8, usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<u8, u8, usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let owner = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         drop(owner);
@@ -228,7 +227,7 @@ fn a_port_nobody_can_receive_on_fails_its_senders() {
 #[test]
 fn a_restarted_owner_serves_what_waits_on_the_port() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, u8, usage::Receive>::declare(PortSpec::new("P", "OWNER"));
+        let port = Port::<u8, u8, usage::Receive>::new(PortSpec::new("P", "OWNER"));
         let first_copy = port.owner().unwrap();
         let mut user = port.user_named("USER").unwrap();
         let sending = tokio::spawn(async move { user.send(5).await });
@@ -244,7 +243,7 @@ fn a_restarted_owner_serves_what_waits_on_the_port() {
 #[test]
 fn a_tight_port_round_trips_across_threads() {
     on_both_runtimes(|| async {
-        let port = Port::<u64, u64, usage::Receive>::declare(
+        let port = Port::<u64, u64, usage::Receive>::new(
             PortSpec::new("SERVO", "ARM").process_type(ProcessType::Tight),
         );
         let mut arm = port.owner().unwrap();
@@ -265,7 +264,7 @@ fn a_tight_port_round_trips_across_threads() {
 #[test]
 fn an_endless_timeout_on_the_real_clock_is_no_overflow() {
     on_both_runtimes(|| async {
-        let port = Port::<u8, u8, usage::Receive>::declare(
+        let port = Port::<u8, u8, usage::Receive>::new(
             PortSpec::new("P", "OWNER").owner_timeout(Duration::MAX),
         );
         let mut owner = port.owner().unwrap();
@@ -279,7 +278,7 @@ fn an_endless_timeout_on_the_real_clock_is_no_overflow() {
 
 #[test]
 fn a_port_says_how_its_values_are_shown_and_the_first_way_set_holds() {
-    let port = Port::<u32, i32, usage::Send>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+    let port = Port::<u32, i32, usage::Send>::new(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
     assert!(port.owner().unwrap().shown().is_none());
     let hex = Shown {
         request: |card: &u32| format!("{card:#x}"),

@@ -26,7 +26,7 @@ type ImagePort = Port<Shared<Image>, Shared<u64>, usage::Receive>;
 
 #[tokio::test]
 async fn a_loaned_message_reaches_its_receiver_where_its_sender_built_it() {
-    let port = ImagePort::declare(PortSpec::new("IMAGE", "VISION"));
+    let port = ImagePort::new(PortSpec::new("IMAGE", "VISION"));
     let mut vision = port.owner().unwrap();
     let mut camera = port.user_named("CAMERA").unwrap();
     let mut image = camera.loan().unwrap();
@@ -86,7 +86,7 @@ fn changing_a_read_only_message_copies_it_once_and_leaves_the_original_as_it_was
 async fn a_ports_lender_makes_every_loan_and_its_refusal_names_the_port() {
     let lent = Arc::new(AtomicUsize::new(0));
     let counted = Arc::clone(&lent);
-    let port = ImagePort::declare(PortSpec::new("IMAGE", "VISION")).lend_with(move || {
+    let port = ImagePort::new(PortSpec::new("IMAGE", "VISION")).lend_with(move || {
         // Two loans, then the transport's memory is used up.
         if counted.fetch_add(1, Ordering::SeqCst) >= 2 {
             return Err(LoanError {
@@ -197,7 +197,7 @@ fn a_clone_of_a_message_no_one_writes_reads_the_same_memory_and_a_writable_ones_
 
 #[tokio::test]
 async fn a_broadcast_of_a_message_no_one_writes_reaches_every_user_where_it_lies() {
-    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::declare(
+    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::new(
         PortSpec::new("FRAME", "CAMERA"),
     );
     let mut camera = port.owner().unwrap();
@@ -237,7 +237,7 @@ async fn a_broadcast_of_a_message_no_one_writes_reaches_every_user_where_it_lies
 
 #[tokio::test]
 async fn a_broadcast_is_handed_to_the_transport_once_and_every_user_reads_what_it_made() {
-    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::declare(
+    let port = Port::<Shared<Image>, Shared<u64>, usage::SendAll, imrs_ports::AnyUser, 3>::new(
         PortSpec::new("FRAME", "CAMERA"),
     );
     // The transport moves each broadcast into memory of its own, which it shares.

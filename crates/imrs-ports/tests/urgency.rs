@@ -26,7 +26,7 @@ impl Wake for Noting {
 /// The urgency of the wakes a receiver and a sender get for one message on a port declared
 /// by `spec`: the request wakes the receiver, the reply wakes the sender.
 fn wakes_of_one_message(spec: PortSpec) -> (Vec<Priority>, Vec<Priority>) {
-    let port = Port::<u8, u8, usage::Receive>::declare(spec);
+    let port = Port::<u8, u8, usage::Receive>::new(spec);
     let mut owner = port.owner().unwrap();
     let mut user = port.user_named("USER").unwrap();
     let (receiver, sender) = (Arc::new(Noting::default()), Arc::new(Noting::default()));

@@ -5,10 +5,8 @@ use imrs_ports::{AnyUser, Port, PortSpec, UsageKind, WireError, Wiring, usage};
 #[test]
 fn too_many_users_is_refused_naming_port_and_module() {
     // READY_TO_CHIP: #USERS=1.
-    let port = Port::<(), (), usage::Receive, AnyUser, 1>::declare(PortSpec::new(
-        "READY_TO_CHIP",
-        "CHIP_IT",
-    ));
+    let port =
+        Port::<(), (), usage::Receive, AnyUser, 1>::new(PortSpec::new("READY_TO_CHIP", "CHIP_IT"));
     let first = port.user_named("FREEZE_CARD").unwrap();
     let second = port.user_named("FREEZE_CARD_COPY").unwrap_err();
     assert_eq!(
@@ -30,7 +28,7 @@ fn too_many_users_is_refused_naming_port_and_module() {
 
 #[test]
 fn a_user_not_on_the_list_is_refused() {
-    let port = Port::<u8, i32, usage::Query>::declare(
+    let port = Port::<u8, i32, usage::Query>::new(
         PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]),
     );
     let refused = port.answer("LOAD_IT", |_: &(), _: u8| 0).unwrap_err();
@@ -50,7 +48,7 @@ fn a_user_not_on_the_list_is_refused() {
 
 #[test]
 fn a_second_owner_is_refused() {
-    let port = Port::<(), (), usage::Send>::declare(PortSpec::new("LET_1_GO", "GATE"));
+    let port = Port::<(), (), usage::Send>::new(PortSpec::new("LET_1_GO", "GATE"));
     let _gate = port.owner().unwrap();
     assert_eq!(
         port.owner().unwrap_err(),
@@ -64,7 +62,7 @@ fn a_second_owner_is_refused() {
 #[test]
 fn wiring_by_name_checks_usage_types_and_lists_every_problem() {
     let mut wiring = Wiring::new();
-    let card_in_place = Port::<(), i32, usage::Send>::declare(
+    let card_in_place = Port::<(), i32, usage::Send>::new(
         PortSpec::new("CARD_IN_PLACE", "LOAD_CARD").user_list(["SCREW_IN_CARD"]),
     );
     wiring.declare(&card_in_place).unwrap();
@@ -133,8 +131,7 @@ fn a_wired_end_talks_to_the_declared_owner() {
         .unwrap();
     runtime.block_on(async {
         let mut wiring = Wiring::new();
-        let port =
-            Port::<(), i32, usage::Send>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+        let port = Port::<(), i32, usage::Send>::new(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
         wiring.declare(&port).unwrap();
         let mut load_card = port.owner().unwrap();
         let mut screw_in_card = wiring

@@ -38,7 +38,7 @@ pub type JobAsker = End<(usize, Option<(usize, usize)>), Option<Job>, usage::Sen
 
 /// The port, owned by the scheduler.
 pub(super) fn job_port(clock: &SharedClock) -> JobPort {
-    Port::declare(
+    Port::new(
         PortSpec::new("NEXT_JOB", SCHEDULER)
             .clock(clock.clone())
             .priority(2),

@@ -32,7 +32,7 @@ impl DevicePorts {
                 let spec = PortSpec::new(device.port(), WORLD)
                     .clock(clock.clone())
                     .user_list([device.user()]);
-                (device, DevicePort::declare(spec))
+                (device, DevicePort::new(spec))
             })
             .collect();
         Self { ports }

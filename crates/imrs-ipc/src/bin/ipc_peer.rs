@@ -129,7 +129,7 @@ fn main() -> ExitCode {
 type Error = Box<dyn std::error::Error>;
 
 async fn owner(cell: &str, port: &str, process_type: ProcessType) -> Result<(), Error> {
-    let port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::declare(
+    let port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::new(
         PortSpec::new(port, "DOUBLER")
             .user_list(["ASKER", "ASKER_2"])
             .process_type(process_type),
@@ -150,7 +150,7 @@ async fn owner(cell: &str, port: &str, process_type: ProcessType) -> Result<(), 
 
 async fn vision(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Receive, AnyUser, 2> =
-        Port::declare(PortSpec::new(port, "VISION").user_list(["CAMERA", "CAMERA_2"]));
+        Port::new(PortSpec::new(port, "VISION").user_list(["CAMERA", "CAMERA_2"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut vision = port.owner()?;
@@ -182,7 +182,7 @@ async fn vision(cell: &str, port: &str) -> Result<(), Error> {
 
 async fn inspector(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Response, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "INSPECTOR").user_list(["ASKER"]));
+        Port::new(PortSpec::new(port, "INSPECTOR").user_list(["ASKER"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let factor = 5;
@@ -219,7 +219,7 @@ async fn frame_child(cell: &str, port: &str, module: &str, n: &str) -> Result<()
 
 async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "CAMERA").user_list(["LEFT"]));
+        Port::new(PortSpec::new(port, "CAMERA").user_list(["LEFT"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut camera = port.owner()?;
@@ -238,7 +238,7 @@ async fn camera(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 
 async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::Query, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "PARENT").user_list(["CHILD"]));
+        Port::new(PortSpec::new(port, "PARENT").user_list(["CHILD"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut parent = port.owner()?;
@@ -251,7 +251,7 @@ async fn parent(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 
 async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::CallAll, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "CALLER").user_list(["ANSWERER"]));
+        Port::new(PortSpec::new(port, "CALLER").user_list(["ANSWERER"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut caller = port.owner()?;
@@ -264,7 +264,7 @@ async fn caller(cell: &str, port: &str, n: &str) -> Result<(), Error> {
 
 async fn announcer(cell: &str, port: &str, n: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::SendAll, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "ANNOUNCER").user_list(["HEARER"]));
+        Port::new(PortSpec::new(port, "ANNOUNCER").user_list(["HEARER"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     let mut announcer = port.owner()?;
@@ -333,7 +333,7 @@ async fn frame_answerer(
 
 async fn responder(cell: &str, port: &str) -> Result<(), Error> {
     let port: Port<Number, Number, usage::Response, AnyUser, 1> =
-        Port::declare(PortSpec::new(port, "TRIPLER").user_list(["ASKER"]));
+        Port::new(PortSpec::new(port, "TRIPLER").user_list(["ASKER"]));
     let _exported = export(&Remote::new(cell)?, &port)?;
     println!("ready");
     // The module's state: the factor its handler answers with.

@@ -12,6 +12,6 @@ struct Gripper {
 
 fn main() {
     let port: Port<Gripper, Gripper, usage::Receive, AnyUser, 1> =
-        Port::declare(PortSpec::new("GRIPPER", "OWNER"));
+        Port::new(PortSpec::new("GRIPPER", "OWNER"));
     let _ = export(&Remote::new("cell").unwrap(), &port);
 }

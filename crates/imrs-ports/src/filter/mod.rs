@@ -57,7 +57,7 @@ where
     /// Declares port `spec` with the filter task `filter_task` (a task of the owning module)
     /// spliced in. The spec's timeout applies to the owner's end of `FILTER`; its priority and
     /// user list to the users' side.
-    pub fn declare(spec: PortSpec, filter_task: impl Into<Name>) -> Self {
+    pub fn new(spec: PortSpec, filter_task: impl Into<Name>) -> Self {
         let filter_task = filter_task.into();
         let owner_side =
             PortSpec::new(format!("{}.FILTER", spec.name()), spec.owner_name().clone())
@@ -65,8 +65,8 @@ where
                 .with_clock_of(&spec)
                 .user_list([filter_task.clone()]);
         Self {
-            port: Port::declare(spec.without_timeout()),
-            filter: Port::declare(owner_side),
+            port: Port::new(spec.without_timeout()),
+            filter: Port::new(owner_side),
             filter_task,
         }
     }

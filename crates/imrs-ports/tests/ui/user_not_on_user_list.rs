@@ -15,7 +15,7 @@ user_list! {
 }
 
 fn main() {
-    let port = Port::<(), i32, usage::Send, CardInPlaceUsers>::declare(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
+    let port = Port::<(), i32, usage::Send, CardInPlaceUsers>::new(PortSpec::new("CARD_IN_PLACE", "LOAD_CARD"));
     // GATE has no business with the card in place.
     let _ = port.user::<Gate>();
 }
