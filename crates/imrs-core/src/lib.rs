@@ -170,7 +170,14 @@ pub use outcome::ModuleOutcome;
 pub use shared::ModuleHandle;
 
 pub use log::{Log, Record};
-pub use module::ctx::{Ctx, PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
+pub use module::ctx::Ctx;
+
+/// The futures and traits behind [`Ctx`]'s port operations: what `ctx.send`, `ctx.receive`
+/// and `ctx.query` return, and how a failure names its port. A cell author awaits these and
+/// never names them.
+pub mod op {
+    pub use crate::module::ctx::{PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
+}
 pub use module::spec::{ModuleSpec, StateView, TaskError, TaskResult};
 pub use order::{Order, Rank, Section};
 pub use processor::{JobHandle, JobLost, Processor};
