@@ -149,14 +149,7 @@ impl Cell {
         U: Usage,
         L: UserList,
     {
-        if let Some(clock) = spec.clock_of()
-            && !same_clock(clock, &self.shared.clock)
-        {
-            return Err(WireError::OtherClock {
-                port: spec.name().clone(),
-            });
-        }
-        let port = Port::new(spec.clock(Arc::clone(&self.shared.clock)));
+        let port = Port::new(self.on_its_clock(spec)?);
         self.declare(&port)?;
         Ok(port)
     }
@@ -182,6 +175,13 @@ impl Cell {
         F::Complement: Plain,
         L: UserList,
     {
+        let port = FilteredPort::new(self.on_its_clock(spec)?, filter_task);
+        self.declare(&port)?;
+        Ok(port)
+    }
+
+    /// `spec` on the cell's clock; refused if it names another.
+    fn on_its_clock(&self, spec: PortSpec) -> Result<PortSpec, WireError> {
         if let Some(clock) = spec.clock_of()
             && !same_clock(clock, &self.shared.clock)
         {
@@ -189,9 +189,7 @@ impl Cell {
                 port: spec.name().clone(),
             });
         }
-        let port = FilteredPort::new(spec.clock(Arc::clone(&self.shared.clock)), filter_task);
-        self.declare(&port)?;
-        Ok(port)
+        Ok(spec.clock(Arc::clone(&self.shared.clock)))
     }
 
     /// Declares to the cell a port made elsewhere — a [`FilteredPort`], or a port a
