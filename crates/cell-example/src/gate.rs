@@ -88,7 +88,12 @@ pub fn gate(
     let (release_port, buffer_port) = (ports.let_1_go.clone(), ports.frequency.clone());
     let device = devices.gate(line);
     ModuleSpec::new(n.gate.clone(), state)
-        .order([timeout.clone(), n.gate.as_str().into()])
+        // RELEASE.FAILED first: a failed RELEASE is reported before anything else runs.
+        .order([
+            "RELEASE.FAILED".into(),
+            timeout.clone(),
+            n.gate.as_str().into(),
+        ])
         .hardware([format!("gate relay and photocell of line {line:?}")])
         .filters(n.frequency.clone(), UsageKind::Receive)
         .task(n.gate.clone(), move |ctx| {

@@ -129,6 +129,7 @@ pub fn load_card(line: Line, ports: &LinePorts, devices: &Devices) -> ModuleSpec
     let n = LineNames::of(line);
     let spec = ModuleSpec::new(n.load_card.clone(), LoadCardState::default())
         .order([
+            ports.card_in_place.handler("TIMEOUT").name(),
             ports.pallet_in_place.handler("TIMEOUT").name(),
             ports.ask_child1.handler("STATUS").name(),
             n.load_card.as_str().into(),

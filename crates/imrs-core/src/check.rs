@@ -96,12 +96,12 @@ pub enum CellError {
         /// The port.
         port: Name,
     },
-    /// A response handler of the module that its order does not rank: it would answer at
-    /// any suspension point, whatever section the module is in.
+    /// A handler of the module (a response or an exception handler) that its order does not
+    /// rank: it would run at any suspension point, whatever section the module is in.
     Unranked {
         /// The module.
         module: Name,
-        /// The handler (`PORT.resp`).
+        /// The handler (`PORT.resp`, `PORT.TIMEOUT`, `TASK.FAILED`, ...).
         handler: Name,
     },
     /// An order names something the module does not have.
@@ -415,13 +415,16 @@ fn check_responses(module: &ModuleDecl, owns: &[Name], problems: &mut Vec<CellEr
     }
 }
 
-/// Every response handler is in the order: one left out would answer wherever the module
-/// is. (An exception handler the order leaves out has a rank of its own, documented at
-/// [`Rank::UNRANKED_HANDLER`](crate::Rank::UNRANKED_HANDLER): it runs at the next
-/// suspension point, as an alarm should.)
+/// Every handler, response or exception, is in the order: one left out would run wherever
+/// the module is, which is the order's whole point to decide.
 fn check_ranked(module: &ModuleDecl, problems: &mut Vec<CellError>) {
     let ranked: BTreeSet<&Name> = module.order.iter().collect();
-    for (handler, _) in &module.responses {
+    let handlers = module
+        .responses
+        .iter()
+        .map(|(handler, _)| handler)
+        .chain(&module.exceptions);
+    for handler in handlers {
         if !ranked.contains(handler) {
             problems.push(CellError::Unranked {
                 module: module.name.clone(),

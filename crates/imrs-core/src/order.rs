@@ -9,10 +9,10 @@ use imrs_ports::Name;
 pub struct Rank(u32);
 
 impl Rank {
-    /// The rank of an exception handler that the order does not name: it runs at the next
-    /// suspension point, whatever section the module is in, as an alarm should. A response
-    /// handler has no such rank: one the order leaves out refuses its module at start.
-    pub const UNRANKED_HANDLER: Rank = Rank(0);
+    /// The rank of a handler the order does not name. The check every module passes at
+    /// start refuses such a handler, so a running module never has one; it is kept as the
+    /// most urgent rank for a module checked by nobody.
+    pub(crate) const UNRANKED_HANDLER: Rank = Rank(0);
 
     /// The rank at `position` (1-based) in an order.
     pub const fn at(position: u32) -> Self {
@@ -111,10 +111,9 @@ impl fmt::Debug for Section {
 ///
 /// Names are the module's own name (its background code), `PORT.resp` for a response
 /// handler, `PORT.TIMEOUT` (or any exception name) for an exception handler, and named
-/// sections such as `GRASP`. Code in no named section is background code. Every response
-/// handler and section of a module must be in its order: a response handler left out
+/// sections such as `GRASP`. Code in no named section is background code. Every handler
+/// and section of a module must be in its order: a handler (response or exception) left out
 /// refuses the module when it starts, and a section left out fails the task that enters it.
-/// An exception handler left out runs at [`Rank::UNRANKED_HANDLER`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Order {
     module: Name,

@@ -40,6 +40,7 @@ fn each_primitive_logs_its_wait_and_a_failure_names_its_primitive() {
                 }
             });
         let loader = ModuleSpec::new("LOAD_CARD", ())
+            .order(["CARD_IN_PLACE.TIMEOUT", "LOAD_CARD"])
             .exception("CARD_IN_PLACE.TIMEOUT", |_ctx: Ctx<()>, _| async {})
             .task("LOAD_CARD", move |ctx| {
                 let port = sender.clone();

@@ -80,6 +80,7 @@ fn an_exception_handler_that_raises_itself_again_does_not_starve_its_thread() {
         let handled = Arc::new(AtomicU32::new(0));
         let count = Arc::clone(&handled);
         let looping = ModuleSpec::new("LOOPING", ())
+            .order(["AGAIN", "LOOPING"])
             .raises(["AGAIN"])
             .exception("AGAIN", move |ctx: Ctx<()>, _| {
                 let count = Arc::clone(&count);

@@ -33,6 +33,7 @@ fn every_slip_is_reported_at_once_by_module_and_name() {
         .respond(&status.handler("STATUS"), |seams: &u32, ()| *seams)
         .task("WELDER_B", |_| async { Ok(()) });
     let gas_monitor = ModuleSpec::new("GAS_MONITOR", ())
+        .order(["GAS.LOW", "MONITOR.FAILED", "GAS_MONITOR"])
         .raises(["GAS.LOW"])
         .exception("GAS.LOW", |_: Ctx<()>, _| async {})
         .exception("MONITOR.FAILED", |_: Ctx<()>, _| async {})
@@ -59,6 +60,10 @@ fn every_slip_is_reported_at_once_by_module_and_name() {
             CellError::Unranked {
                 module: "WELDER_B".into(),
                 handler: "B_STATUS.STATUS".into(),
+            },
+            CellError::Unranked {
+                module: "WELDER_B".into(),
+                handler: "TORCH_READY.TIMOUT".into(),
             },
             CellError::UnknownException {
                 module: "WELDER_B".into(),
