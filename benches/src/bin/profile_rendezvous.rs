@@ -37,7 +37,9 @@ fn queries(round_trips: u64) {
     current_thread().block_on(async move {
         let cell = Cell::new(std::sync::Arc::new(RealClock::new()));
         let processor = Processor::new("CPU1");
-        let port = Port::<u64, u64, usage::Query>::new(PortSpec::new("STATUS", "ASKER"));
+        let port: Port<u64, u64, usage::Query> = cell
+            .port(PortSpec::new("STATUS", "ASKER"))
+            .expect("a new cell has no STATUS");
         let responder = ModuleSpec::new("ROBOT", 7u64)
             .order(["STATUS.STATE", "ROBOT"])
             .respond(&port.handler("STATE"), |s: &u64, q: u64| s + q)

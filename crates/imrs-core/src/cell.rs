@@ -253,10 +253,11 @@ impl Cell {
         lock(&self.shared.wiring).ports()
     }
 
-    /// The seed's load-time check over a whole cell: every problem with these modules and
-    /// the declared ports, all at once, each naming its module and port — including what
-    /// no single module shows (a port whose owner is not among them, too many users). For
-    /// tools; a cell needs no call to it, since each module is checked when it starts.
+    /// Shin's load-time check over a whole cell: every problem with these modules and the
+    /// declared ports, all at once, each naming its module and port — including what only
+    /// the whole cell shows (a port whose owner is not among them; too many users among
+    /// modules not started yet). For tools; a cell needs no call to it, since each module
+    /// is checked when it starts, against the ports and the modules running then.
     pub fn check(&self, modules: &[ModuleDecl]) -> Result<(), CellErrors> {
         check(&lock(&self.shared.wiring), modules)
     }

@@ -3,11 +3,11 @@
 //! from the cell, which calls it, and from a module's context, which it extends with
 //! `costart`: a module can start modules, and this is the one place that knows both.
 
-use std::collections::btree_map::Entry;
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use imrs_ports::Name;
 use imrs_ports::transport::Presence;
+use imrs_ports::{Name, Wiring};
 
 use crate::check::{CellError, CellErrors, check_module};
 use crate::event::EventKind;
@@ -46,15 +46,32 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
     mut factory: Option<Factory<S>>,
 ) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellErrors> {
     let name = first.name.clone();
-    check_module(&lock(&cell.wiring), &first.declaration())?;
     let kill = Arc::new(KillSwitch::default());
-    match lock(&cell.modules).entry(name.clone()) {
-        Entry::Occupied(_) => return Err(CellError::DuplicateModule { module: name }.into()),
-        Entry::Vacant(vacant) => vacant.insert(Member {
-            switch: Arc::clone(&kill),
-            placement: first.placement(parent.clone(), processor, &lock(&cell.wiring)),
-        }),
-    };
+    {
+        // The modules, then the wiring: the order every path that takes both keeps.
+        let mut modules = lock(&cell.modules);
+        if modules.contains_key(&name) {
+            return Err(CellError::DuplicateModule { module: name }.into());
+        }
+        let wiring = lock(&cell.wiring);
+        let placement = first.placement(parent.clone(), processor, &wiring);
+        let mut problems = match check_module(&wiring, &first.declaration()) {
+            Ok(()) => Vec::new(),
+            Err(found) => found.0,
+        };
+        // Room on each port it uses, beside the modules running now.
+        problems.extend(too_many_users(&wiring, &modules, &name, &placement.uses));
+        if !problems.is_empty() {
+            return Err(CellErrors(problems));
+        }
+        modules.insert(
+            name.clone(),
+            Member {
+                switch: Arc::clone(&kill),
+                placement,
+            },
+        );
+    }
     let presence = Presence::new(name.clone());
     let done = Arc::new(Outcome::default());
     let report = Teller::new(&done);
@@ -148,6 +165,32 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
         report.tell(outcome);
     };
     Ok((handle, supervisor))
+}
+
+/// The ports in `uses` that module `name` would take past their number of users, with the
+/// modules running now that use them.
+fn too_many_users(
+    wiring: &Wiring,
+    modules: &BTreeMap<Name, Member>,
+    name: &Name,
+    uses: &[Name],
+) -> Vec<CellError> {
+    uses.iter()
+        .filter_map(|port| {
+            let capacity = wiring.port_info(port.as_str())?.capacity;
+            let mut users: Vec<Name> = modules
+                .iter()
+                .filter(|(module, member)| *module != name && member.placement.uses.contains(port))
+                .map(|(module, _)| module.clone())
+                .collect();
+            users.push(name.clone());
+            (users.len() > capacity).then(|| CellError::TooManyUsers {
+                port: port.clone(),
+                capacity,
+                modules: users,
+            })
+        })
+        .collect()
 }
 
 impl<S: Send + Sync + 'static> Ctx<S> {

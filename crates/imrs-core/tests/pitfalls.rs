@@ -248,3 +248,60 @@ fn a_timeout_bounds_only_the_ends_it_is_declared_for() {
         unbounded.abort();
     });
 }
+
+#[test]
+fn a_module_past_a_ports_number_of_users_is_refused_at_start() {
+    paused_runtime().block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        // #USERS=2: two grippers may send to the palletizer, not three.
+        let place: Port<(), (), usage::Receive, AnyUser, 2> =
+            cell.port(PortSpec::new("PLACE", "PALLETIZER")).unwrap();
+        let gripper = |name: &'static str| {
+            ModuleSpec::new(name, ())
+                .uses(&place)
+                .task(name, |ctx| async move {
+                    ctx.delay(secs(60)).await;
+                    Ok(())
+                })
+        };
+        cell.start(gripper("GRIPPER_A")).unwrap();
+        cell.start(gripper("GRIPPER_B")).unwrap();
+        let refused = cell.start(gripper("GRIPPER_C")).unwrap_err();
+        assert_eq!(
+            refused.0,
+            [CellError::TooManyUsers {
+                port: "PLACE".into(),
+                capacity: 2,
+                modules: vec!["GRIPPER_A".into(), "GRIPPER_B".into(), "GRIPPER_C".into()],
+            }]
+        );
+    });
+}
+
+#[test]
+fn a_second_module_of_a_running_modules_name_is_refused_as_a_duplicate() {
+    paused_runtime().block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        let status: Port<(), u32, usage::Response> =
+            cell.port(PortSpec::new("STATUS", "PALLETIZER")).unwrap();
+        let palletizer = || {
+            let ask = status.handler("ASK");
+            ModuleSpec::new("PALLETIZER", 0u32)
+                .order([ask.name(), "PALLETIZER".into()])
+                .respond(&ask, |placed: &u32, ()| *placed)
+                .task("PALLETIZER", |ctx| async move {
+                    ctx.delay(secs(60)).await;
+                    Ok(())
+                })
+        };
+        cell.start(palletizer()).unwrap();
+        // The second copy's answering end cannot attach either; the name is what is wrong.
+        let refused = cell.start(palletizer()).unwrap_err();
+        assert_eq!(
+            refused.0,
+            [CellError::DuplicateModule {
+                module: "PALLETIZER".into()
+            }]
+        );
+    });
+}

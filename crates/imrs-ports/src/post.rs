@@ -115,7 +115,8 @@ pin_project! {
     /// The future of [`End::send`](crate::End::send) and [`End::query`](crate::End::query).
     ///
     /// Dropping it before it completes withdraws the request: a receiver that already took
-    /// it may still reply, and the reply is dropped.
+    /// it may still reply, and gets its reply back ([`Replied::Late`](crate::Replied::Late)).
+    /// A reply that had already come in when the future is dropped is dropped with it.
     #[must_use = "a send or query does nothing unless awaited"]
     pub struct Posting<'a, Req, Rep, O> {
         attachment: &'a Attachment<Req, Rep>,

@@ -39,7 +39,7 @@ pub(crate) enum Answer<Rep> {
 pub(crate) enum Withdrawn<Req, Rep> {
     /// No server had taken the request; here it is.
     Unsent(Req),
-    /// A server holds the request; its eventual answer will be dropped.
+    /// A server holds the request; its eventual answer goes back to it.
     Abandoned,
     /// The answer came in before the poster gave up.
     Answered(Answer<Rep>),

@@ -66,11 +66,11 @@ impl<T: Send + 'static, const CAP: usize> BoundedBuffer<T, CAP> {
                 .await;
             match event {
                 Ok(Event::FromUser(message, reply)) => {
+                    // Kept even if the user gave up meanwhile: a sender that gives up after
+                    // its message was taken is told so (`SendError::ReplyTimeout`), and the
+                    // message goes on to the owner.
                     self.queue.push_back(message);
-                    // A user that gave up was told its message was not taken: keep it so.
-                    if let Replied::Late(()) = reply.reply(()) {
-                        self.queue.pop_back();
-                    }
+                    let _taken = reply.reply(());
                 }
                 Ok(Event::FromOwner(reply)) => {
                     // An owner that gave up never reads the message: it stays first in line.
