@@ -155,6 +155,12 @@ pub enum EventKind {
         /// The handler (`PORT.resp`).
         handler: Name,
     },
+    /// A response handler answered a query whose querier had given up (timed out, or its
+    /// module died): nobody read the answer.
+    RespondedLate {
+        /// The handler (`PORT.resp`).
+        handler: Name,
+    },
     /// An exception was raised in the module.
     ExceptionRaised {
         /// The exception (`PORT.TIMEOUT`).
@@ -229,6 +235,9 @@ impl fmt::Display for Event {
             EventKind::Queried { port, .. } => write!(f, "queried {port}"),
             EventKind::PortError { port, error, .. } => write!(f, "{port}: {error}"),
             EventKind::Responded { handler } => write!(f, "responded {handler}"),
+            EventKind::RespondedLate { handler } => {
+                write!(f, "responded {handler} after its querier gave up")
+            }
             EventKind::ExceptionRaised { exception } => write!(f, "raised {exception}"),
             EventKind::ExceptionHandled { exception } => write!(f, "handling {exception}"),
             EventKind::ExceptionUnhandled { exception } => {

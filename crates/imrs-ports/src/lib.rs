@@ -87,7 +87,7 @@ pub use port::{Handler, Port, PortSpec};
 pub use priority::Priority;
 pub use process_type::ProcessType;
 pub use receive::{Receiving, Replied, ReplyHandle};
-pub use response::{ModuleState, Respond, ResponseEnd, respond_while};
+pub use response::{ModuleState, Respond, ResponseEnd, Served, respond_while};
 pub use select::{AllClosed, Select, select, when};
 pub use shared::{LoanError, Shared};
 pub use shown::Shown;

@@ -20,7 +20,7 @@ use crate::error::ReceiveError;
 use crate::meta::Name;
 use crate::presence::Presence;
 use crate::priority::Priority;
-use crate::receive::ReplyHandle;
+use crate::receive::{Replied, ReplyHandle};
 
 type Handler<S, Req, Rep> = Box<dyn Fn(&S, Req) -> Rep + Send + Sync>;
 
@@ -88,18 +88,21 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> ResponseEnd<Req, Rep, S> {
     }
 
     /// The hook the order scheduler drives: runs the handler on the oldest waiting query,
-    /// reading `state`, and sends its answer. Returns whether a query was answered.
+    /// reading `state`, and sends its answer. Says whether a query waited, and whether its
+    /// querier was still there to read the answer.
     ///
     /// If the handler panics, the querier gets
     /// [`QueryError::NoResponse`](crate::QueryError::NoResponse) instead of hanging.
-    pub fn respond(&mut self, state: &S) -> bool {
+    pub fn respond(&mut self, state: &S) -> Served {
         let Some((query, from)) = self.attachment.try_take() else {
-            return false;
+            return Served::Idle;
         };
         // Built before the handler runs, so that a panic in it drops the handle unanswered.
         let handle = ReplyHandle::new(&self.attachment, from);
-        handle.reply((self.handler)(state, query));
-        true
+        match handle.reply((self.handler)(state, query)) {
+            Replied::Delivered => Served::Answered,
+            Replied::Late(_) => Served::Late,
+        }
     }
 
     /// Takes the oldest waiting query without running the handler, with the right to answer
@@ -144,6 +147,18 @@ impl<Req, Rep, S> fmt::Debug for ResponseEnd<Req, Rep, S> {
     }
 }
 
+/// What one turn of a response handler did ([`ResponseEnd::respond`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Served {
+    /// No query waited.
+    Idle,
+    /// A query was answered, and its querier has the answer.
+    Answered,
+    /// A query was answered, but its querier had given up (timed out, or its module died):
+    /// nobody reads the answer.
+    Late,
+}
+
 /// A response end as seen by whatever decides when handlers run.
 #[diagnostic::on_unimplemented(
     message = "`{Self}` is not a response end answering from a state `{S}`",
@@ -159,7 +174,7 @@ pub trait Respond<S> {
     /// Ready when a query waits; see [`ResponseEnd::poll_pending`].
     fn poll_pending(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), ReceiveError>>;
     /// Answers one waiting query; see [`ResponseEnd::respond`].
-    fn respond(&mut self, state: &S) -> bool;
+    fn respond(&mut self, state: &S) -> Served;
     /// Records that this end is held by the module of `presence`, for an end attached before
     /// its module ran (see [`Presence`](crate::transport::Presence)). By default, nothing.
     fn bind(&mut self, presence: &Arc<Presence>) {
@@ -180,7 +195,7 @@ impl<Req: Send + 'static, Rep: Send + 'static, S> Respond<S> for ResponseEnd<Req
         ResponseEnd::poll_pending(self, cx)
     }
 
-    fn respond(&mut self, state: &S) -> bool {
+    fn respond(&mut self, state: &S) -> Served {
         ResponseEnd::respond(self, state)
     }
 

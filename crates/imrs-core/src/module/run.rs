@@ -23,7 +23,7 @@ use std::task::{Context, Poll, Waker};
 
 use imrs_ports::clock::Sleep;
 use imrs_ports::transport::Presence;
-use imrs_ports::{Name, Respond};
+use imrs_ports::{Name, Respond, Served};
 
 use super::ctx::{Ctx, ModuleShared, SectionCell};
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
@@ -235,10 +235,13 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                     self.shared.state.read(|state| end.respond(state))
                 }));
                 let kind = match answered {
-                    Ok(true) => EventKind::Responded {
+                    Ok(Served::Answered) => EventKind::Responded {
                         handler: response.name.clone(),
                     },
-                    Ok(false) => continue,
+                    Ok(Served::Late) => EventKind::RespondedLate {
+                        handler: response.name.clone(),
+                    },
+                    Ok(Served::Idle) => continue,
                     Err(panic) => EventKind::TaskFailed {
                         reason: format!(
                             "response handler panicked: {}",
