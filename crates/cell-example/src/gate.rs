@@ -87,10 +87,11 @@ pub fn gate(
     let (let_1_go, frequency) = (ports.let_1_go.clone(), ports.frequency.clone());
     let (release_port, buffer_port) = (ports.let_1_go.clone(), ports.frequency.clone());
     let device = devices.gate(line);
+    let release_failed = imrs_core::Exception::failure_of("RELEASE");
     ModuleSpec::new(n.gate.clone(), state)
         // RELEASE.FAILED first: a failed RELEASE is reported before anything else runs.
         .order([
-            "RELEASE.FAILED".into(),
+            release_failed.clone(),
             timeout.clone(),
             n.gate.as_str().into(),
         ])
@@ -194,7 +195,7 @@ pub fn gate(
             ctx.restart_task("RELEASE");
         })
         .exception(
-            "RELEASE.FAILED",
+            release_failed,
             |ctx: Ctx<GateState>, exception| async move {
                 // The next LET_1_GO times out and restarts it (the Appendix's note 2).
                 alarm(

@@ -29,13 +29,5 @@ pub struct ModuleDecl {
 
 /// The ports declared to `wiring` whose owner is `module`.
 pub(crate) fn owned_by(wiring: &Wiring, module: &Name) -> Vec<Name> {
-    wiring
-        .port_names()
-        .filter(|port| {
-            wiring
-                .port_info(port.as_str())
-                .is_some_and(|info| info.owner == *module)
-        })
-        .cloned()
-        .collect()
+    wiring.owned_by(module).cloned().collect()
 }

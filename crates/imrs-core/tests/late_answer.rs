@@ -56,18 +56,21 @@ fn an_answer_to_a_querier_that_timed_out_is_logged_as_late() {
         cell.start(palletizer).unwrap();
         let mut asker = cell.start(asker).unwrap();
         assert_eq!(asker.finished().await, ModuleOutcome::Finished);
-        let late = loop {
-            let late: Vec<_> = cell
+        // The handler's answer lands on the other worker just after the asker ends: look a
+        // bounded number of times, so that a missing event fails the test rather than hangs it.
+        let mut late = Vec::new();
+        for _ in 0..1_000_000 {
+            late = cell
                 .events()
                 .snapshot()
                 .into_iter()
                 .filter(|event| matches!(event.kind, EventKind::RespondedLate { .. }))
                 .collect();
             if !late.is_empty() {
-                break late;
+                break;
             }
             tokio::task::yield_now().await;
-        };
+        }
         assert_eq!(late.len(), 1);
         assert_eq!(late[0].module, "PALLETIZER");
         let line = late[0].to_string();

@@ -1,5 +1,5 @@
-//! The slips a new user made that used to compile, pass the check and misbehave in silence:
-//! each now fails loudly, by name, when the cell starts (or in the task that makes it).
+//! Slips a user can make in writing a cell: each fails loudly, by name, when the cell starts
+//! (or in the task that makes it), never in silence at run time.
 
 mod common;
 
@@ -303,5 +303,27 @@ fn a_second_module_of_a_running_modules_name_is_refused_as_a_duplicate() {
                 module: "PALLETIZER".into()
             }]
         );
+    });
+}
+
+#[test]
+fn a_port_declared_used_twice_by_one_module_counts_one_user() {
+    paused_runtime().block_on(async {
+        let (cell, _clock) = Cell::virtual_clock();
+        // #USERS=1, and the one user both declares the use and answers on the port.
+        let status: Port<(), u32, usage::Query> =
+            cell.port(PortSpec::new("STATUS", "PALLETIZER")).unwrap();
+        let ask = status.handler("ASK");
+        let gripper = ModuleSpec::new("GRIPPER", 3u32)
+            .order([ask.name(), "GRIPPER".into()])
+            .uses(&status)
+            .respond(&ask, |held: &u32, ()| *held)
+            .uses(&status)
+            .task("GRIPPER", |ctx| async move {
+                ctx.delay(secs(60)).await;
+                Ok(())
+            });
+        // Two declarations of one use: still one user of a port of one.
+        cell.start(gripper).unwrap();
     });
 }

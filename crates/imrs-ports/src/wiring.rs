@@ -185,6 +185,14 @@ impl Wiring {
         self.ports.keys()
     }
 
+    /// The names of the declared ports whose owner is `module`, in order.
+    pub fn owned_by<'a>(&'a self, module: &'a Name) -> impl Iterator<Item = &'a Name> {
+        self.ports
+            .iter()
+            .filter(move |(_, port)| port.meta().owner == *module)
+            .map(|(name, _)| name)
+    }
+
     /// What the wiring knows of every declared port, in name order.
     pub fn ports(&self) -> Vec<PortInfo> {
         self.ports

@@ -126,14 +126,14 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
         U: Usage,
         L: UserList,
     {
-        self.uses.push((port.name().clone(), port.user_usage()));
+        self.add_use(port.name().clone(), port.user_usage());
         self
     }
 
     /// `USE PORT ... USAGE=usage`, for a port known only by name (wired through
     /// [`Cell::use_port`](crate::Cell::use_port)).
     pub fn uses_named(mut self, port: impl Into<Name>, usage: UsageKind) -> Self {
-        self.uses.push((port.into(), usage));
+        self.add_use(port.into(), usage);
         self
     }
 
@@ -155,13 +155,21 @@ impl<S: Send + Sync + 'static> ModuleSpec<S> {
     {
         let port = handler.port();
         if !U::OWNER_ANSWERS {
-            self.uses.push((port.name().clone(), UsageKind::Response));
+            self.add_use(port.name().clone(), UsageKind::Response);
         }
         match port.answer(self.name.clone(), answer) {
             Ok(end) => self.responses.push((handler.name(), Box::new(end))),
             Err(problem) => self.problems.push(problem),
         }
         self
+    }
+
+    /// Records a use of `port`: once, however many times it is declared (`.uses(&port)`
+    /// beside a response handler on the same port is one user, not two).
+    fn add_use(&mut self, port: Name, usage: UsageKind) {
+        if !self.uses.contains(&(port.clone(), usage)) {
+            self.uses.push((port, usage));
+        }
     }
 
     /// A view of this module's state from outside, for a test or a report to read during or
