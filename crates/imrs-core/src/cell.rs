@@ -125,11 +125,13 @@ impl Cell {
         &self.shared.events
     }
 
-    /// Observes the primitives closely from now on (or no more): the event of each send,
-    /// receive and query says how long it waited, and carries the text of its message and
-    /// reply where the port shows them ([`Port::shown`](imrs_ports::Port::shown)). Off by
-    /// default: a primitive then reads the clock once, for its event, and formats nothing.
-    /// A recorder and a timeline turn it on.
+    /// Observes the primitives from now on (or no more): each send, receive, query, waitfor
+    /// and response handler's answer that succeeds is logged, saying how long it waited and
+    /// carrying the text of its message and reply where the port shows them
+    /// ([`Port::shown`](imrs_ports::Port::shown)). Off by default: a primitive that
+    /// succeeds then logs nothing and reads no clock, so that the path modules use costs
+    /// what the ports cost; failures, timeouts, sections, exceptions, deadlocks, alarms and
+    /// module life are logged either way. A recorder and a timeline turn it on.
     pub fn observe(&self, on: bool) {
         self.shared.observe.store(on, Ordering::Relaxed);
     }

@@ -275,5 +275,11 @@ impl Record for Event {
     }
 }
 
+/// Whether `tracing` takes the core's events (a subscriber wants `imrs` at warn or
+/// finer): then an event is made even where the log would not see it.
+pub(crate) fn traced() -> bool {
+    tracing::enabled!(target: "imrs", tracing::Level::WARN)
+}
+
 /// The event log of a cell.
 pub type EventLog = Log<Event>;

@@ -9,6 +9,7 @@
 
 use std::collections::VecDeque;
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// What a [`Log`] keeps.
@@ -22,6 +23,10 @@ type Sink<E> = Box<dyn FnMut(&E) + Send>;
 /// Records of type `E`, in the order they were made.
 pub struct Log<E> {
     inner: Mutex<Inner<E>>,
+    /// Whether a record made now would be kept or seen: a capacity above 0, or a
+    /// subscriber. Read without the lock, so that a log nobody reads costs its writers
+    /// nothing ([`Log::is_wanted`]).
+    wanted: AtomicBool,
 }
 
 struct Inner<E> {
@@ -50,7 +55,15 @@ impl<E: Record> Log<E> {
                 forgotten: 0,
                 sinks: Vec::new(),
             }),
+            wanted: AtomicBool::new(capacity > 0),
         }
+    }
+
+    /// Whether anyone would see a record made now: the log keeps records, or someone
+    /// subscribed. A writer whose record costs something to make (a clock read, a text)
+    /// may skip it when not; [`Log::record`] keeps and streams whatever it is given.
+    pub fn is_wanted(&self) -> bool {
+        self.wanted.load(Ordering::Relaxed)
     }
 
     /// Keeps at most `capacity` records from now on, forgetting the oldest beyond it.
@@ -58,6 +71,8 @@ impl<E: Record> Log<E> {
         let mut inner = self.lock();
         inner.capacity = capacity;
         inner.trim();
+        self.wanted
+            .store(capacity > 0 || !inner.sinks.is_empty(), Ordering::Relaxed);
     }
 
     /// Stops keeping records in memory (subscribers still see them): `set_capacity(0)`.
@@ -73,6 +88,7 @@ impl<E: Record> Log<E> {
     /// Calls `sink` with every record made from now on, in order.
     pub fn subscribe(&self, sink: impl FnMut(&E) + Send + 'static) {
         self.lock().sinks.push(Box::new(sink));
+        self.wanted.store(true, Ordering::Relaxed);
     }
 
     /// Logs `record`.

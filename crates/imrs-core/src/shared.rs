@@ -3,7 +3,7 @@
 //! module from outside. The cell and the supervisors that run modules both build on it.
 
 use std::collections::BTreeMap;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::{Name, SharedClock, Wiring};
@@ -17,8 +17,8 @@ use crate::tree::Placement;
 pub(crate) struct CellShared {
     pub(crate) clock: SharedClock,
     pub(crate) events: EventLog,
-    /// Whether the primitives' events say how long each waited and carry the text of the
-    /// values of the ports that show them.
+    /// Whether the primitives that succeed are logged, each saying how long it waited and
+    /// carrying the text of the values of the ports that show them.
     pub(crate) observe: AtomicBool,
     pub(crate) waits: Mutex<WaitGraph>,
     pub(crate) wiring: Mutex<Wiring>,
@@ -52,6 +52,11 @@ impl CellShared {
         lock(&self.modules)
             .get(&Name::from(module))
             .map(|member| Arc::clone(&member.switch))
+    }
+
+    /// Whether the cell observes its primitives ([`Cell::observe`](crate::Cell::observe)).
+    pub(crate) fn observing(&self) -> bool {
+        self.observe.load(Ordering::Relaxed)
     }
 
     pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {

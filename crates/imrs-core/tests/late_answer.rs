@@ -14,6 +14,8 @@ use imrs_core::prelude::*;
 fn an_answer_to_a_querier_that_timed_out_is_logged_as_late() {
     multi_thread_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         // The asker's query is bounded by 1 s of the cell's (virtual) clock.
         let status: Port<(), u32, usage::Response> = cell
             .port(PortSpec::new("STATUS", "PALLETIZER").user_timeout(secs(1)))

@@ -22,6 +22,8 @@ fn events_of(cell: &Cell, module: &str) -> Vec<Event> {
 fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_outrank_all() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         // SHARE_FEEDER1, answered by CHIP_IT's CRIT_SECTION handler. (In the Appendix CHIP_IT2
         // owns it; here CHIP_IT owns it so that four queriers can ask at overlapping times.)
         let share_feeder1: Port<(), i32, usage::Response, AnyUser, 4> = cell
@@ -144,6 +146,8 @@ fn crit_section_is_served_in_insert_never_in_grasp_or_background_and_timeouts_ou
 fn a_let_1_go_timeout_interrupts_gates_background_which_restarts_release() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         // LET_1_GO: USAGE=SEND, #USERS=1, TIMEOUT=2 sec.
         let let_1_go: Port<(), i32, usage::Send> = cell.port(
             PortSpec::new("LET_1_GO", "GATE")
@@ -218,6 +222,8 @@ fn a_high_rank_handler_waiting_on_a_low_rank_task_of_its_module_is_not_blocked()
     // thread's progress, so the background task serves the handler.
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         let help: Port<&'static str, u8, usage::Send> =
             cell.port(PortSpec::new("HELP", "GATE")).unwrap();
         let dead: Port<(), (), usage::Send> = cell

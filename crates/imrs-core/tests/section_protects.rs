@@ -79,6 +79,8 @@ fn all_finished(askers: &[ModuleHandle]) {
 fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_background() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         let status: Port<(), (u32, u32), usage::Response, AnyUser, 8> =
             cell.port(PortSpec::new("B_STATUS", "WELDER_B")).unwrap();
         let welder = ModuleSpec::new("WELDER_B", Welder::default())
@@ -134,6 +136,8 @@ fn a_query_waits_for_a_named_section_to_be_left_while_another_thread_is_in_backg
 fn crit_section_is_answered_in_insert_and_never_in_grasp_or_background_while_freeze_card_runs() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
+        // The test reads the primitives that succeed from the log: logged while observed.
+        cell.observe(true);
         let share_feeder1: Port<(), i32, usage::Response, AnyUser, 8> = cell
             .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT"))
             .unwrap();

@@ -150,6 +150,13 @@ impl<'a, Req, Rep, O> Posting<'a, Req, Rep, O> {
             _outcome: PhantomData,
         }
     }
+
+    /// Calls `visit` with each module at the other end of the port, as
+    /// [`End::each_peer`](crate::End::each_peer) does: for a module that notes whom it
+    /// waits on only once the send or query has to wait.
+    pub fn each_peer(&self, visit: impl FnMut(Name)) {
+        self.attachment.each_peer(visit);
+    }
 }
 
 impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {

@@ -109,7 +109,15 @@ impl<S> ModuleShared<S> {
     }
 
     pub(crate) fn event(&self, task: Option<&Name>, kind: EventKind) {
-        self.event_at(self.cell.clock.now(), task, kind);
+        if self.logged() {
+            self.event_at(self.cell.clock.now(), task, kind);
+        }
+    }
+
+    /// Whether an event made now would be seen: the log keeps or streams it, or `tracing`
+    /// takes it. When not, an event costs nothing, not even its clock read.
+    pub(crate) fn logged(&self) -> bool {
+        self.cell.events.is_wanted() || crate::event::traced()
     }
 
     /// As [`ModuleShared::event`], at `at`: for a caller that has just read the clock.
@@ -331,11 +339,12 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Sends,
     {
-        let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&message)));
         let started = Started {
-            waiting: Some(waiting),
+            peers: Some(|posting: &Posting<'a, Req, Rep, SendOutcome>, on| {
+                posting.each_peer(|peer| on.push(peer));
+            }),
             watch,
             primitive: Primitive::Send,
             show: ShowReply(shown.map(|shown| shown.reply)),
@@ -357,7 +366,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |_| None);
         let started = Started {
-            waiting: None,
+            peers: None,
             watch,
             primitive: Primitive::Receive,
             show: ShowRequest(shown.map(|shown| shown.request)),
@@ -377,11 +386,12 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Queries,
     {
-        let waiting = self.wait_on(end.port(), |on| end.each_peer(|peer| on.push(peer)));
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&query)));
         let started = Started {
-            waiting: Some(waiting),
+            peers: Some(|posting: &Posting<'a, Req, Rep, QueryOutcome>, on| {
+                posting.each_peer(|peer| on.push(peer));
+            }),
             watch,
             primitive: Primitive::Query,
             show: ShowReply(shown.map(|shown| shown.reply)),
@@ -392,7 +402,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
 
     /// Whether the cell observes its primitives closely ([`Cell::observe`]).
     fn observing(&self) -> bool {
-        self.module.cell.observe.load(Ordering::Relaxed)
+        self.module.cell.observing()
     }
 
     /// What an operation on `end` watches, if the cell observes (else nothing, at the cost
@@ -434,6 +444,8 @@ impl<S: Send + Sync + 'static> Ctx<S> {
             .waitfor(self.task.as_str(), message, combine, timeout)
             .await;
         match &result {
+            // Logged, as every primitive that succeeds, only while the cell observes.
+            Ok(_) if since.is_none() => {}
             Ok(_) => self.event(EventKind::WaitForReleased {
                 barrier: barrier.name().clone(),
             }),
@@ -553,14 +565,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         }
     }
 
-    fn wait_on(&self, port: &Name, peers: impl FnOnce(&mut Vec<Name>)) -> WaitGuard {
+    fn wait_on(&self, port: &Name, peers: impl FnOnce(&mut Vec<Name>)) -> WaitGuard<'_> {
         let cell = &self.module.cell;
         let (id, cycle) = cell.waits().begin(&self.module.name, port, peers);
         if let Some(cycle) = cycle {
             self.event(EventKind::Deadlock { cycle });
         }
         WaitGuard {
-            cell: Arc::clone(cell),
+            cell,
             module: self.module.name.clone(),
             id,
         }
@@ -604,13 +616,13 @@ impl<S: Send + Sync + 'static> Drop for SectionGuard<'_, S> {
 }
 
 /// A module's wait in the deadlock graph, removed when the wait ends.
-struct WaitGuard {
-    cell: Arc<CellShared>,
+struct WaitGuard<'a> {
+    cell: &'a CellShared,
     module: Name,
     id: u64,
 }
 
-impl Drop for WaitGuard {
+impl Drop for WaitGuard<'_> {
     fn drop(&mut self) {
         self.cell.waits().end(&self.module, self.id);
     }
@@ -643,7 +655,8 @@ impl PortFailure for ReceiveError {
 pin_project_lite::pin_project! {
     /// A port operation of a task, [`Ctx::send`], [`Ctx::receive`] or [`Ctx::query`]: the
     /// end's own future, and what the module logs when it ends (the event, the timeout
-    /// exception, the end of the wait in the deadlock graph).
+    /// exception, the end of the wait in the deadlock graph). A send or a query enters the
+    /// deadlock graph only once it has to wait: one answered at its first poll never does.
     ///
     /// A named type rather than an `async fn`, so that its type does not carry the end's
     /// usage: a misused end is reported once, where the operation is called.
@@ -651,7 +664,9 @@ pin_project_lite::pin_project! {
     pub struct PortOp<'a, S, F, D> {
         ctx: &'a Ctx<S>,
         port: Option<Name>,
-        waiting: Option<WaitGuard>,
+        // Whom a send or a query waits on, read once it has to wait; `None` for a receive.
+        peers: Option<fn(&F, &mut Vec<Name>)>,
+        waiting: Option<WaitGuard<'a>>,
         // What an observing cell watches; `None` (and no clock read, no text) otherwise.
         watch: Option<Box<Watch>>,
         primitive: Primitive,
@@ -671,11 +686,11 @@ struct Watch {
     text: Option<String>,
 }
 
-/// What a port operation knows when it starts: its wait in the deadlock graph, what it
-/// watches (only while the cell observes), which primitive it is, how to show what comes
-/// back, and the event it logs when it ends.
-struct Started<D> {
-    waiting: Option<WaitGuard>,
+/// What a port operation knows when it starts: whom it would wait on, what it watches (only
+/// while the cell observes), which primitive it is, how to show what comes back, and the
+/// event it logs when it ends.
+struct Started<F, D> {
+    peers: Option<fn(&F, &mut Vec<Name>)>,
     watch: Option<Box<Watch>>,
     primitive: Primitive,
     show: D,
@@ -684,11 +699,12 @@ struct Started<D> {
 
 impl<'a, S, F, D> PortOp<'a, S, F, D> {
     // Built in one go, so that the operation's future is moved as few times as it can be.
-    fn new(ctx: &'a Ctx<S>, port: Name, operation: F, started: Started<D>) -> Self {
+    fn new(ctx: &'a Ctx<S>, port: Name, operation: F, started: Started<F, D>) -> Self {
         Self {
             ctx,
             port: Some(port),
-            waiting: started.waiting,
+            peers: started.peers,
+            waiting: None,
             watch: started.watch,
             primitive: started.primitive,
             show: started.show,
@@ -734,45 +750,54 @@ where
     type Output = F::Output;
 
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<F::Output> {
-        let this = self.project();
+        let mut this = self.project();
         let clock = &this.ctx.module.cell.clock;
-        let Poll::Ready(result) = this.operation.poll(cx) else {
+        let Poll::Ready(result) = this.operation.as_mut().poll(cx) else {
             if let Some(watch) = this.watch {
                 watch.since.get_or_insert_with(|| clock.now());
+            }
+            if let (None, Some(peers), Some(port)) = (&this.waiting, *this.peers, &this.port) {
+                let operation = this.operation.as_ref().get_ref();
+                *this.waiting = Some(this.ctx.wait_on(port, |on| peers(operation, on)));
             }
             return Poll::Pending;
         };
         drop(this.waiting.take());
         let port = this.port.take().expect("a port operation completes once");
+        let Some(watch) = this.watch.take() else {
+            // Not observed: a primitive that succeeds logs nothing, at the cost of no clock
+            // read; one that fails is logged, and a timeout raises its exception.
+            if let Err(error) = &result {
+                let timed_out = error.is_timeout();
+                this.ctx
+                    .port_failed(port, *this.primitive, error.to_string(), None, timed_out);
+            }
+            return Poll::Ready(result);
+        };
         let now = clock.now();
-        let mut observed = this.watch.take().map(|watch| {
-            let waited = watch
+        let mut observed = Box::new(Observed {
+            waited: watch
                 .since
-                .map_or(Duration::ZERO, |since| now.saturating_duration_since(since));
-            Box::new(Observed {
-                waited,
-                message: watch.text,
-                reply: None,
-            })
+                .map_or(Duration::ZERO, |since| now.saturating_duration_since(since)),
+            message: watch.text,
+            reply: None,
         });
         match &result {
             Ok(value) => {
-                if let Some(observed) = &mut observed {
-                    // What came back: a send's or a query's reply, a receive's message.
-                    let shown = this.show.show(value);
-                    match *this.primitive {
-                        Primitive::Receive => observed.message = shown,
-                        _ => observed.reply = shown,
-                    }
+                // What came back: a send's or a query's reply, a receive's message.
+                let shown = this.show.show(value);
+                match *this.primitive {
+                    Primitive::Receive => observed.message = shown,
+                    _ => observed.reply = shown,
                 }
-                let kind = (this.done)(port, observed);
+                let kind = (this.done)(port, Some(observed));
                 this.ctx.module.event_at(now, Some(&this.ctx.task), kind);
             }
             Err(error) => this.ctx.port_failed(
                 port,
                 *this.primitive,
                 error.to_string(),
-                observed,
+                Some(observed),
                 error.is_timeout(),
             ),
         }

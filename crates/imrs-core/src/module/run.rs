@@ -235,6 +235,8 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                     self.shared.state.read(|state| end.respond(state))
                 }));
                 let kind = match answered {
+                    // Logged, as every primitive that succeeds, only while the cell observes.
+                    Ok(Served::Answered) if !self.shared.cell.observing() => continue,
                     Ok(Served::Answered) => EventKind::Responded {
                         handler: response.name.clone(),
                     },
@@ -258,6 +260,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// Before the module's future returns `Pending`: registers every response handler for a
     /// wake when a query comes. Returns whether one that may start now came meanwhile.
     fn park(&mut self, cx: &mut Context<'_>) -> bool {
+        if self.responses.is_empty() {
+            return false;
+        }
         let host = self.host_rank();
         let mut ready = false;
         for response in &mut self.responses {
@@ -461,8 +466,9 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
 
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<ModuleExit> {
         let this = self.get_mut();
-        let span = this.span.clone();
-        let _entered = span.enter();
+        // Without a subscriber the span is disabled, and entering it would still cost a
+        // clone and a `log` check at every poll.
+        let _entered = (!this.span.is_disabled()).then(|| this.span.clone().entered());
         if this.kill.poll_killed(cx, &mut this.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
