@@ -41,6 +41,7 @@ impl KillSwitch {
     /// `registered` (the waker this copy registered last) will wake the same task. A kill
     /// ends the copy, so the waker registered is taken by a wake only once per copy, and
     /// skipping the registration (two compare-and-swaps at every poll) loses no kill.
+    #[inline]
     pub(crate) fn poll_killed(&self, cx: &mut Context<'_>, registered: &mut Option<Waker>) -> bool {
         if self.killed.load(Ordering::Acquire) {
             return true;

@@ -195,9 +195,10 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// It registers for no wake (it runs after every poll of every thread, and a waker
     /// registration costs atomic read-modify-writes): [`ModuleRun::park`] does, once, before
     /// the module's future returns `Pending`.
+    #[inline(always)]
     fn admit(&mut self) -> bool {
         // The usual case, after nearly every poll: nothing raised, no restart asked, no
-        // query waiting. Two loads, and no rank is computed.
+        // query waiting. Two loads, no call, and no rank is computed.
         let pending = self.shared.has_pending();
         if !pending
             && !self
@@ -207,6 +208,11 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         {
             return false;
         }
+        self.admit_pending(pending)
+    }
+
+    /// [`ModuleRun::admit`] when something may be pending.
+    fn admit_pending(&mut self, pending: bool) -> bool {
         let mut started = pending && self.restart_requested();
         while self.shared.has_pending() {
             let host = self.host_rank();
@@ -501,7 +507,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 progress |= self.poll_task(index, cx);
                 progress |= self.admit();
             }
-            if let Some(exit) = self.exit() {
+            // Only a thread that finished or started can end the module: a poll that moved
+            // nothing leaves the answer as it was the last time, `None`.
+            if progress && let Some(exit) = self.exit() {
                 return Poll::Ready(exit);
             }
             if !progress && !self.park(cx) {
