@@ -15,8 +15,8 @@ use tokio::sync::{mpsc, oneshot};
 
 use crate::{Tail, current_thread, peers};
 
-/// A tokio ask: the message and a oneshot for the answer.
-pub type Ask<const N: usize> = (Box<[u8; N]>, oneshot::Sender<u64>);
+/// A tokio ask: the message, by value, and a oneshot for the answer.
+pub type Ask<const N: usize> = ([u8; N], oneshot::Sender<u64>);
 
 /// Runs `iters` round trips of `$round_trip` (an expression to await), timing all of them,
 /// and each one into `$tail` when there is one.
@@ -138,7 +138,7 @@ pub fn imrs_cross_thread<const N: usize>(
 /// An ask: the message and a oneshot for the answer, the usual tokio actor pattern.
 pub async fn ask<const N: usize>(asks: &mpsc::Sender<Ask<N>>) -> Result<u64, &'static str> {
     let (reply, answer) = oneshot::channel();
-    asks.send((Box::new(black_box([1u8; N])), reply))
+    asks.send((black_box([1u8; N]), reply))
         .await
         .map_err(|_| "closed")?;
     answer.await.map_err(|_| "dropped")
