@@ -79,56 +79,46 @@ fn main() {
         let cold = |who: &str| format!("rendezvous_cross_thread_cold/{who}/{size}");
         let tight = |who: &str| format!("rendezvous_tight/{who}/{size}");
         row(
-            &same("imrs"),
-            &same("tokio_ask_current_thread"),
+            &same("imrs_one_processor"),
+            &same("tokio_two_tasks"),
             1.0,
             same_thread_target,
         );
         row(
-            &same("imrs"),
-            &same("kameo_ask_current_thread"),
+            &same("imrs_one_processor"),
+            &same("kameo_ask"),
             1.0,
             "(vs kameo)",
         );
         row(
-            &same("imrs"),
-            &same("ractor_call_current_thread"),
+            &same("imrs_one_processor"),
+            &same("ractor_call"),
             1.0,
             "(vs ractor)",
         );
         row(
-            &same("imrs_prioritized"),
-            &same("imrs"),
+            &same("imrs_one_processor_prioritized"),
+            &same("imrs_one_processor"),
             1.0,
             "<= 1.1 (priorities on)",
         );
         row(
             &same("imrs_two_tasks"),
-            &same("tokio_ask_current_thread"),
+            &same("tokio_two_tasks"),
             1.0,
             "(one task per end)",
         );
         row(
             &cold("imrs"),
-            &cold("tokio_ask_multi_thread"),
+            &cold("tokio_ask"),
             1.0,
             "<= 0.8 (see cross_thread_runs)",
         );
-        row(
-            &cold("imrs"),
-            &cold("kameo_ask_multi_thread"),
-            1.0,
-            "(vs kameo)",
-        );
-        row(
-            &cold("imrs"),
-            &cold("ractor_call_multi_thread"),
-            1.0,
-            "(vs ractor)",
-        );
+        row(&cold("imrs"), &cold("kameo_ask"), 1.0, "(vs kameo)");
+        row(&cold("imrs"), &cold("ractor_call"), 1.0, "(vs ractor)");
         row(
             &cold("crossbeam_ping_pong"),
-            &cold("tokio_ask_multi_thread"),
+            &cold("tokio_ask"),
             1.0,
             "(baseline)",
         );
@@ -256,7 +246,7 @@ fn main() {
     };
     let (imrs, tokio) = (
         tail("rendezvous_cross_thread_cold_imrs_8B"),
-        tail("rendezvous_cross_thread_cold_tokio_ask_multi_thread_8B"),
+        tail("rendezvous_cross_thread_cold_tokio_ask_8B"),
     );
     if let (Some(imrs), Some(tokio)) = (imrs, tokio) {
         say!(
