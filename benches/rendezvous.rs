@@ -1,9 +1,16 @@
-//! A send → receive → reply round trip: (a) between two modules on one processor (and, for
-//! comparison, as two tokio tasks on one thread), (b) across two
-//! threads with the receiver parked, (c) across two threads on a TIGHT port; for an 8-byte
-//! and a 1 KiB message. Baselines in the same groups: tokio mpsc + oneshot "ask" on the
-//! current-thread and the multi-thread runtime, kameo's `ask` and ractor's `call!` on the
-//! same runtimes, a crossbeam ping-pong, an atomic spin ping-pong.
+//! A send → receive → reply round trip, for an 8-byte and a 1 KiB message moved by value,
+//! every baseline beside the IMRS case it matches, in the same group:
+//!
+//! - `rendezvous_same_thread`, one thread: IMRS with each end a task of its own (the asker in
+//!   `block_on`, the server spawned) beside tokio mpsc + oneshot "ask", kameo's `ask` and
+//!   ractor's `call!` placed the same way; IMRS with both ends jobs of one processor (one
+//!   task) beside tokio's two ends joined in one task (`tokio::join!`) and two tasks of one
+//!   `LocalSet`; and the processor with priorities on.
+//! - `rendezvous_cross_thread_cold`: the server on a current-thread runtime in a thread of its
+//!   own, parked between messages, the asker on a current-thread runtime of the bench's
+//!   thread, for IMRS, tokio, kameo and ractor alike; a crossbeam ping-pong.
+//! - `rendezvous_tight`: a TIGHT port across two threads beside two threads spinning on one
+//!   atomic, and spinning on one that carries the message on its cache line.
 
 #[path = "config.rs"]
 mod config;
@@ -17,23 +24,30 @@ use imrs_ports::ProcessType;
 
 fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     let mut group = c.benchmark_group("rendezvous_same_thread");
-    group.bench_function(BenchmarkId::new("imrs", size), |b| {
-        b.iter_custom(|n| imrs_same_thread::<N>(n, None))
-    });
-    group.bench_function(BenchmarkId::new("imrs_prioritized", size), |b| {
-        b.iter_custom(imrs_same_thread_prioritized::<N>)
-    });
     group.bench_function(BenchmarkId::new("imrs_two_tasks", size), |b| {
         b.iter_custom(|n| imrs_same_thread_tasks::<N>(n, None))
     });
-    group.bench_function(BenchmarkId::new("tokio_ask_current_thread", size), |b| {
+    group.bench_function(BenchmarkId::new("tokio_two_tasks", size), |b| {
         b.iter_custom(tokio_ask_current_thread::<N>)
     });
-    group.bench_function(BenchmarkId::new("kameo_ask_current_thread", size), |b| {
+    group.bench_function(BenchmarkId::new("kameo_ask", size), |b| {
         b.iter_custom(kameo_ask_current_thread::<N>)
     });
-    group.bench_function(BenchmarkId::new("ractor_call_current_thread", size), |b| {
+    group.bench_function(BenchmarkId::new("ractor_call", size), |b| {
         b.iter_custom(ractor_call_current_thread::<N>)
+    });
+    group.bench_function(BenchmarkId::new("imrs_one_processor", size), |b| {
+        b.iter_custom(|n| imrs_same_thread::<N>(n, None))
+    });
+    group.bench_function(
+        BenchmarkId::new("imrs_one_processor_prioritized", size),
+        |b| b.iter_custom(imrs_same_thread_prioritized::<N>),
+    );
+    group.bench_function(BenchmarkId::new("tokio_join_one_task", size), |b| {
+        b.iter_custom(tokio_join_one_task::<N>)
+    });
+    group.bench_function(BenchmarkId::new("tokio_local_set", size), |b| {
+        b.iter_custom(tokio_local_set::<N>)
     });
     group.finish();
 
@@ -41,14 +55,14 @@ fn sizes<const N: usize>(c: &mut Criterion, size: &str) {
     group.bench_function(BenchmarkId::new("imrs", size), |b| {
         b.iter_custom(|n| imrs_cross_thread::<N>(n, ProcessType::Loose, None))
     });
-    group.bench_function(BenchmarkId::new("tokio_ask_multi_thread", size), |b| {
-        b.iter_custom(|n| tokio_ask_multi_thread::<N>(n, None))
+    group.bench_function(BenchmarkId::new("tokio_ask", size), |b| {
+        b.iter_custom(|n| tokio_ask_cross_thread::<N>(n, None))
     });
-    group.bench_function(BenchmarkId::new("kameo_ask_multi_thread", size), |b| {
-        b.iter_custom(kameo_ask_multi_thread::<N>)
+    group.bench_function(BenchmarkId::new("kameo_ask", size), |b| {
+        b.iter_custom(kameo_ask_cross_thread::<N>)
     });
-    group.bench_function(BenchmarkId::new("ractor_call_multi_thread", size), |b| {
-        b.iter_custom(ractor_call_multi_thread::<N>)
+    group.bench_function(BenchmarkId::new("ractor_call", size), |b| {
+        b.iter_custom(ractor_call_cross_thread::<N>)
     });
     group.bench_function(BenchmarkId::new("crossbeam_ping_pong", size), |b| {
         b.iter_custom(crossbeam_ping_pong::<N>)
@@ -76,7 +90,7 @@ type TimedRun = fn(u64, Option<&mut Tail>) -> Duration;
 fn tails() {
     let count = if benchmarking() { 20_000 } else { 50 };
     let cases: [(&str, TimedRun); 6] = [
-        ("rendezvous_same_thread/imrs/8B", |n, t| {
+        ("rendezvous_same_thread/imrs_one_processor/8B", |n, t| {
             imrs_same_thread::<8>(n, t)
         }),
         ("rendezvous_same_thread/imrs_two_tasks/8B", |n, t| {
@@ -85,10 +99,9 @@ fn tails() {
         ("rendezvous_cross_thread_cold/imrs/8B", |n, t| {
             imrs_cross_thread::<8>(n, ProcessType::Loose, t)
         }),
-        (
-            "rendezvous_cross_thread_cold/tokio_ask_multi_thread/8B",
-            |n, t| tokio_ask_multi_thread::<8>(n, t),
-        ),
+        ("rendezvous_cross_thread_cold/tokio_ask/8B", |n, t| {
+            tokio_ask_cross_thread::<8>(n, t)
+        }),
         ("rendezvous_tight/imrs/8B", |n, t| {
             imrs_cross_thread::<8>(n, ProcessType::Tight, t)
         }),

@@ -11,7 +11,7 @@ pub mod ring;
 
 pub use ctx::{KEPT, Timed, ctx_modules, ctx_on_processor, new_cell};
 pub use idle::{IdleModules, IdleTasks, idle_modules, idle_tokio_tasks, resident_bytes};
-pub use ring::{imrs_ring, runtime};
+pub use ring::{imrs_ring, kameo_ring, ractor_ring, runtime, tokio_ring};
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

@@ -1,15 +1,15 @@
-//! The cross-thread cold round trip, run several times in one process: IMRS (the receiver on
-//! a thread of its own, parked between messages) against tokio mpsc + oneshot on a
-//! multi-thread runtime, each run timing both, one after the other. Prints every run's
-//! ratio and both p99.9 tails, then the median and the spread: on a shared machine one run
-//! says little.
+//! The cross-thread cold round trip, run several times in one process: IMRS against tokio
+//! mpsc + oneshot, each with the receiver on a current-thread runtime in a thread of its own
+//! (parked between messages) and the asker on a current-thread runtime of the main thread,
+//! each run timing both, one after the other. Prints every run's ratio and both p99.9 tails,
+//! then the median and the spread: on a shared machine one run says little.
 //!
 //! ```text
 //! cargo run --release -p imrs-benches --bin cross_thread_runs [RUNS] [ROUND_TRIPS]
 //! ```
 
 use imrs_benches::Tail;
-use imrs_benches::rendezvous::{imrs_cross_thread, tokio_ask_multi_thread};
+use imrs_benches::rendezvous::{imrs_cross_thread, tokio_ask_cross_thread};
 use imrs_ports::ProcessType;
 
 fn main() {
@@ -25,7 +25,7 @@ fn main() {
             Tail::with_capacity(round_trips as usize),
         );
         let imrs_time = imrs_cross_thread::<8>(round_trips, ProcessType::Loose, Some(&mut imrs));
-        let tokio_time = tokio_ask_multi_thread::<8>(round_trips, Some(&mut tokio));
+        let tokio_time = tokio_ask_cross_thread::<8>(round_trips, Some(&mut tokio));
         let (imrs_mean, tokio_mean) = (
             imrs_time.as_secs_f64() * 1e9 / round_trips as f64,
             tokio_time.as_secs_f64() * 1e9 / round_trips as f64,

@@ -1,9 +1,10 @@
 //! Same-thread round trips in a loop, for a profiler (`valgrind --tool=callgrind`), so that
 //! the ratio table's figures can be traced to where the time goes. Both ends run on one
-//! processor, as in `rendezvous_same_thread/imrs`; with `query`, the round trips are
-//! queries into a response handler of an idle module, as in `query/responder_idle`; with `ctx`, two modules
-//! talking through `ctx.send` and `ctx.receive`, as in `ctx_same_thread/ctx`; with `ring`, hops
-//! around a ring of 1 000 modules on one thread, as in `ring_1000/imrs/1_threads`.
+//! processor, as in `rendezvous_same_thread/imrs_one_processor`; with `query`, the round
+//! trips are queries into a response handler of an idle module, as in
+//! `query/responder_idle`; with `ctx`, two modules talking through `ctx.send` and
+//! `ctx.receive`, as in `ctx_same_thread/ctx`; with `ring`, hops around a ring of 1 000
+//! modules on one thread, as in `ring_1000/imrs/1_threads`.
 //!
 //! ```text
 //! cargo build --release -p imrs-benches --bin profile_rendezvous
