@@ -361,7 +361,7 @@ impl Cell {
     /// 000 §2). `Display` draws it; `println!("{}", cell.tree())`.
     pub fn tree(&self) -> ModuleTree {
         let modules = lock(&self.shared.modules);
-        ModuleTree::of(modules.values().map(|member| &member.placement))
+        ModuleTree::of(modules.placements())
     }
 }
 
@@ -371,7 +371,7 @@ impl fmt::Debug for Cell {
             .field("clock", &self.shared.clock)
             .field(
                 "modules",
-                &lock(&self.shared.modules).keys().collect::<Vec<_>>(),
+                &lock(&self.shared.modules).names().collect::<Vec<_>>(),
             )
             .finish_non_exhaustive()
     }

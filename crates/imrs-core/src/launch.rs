@@ -3,7 +3,6 @@
 //! from the cell, which calls it, and from a module's context, which it extends with
 //! `costart`: a module can start modules, and this is the one place that knows both.
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use imrs_ports::transport::Presence;
@@ -16,7 +15,7 @@ use crate::module::ctx::Ctx;
 use crate::module::run::{ModuleExit, ModuleRun};
 use crate::module::spec::ModuleSpec;
 use crate::outcome::{ModuleOutcome, Outcome, Teller};
-use crate::shared::{CellShared, Children, Member, ModuleHandle, lock};
+use crate::shared::{CellShared, Children, Member, Members, ModuleHandle, lock};
 use crate::supervision::RestartPolicy;
 
 pub(crate) type Factory<S> = Box<dyn FnMut() -> ModuleSpec<S> + Send>;
@@ -50,7 +49,7 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
     {
         // The modules, then the wiring: the order every path that takes both keeps.
         let mut modules = lock(&cell.modules);
-        if modules.contains_key(&name) {
+        if modules.contains(&name) {
             return Err(CellError::DuplicateModule { module: name }.into());
         }
         let wiring = lock(&cell.wiring);
@@ -171,20 +170,30 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
 /// modules running now that use them.
 fn too_many_users(
     wiring: &Wiring,
-    modules: &BTreeMap<Name, Member>,
+    modules: &Members,
     name: &Name,
     uses: &[Name],
 ) -> Vec<CellError> {
     uses.iter()
         .filter_map(|port| {
+            let running = modules.users_of(port);
+            let others = running.iter().filter(|module| *module != name).count();
+            // Looked up only for a port that has users already: a first user always fits.
+            if others == 0 {
+                return None;
+            }
             let capacity = wiring.port_info(port.as_str())?.capacity;
-            let mut users: Vec<Name> = modules
+            if others < capacity {
+                return None;
+            }
+            let mut users: Vec<Name> = running
                 .iter()
-                .filter(|(module, member)| *module != name && member.placement.uses.contains(port))
-                .map(|(module, _)| module.clone())
+                .filter(|module| *module != name)
+                .cloned()
                 .collect();
+            users.sort();
             users.push(name.clone());
-            (users.len() > capacity).then(|| CellError::TooManyUsers {
+            Some(CellError::TooManyUsers {
                 port: port.clone(),
                 capacity,
                 modules: users,

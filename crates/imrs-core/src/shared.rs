@@ -22,7 +22,63 @@ pub(crate) struct CellShared {
     pub(crate) observe: AtomicBool,
     pub(crate) waits: Mutex<WaitGraph>,
     pub(crate) wiring: Mutex<Wiring>,
-    pub(crate) modules: Mutex<BTreeMap<Name, Member>>,
+    pub(crate) modules: Mutex<Members>,
+}
+
+/// The running modules, by name, and the running users of each port.
+#[derive(Default)]
+pub(crate) struct Members {
+    by_name: BTreeMap<Name, Member>,
+    /// The running modules that use each port, kept beside `by_name`: a module's start
+    /// counts its ports' users here rather than look through every running module.
+    users: BTreeMap<Name, Vec<Name>>,
+}
+
+impl Members {
+    pub(crate) fn contains(&self, module: &Name) -> bool {
+        self.by_name.contains_key(module)
+    }
+
+    pub(crate) fn get(&self, module: &Name) -> Option<&Member> {
+        self.by_name.get(module)
+    }
+
+    pub(crate) fn insert(&mut self, module: Name, member: Member) {
+        for port in &member.placement.uses {
+            self.users
+                .entry(port.clone())
+                .or_default()
+                .push(module.clone());
+        }
+        self.by_name.insert(module, member);
+    }
+
+    pub(crate) fn remove(&mut self, module: &Name) {
+        let Some(member) = self.by_name.remove(module) else {
+            return;
+        };
+        for port in &member.placement.uses {
+            if let Some(users) = self.users.get_mut(port) {
+                users.retain(|user| user != module);
+                if users.is_empty() {
+                    self.users.remove(port);
+                }
+            }
+        }
+    }
+
+    /// The running modules that use `port`, in the order they started.
+    pub(crate) fn users_of(&self, port: &Name) -> &[Name] {
+        self.users.get(port).map_or(&[], Vec::as_slice)
+    }
+
+    pub(crate) fn names(&self) -> impl Iterator<Item = &Name> {
+        self.by_name.keys()
+    }
+
+    pub(crate) fn placements(&self) -> impl Iterator<Item = &Placement> {
+        self.by_name.values().map(|member| &member.placement)
+    }
 }
 
 /// A running module: its switch, and where it sits in the tree.

@@ -65,6 +65,9 @@ where
 #[derive(Default)]
 pub struct Wiring {
     ports: BTreeMap<Name, Box<dyn Declared>>,
+    /// The ports each module owns, in name order: read at every module start, which would
+    /// otherwise look through every port of the cell.
+    owners: BTreeMap<Name, Vec<Name>>,
     /// Ports whose owner runs in another process: their owner is checked there.
     elsewhere: BTreeSet<Name>,
     problems: Vec<WireError>,
@@ -95,6 +98,9 @@ impl Wiring {
                 module: port.owner_module().clone(),
             }));
         }
+        let owned = self.owners.entry(port.owner_module().clone()).or_default();
+        let at = owned.partition_point(|known| *known < name);
+        owned.insert(at, name.clone());
         self.ports.insert(name, Box::new(port.clone()));
         Ok(())
     }
@@ -187,10 +193,7 @@ impl Wiring {
 
     /// The names of the declared ports whose owner is `module`, in order.
     pub fn owned_by<'a>(&'a self, module: &'a Name) -> impl Iterator<Item = &'a Name> {
-        self.ports
-            .iter()
-            .filter(move |(_, port)| port.meta().owner == *module)
-            .map(|(name, _)| name)
+        self.owners.get(module).into_iter().flatten()
     }
 
     /// What the wiring knows of every declared port, in name order.
