@@ -279,6 +279,44 @@ fn a_module_past_a_ports_number_of_users_is_refused_at_start() {
 }
 
 #[test]
+fn a_user_that_ended_makes_room_on_its_port_and_the_refusal_names_the_users_in_order() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        // #USERS=1: one gripper at a time may send to the palletizer.
+        let place: Port<(), (), usage::Receive> =
+            cell.port(PortSpec::new("PLACE", "PALLETIZER")).unwrap();
+        let gripper = |name: &'static str, works: u64| {
+            ModuleSpec::new(name, ())
+                .uses(&place)
+                .task(name, move |ctx| async move {
+                    ctx.delay(secs(works)).await;
+                    Ok(())
+                })
+        };
+        let mut first = cell.start(gripper("GRIPPER_B", 10)).unwrap();
+        let refused = cell.start(gripper("GRIPPER_A", 10)).unwrap_err();
+        assert_eq!(
+            refused.0,
+            [CellError::TooManyUsers {
+                port: "PLACE".into(),
+                capacity: 1,
+                modules: vec!["GRIPPER_B".into(), "GRIPPER_A".into()],
+            }]
+        );
+        drive(&clock, at(11)).await;
+        assert_eq!(first.finished().await, ModuleOutcome::Finished);
+        // GRIPPER_B has ended: its place on PLACE is free again.
+        cell.start(gripper("GRIPPER_A", 10)).unwrap();
+        let refused = cell.start(gripper("GRIPPER_C", 10)).unwrap_err();
+        assert!(matches!(
+            &refused.0[..],
+            [CellError::TooManyUsers { modules, .. }]
+                if *modules == vec![Name::from("GRIPPER_A"), Name::from("GRIPPER_C")]
+        ));
+    });
+}
+
+#[test]
 fn a_second_module_of_a_running_modules_name_is_refused_as_a_duplicate() {
     paused_runtime().block_on(async {
         let (cell, _clock) = Cell::virtual_clock();
