@@ -118,21 +118,22 @@ pub enum EventKind {
         /// The section.
         section: Name,
     },
-    /// A send completed with a reply.
+    /// A send completed with a reply: logged while the cell observes its primitives
+    /// ([`Cell::observe`](crate::Cell::observe)), as every primitive that succeeds.
     Sent {
         /// The port.
         port: Name,
         /// What a cell that observes its primitives adds.
         observed: Option<Box<Observed>>,
     },
-    /// A message was received.
+    /// A message was received (logged while the cell observes).
     Received {
         /// The port.
         port: Name,
         /// What a cell that observes its primitives adds.
         observed: Option<Box<Observed>>,
     },
-    /// A query was answered.
+    /// A query was answered (logged while the cell observes).
     Queried {
         /// The port.
         port: Name,
@@ -150,7 +151,7 @@ pub enum EventKind {
         /// What a cell that observes its primitives adds.
         observed: Option<Box<Observed>>,
     },
-    /// A response handler answered a query.
+    /// A response handler answered a query (logged while the cell observes).
     Responded {
         /// The handler (`PORT.resp`).
         handler: Name,
@@ -176,7 +177,8 @@ pub enum EventKind {
         /// The exception.
         exception: Name,
     },
-    /// Every member of a `waitfor` arrived, and this task went on.
+    /// Every member of a `waitfor` arrived, and this task went on (logged while the cell
+    /// observes).
     WaitForReleased {
         /// The rendezvous.
         barrier: Name,
