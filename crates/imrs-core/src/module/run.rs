@@ -87,7 +87,9 @@ pub(crate) struct ModuleRun<S> {
     /// The module's presence, entered around every poll so that the ends its threads attach
     /// are known as the module's (taken out while it is entered).
     presence: Option<Arc<Presence>>,
-    span: tracing::Span,
+    /// The module's span, where a subscriber wanted it when the copy started: boxed, since
+    /// most cells have none and every idle module would carry its room.
+    span: Option<Box<tracing::Span>>,
 }
 
 impl<S: Send + Sync + 'static> ModuleRun<S> {
@@ -124,6 +126,8 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             })
             .collect();
         let span = tracing::info_span!("module", name = %spec.name);
+        // A span made without a subscriber stays disabled for good.
+        let span = (!span.is_disabled()).then(|| Box::new(span));
         let shared = Arc::new(ModuleShared::new(
             spec.name, parent, spec.state, order, cell, children,
         ));
@@ -472,9 +476,8 @@ impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
 
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<ModuleExit> {
         let this = self.get_mut();
-        // Without a subscriber the span is disabled, and entering it would still cost a
-        // clone and a `log` check at every poll.
-        let _entered = (!this.span.is_disabled()).then(|| this.span.clone().entered());
+        // Without a subscriber there is no span, and nothing to enter at every poll.
+        let _entered = this.span.as_deref().map(|span| span.clone().entered());
         if this.kill.poll_killed(cx, &mut this.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
