@@ -10,15 +10,19 @@
 //! `--help` lists every flag. `RUST_LOG=imrs=debug` shows the events and spans the core
 //! emits, on stderr.
 
-use std::process::ExitCode;
-
 use std::io::{self, IsTerminal, Write};
+use std::process::ExitCode;
+use std::time::Instant;
 
 use cell_example::processes::run_line;
-use cell_example::{CellConfig, FeederPolicy, Report, keeping_up_line, parse, run, speed_line};
+use cell_example::{
+    CellConfig, Comparison, Report, compare, keeping_up_line, parse, run, speed_line,
+};
 use tracing_subscriber::EnvFilter;
 
 fn main() -> ExitCode {
+    // The speed line counts the whole command's wall time.
+    let started = Instant::now();
     // Silent unless RUST_LOG asks: the report is the example's output.
     let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("error"));
     tracing_subscriber::fmt()
@@ -27,7 +31,11 @@ fn main() -> ExitCode {
         .with_ansi(io::stderr().is_terminal())
         .init();
     let config = match parse(std::env::args_os().skip(1)) {
-        Ok(config) => config,
+        // The report is folded from the events as they come: none is kept to be read later.
+        Ok(config) => CellConfig {
+            kept_events: 0,
+            ..config
+        },
         Err(refused) if refused.status == 0 => {
             print!("{refused}");
             return ExitCode::SUCCESS;
@@ -47,9 +55,22 @@ fn main() -> ExitCode {
             }
         };
     }
-    let (report, tree) = match run(&config) {
+    // The other feeder policies, same seed, hours and faults, run beside the chosen one for
+    // the side-by-side table; across processes, the chosen one runs alone.
+    let comparison = (!config.processes).then(|| compare(&config));
+    let alone;
+    let chosen = match &comparison {
+        Some(comparison) => comparison
+            .run_of(config.feeder)
+            .expect("every policy is compared"),
+        None => {
+            alone = run(&config);
+            &alone
+        }
+    };
+    let (report, tree) = match chosen {
         Ok(record) => (
-            Report::of(&record),
+            Report::of(record),
             config.show_tree.then(|| record.tree.to_string()),
         ),
         Err(problems) => {
@@ -73,7 +94,11 @@ fn main() -> ExitCode {
         Some(tree) => writeln!(out, "module tree (Shin 1985, §2):\n{tree}"),
         None => Ok(()),
     };
-    match printed.and_then(|()| print_all(&mut out, &config, &report)) {
+    let printed = printed.and_then(|()| match &comparison {
+        Some(comparison) => print_compared(&mut out, &report, comparison, started),
+        None => print_alone(&mut out, &report),
+    });
+    match printed {
         Ok(()) => {}
         // A reader that stopped reading (`| head`) is not a failure of the run.
         Err(error) if error.kind() == io::ErrorKind::BrokenPipe => {}
@@ -89,38 +114,32 @@ fn main() -> ExitCode {
     }
 }
 
-/// Writes the report, then the other feeder policies' beside it, to `out`.
-fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::Result<()> {
+/// Writes the report of a run across processes to `out`, with whether its processes kept up.
+fn print_alone(out: &mut impl Write, report: &Report) -> io::Result<()> {
     write!(out, "{report}")?;
-    if config.processes {
-        // The other policies do not run across processes: see `cell_example::processes`.
-        writeln!(out)?;
-        if let Some(kept_up) = keeping_up_line(report) {
-            writeln!(out, "{kept_up}")?;
-        }
-        writeln!(out, "{}", speed_line(report))?;
-        return out.flush();
+    // The other policies do not run across processes: see `cell_example::processes`.
+    writeln!(out)?;
+    if let Some(kept_up) = keeping_up_line(report) {
+        writeln!(out, "{kept_up}")?;
     }
-    // The other feeder policies, same seed, hours and faults, for the side-by-side table.
+    writeln!(out, "{}", speed_line(report))?;
+    out.flush()
+}
+
+/// Writes the report, then every feeder policy's beside it, to `out`, and last how fast they
+/// all ran since the command `started`.
+fn print_compared(
+    out: &mut impl Write,
+    report: &Report,
+    comparison: &Comparison,
+    started: Instant,
+) -> io::Result<()> {
+    write!(out, "{report}")?;
     let mut reports = Vec::new();
-    for policy in [
-        FeederPolicy::Appendix,
-        FeederPolicy::Arbiter,
-        FeederPolicy::Coordinator,
-    ] {
-        if policy == config.feeder {
-            reports.push(report.clone());
-            continue;
-        }
-        let other = CellConfig {
-            feeder: policy,
-            progress: false,
-            record: None,
-            timeline: None,
-            ..config.clone()
-        };
-        match run(&other) {
-            Ok(record) => reports.push(Report::of(&record)),
+    for (policy, ran) in &comparison.runs {
+        match ran {
+            Ok(_) if *policy == report.policy => reports.push(report.clone()),
+            Ok(record) => reports.push(Report::of(record)),
             Err(problems) => {
                 eprintln!("the {policy:?} feeder policy could not run: {problems}");
                 return out.flush();
@@ -134,6 +153,6 @@ fn print_all(out: &mut impl Write, config: &CellConfig, report: &Report) -> io::
     )?;
     write!(out, "{}", Report::side_by_side(&reports))?;
     writeln!(out)?;
-    writeln!(out, "{}", speed_line(report))?;
+    writeln!(out, "{}", comparison.speed_line(started.elapsed()))?;
     out.flush()
 }

@@ -8,14 +8,16 @@
 //! Appendix's restrictions, in [`ports`]. Where the Appendix writes `{signal for help}`, the
 //! modules raise an alarm and retry or restart, as the paper suggests.
 //!
-//! Two policies share the feeders: the Appendix's query/order scheme, which deadlocks as the
-//! paper's note 6 predicts and breaks the deadlock with asymmetric timeout handlers, and an
-//! arbiter (the monitor task the paper's conclusion points to). The [`report`] sets them side
-//! by side, with what rapier measured.
+//! Three policies share the feeders: the Appendix's query/order scheme, which deadlocks as
+//! the paper's note 6 predicts and breaks the deadlock with asymmetric timeout handlers, an
+//! arbiter (the monitor task the paper's conclusion points to), and a coordinator that
+//! reserves the space each trajectory sweeps. [`compare()`] runs the cell under all three at
+//! once, and the [`report`] sets them side by side, with what rapier measured.
 
 pub mod alarms;
 pub mod chip;
 pub mod cli;
+pub mod compare;
 pub mod devices;
 pub mod faults;
 pub mod gate;
@@ -32,6 +34,7 @@ pub mod tally;
 
 pub use chip::FeederPolicy;
 pub use cli::{CliError, parse};
+pub use compare::{Comparison, POLICIES, compare};
 pub use faults::{CellFault, CellFaultKind};
 pub use lateness::keeping_up_line;
 pub use report::{Report, speed_line};

@@ -608,7 +608,8 @@ impl fmt::Display for Report {
     }
 }
 
-/// The last line of a report: how fast the simulation ran. It differs from run to run.
+/// How fast one run ran: the last line of a run across processes. (The example's other runs
+/// end with every feeder policy's, [`crate::compare::speed_line`].) It differs from run to run.
 pub fn speed_line(report: &Report) -> String {
     let ratio = report.simulated / report.wall.max(1e-9);
     format!(

@@ -33,6 +33,7 @@
 mod deadlock;
 mod detour;
 mod pipeline;
+mod space;
 mod sweep;
 mod table;
 

@@ -4,9 +4,8 @@
 use std::collections::VecDeque;
 
 use imrs_ports::Name;
-use parry3d::math::{Pose, Vector};
-use parry3d::query;
-use parry3d::shape::Capsule;
+
+use super::space::Space;
 
 /// The poses of an arm along a trajectory: base, elbow and tool in the working plane.
 pub type Sweep = Vec<[[f32; 2]; 3]>;
@@ -18,21 +17,15 @@ pub type Sweep = Vec<[[f32; 2]; 3]>;
 pub struct Reservations {
     radius: f32,
     margin: f32,
-    held: Vec<(Name, Vec<Capsule>)>,
-    waiting: VecDeque<(Name, Vec<Capsule>)>,
+    held: Vec<(Name, Space)>,
+    waiting: VecDeque<(Name, Space)>,
 }
 
-fn capsules(sweep: &Sweep, radius: f32) -> Vec<Capsule> {
-    let v = |p: [f32; 2]| Vector::new(p[0], p[1], 0.0);
-    sweep
+fn space(sweep: &Sweep, radius: f32) -> Space {
+    let links = sweep
         .iter()
-        .flat_map(|[base, elbow, tool]| {
-            [
-                Capsule::new(v(*base), v(*elbow), radius),
-                Capsule::new(v(*elbow), v(*tool), radius),
-            ]
-        })
-        .collect()
+        .flat_map(|&[base, elbow, tool]| [(base, elbow), (elbow, tool)]);
+    Space::new(links, radius)
 }
 
 impl Reservations {
@@ -46,24 +39,15 @@ impl Reservations {
         }
     }
 
-    fn clear_of(&self, space: &[Capsule], other: &[Capsule]) -> bool {
-        space.iter().all(|a| {
-            other.iter().all(|b| {
-                query::distance(&Pose::IDENTITY, a, &Pose::IDENTITY, b)
-                    .is_ok_and(|d| d.distance >= self.margin)
-            })
-        })
-    }
-
     /// `robot` asks for the space of `sweep`: granted now (true) if it keeps clear of every
     /// reservation held and of every earlier request still waiting; else it waits in turn.
     pub fn request(&mut self, robot: impl Into<Name>, sweep: &Sweep) -> bool {
-        let (robot, space) = (robot.into(), capsules(sweep, self.radius));
+        let (robot, space) = (robot.into(), space(sweep, self.radius));
         let free = self
             .held
             .iter()
             .chain(&self.waiting)
-            .all(|(_, other)| self.clear_of(&space, other));
+            .all(|(_, other)| space.clear_of(other, self.margin));
         if free {
             self.held.push((robot, space));
         } else {
@@ -82,7 +66,7 @@ impl Reservations {
                 .held
                 .iter()
                 .chain(&still)
-                .all(|(_, other)| self.clear_of(&space, other));
+                .all(|(_, other)| space.clear_of(other, self.margin));
             if free {
                 granted.push(waiter.clone());
                 self.held.push((waiter, space));

@@ -1,0 +1,39 @@
+//! The feeder policies compared at once, each on a thread of its own: every run gives what it
+//! gives alone, and the runs come back in the table's order.
+
+use cell_example::{CellConfig, POLICIES, Report, compare, run};
+
+/// A report with its wall time, which differs from run to run, left out.
+fn report(record: &cell_example::RunRecord) -> Report {
+    Report {
+        wall: 0.0,
+        ..Report::of(record)
+    }
+}
+
+#[test]
+fn each_policy_compared_at_once_reports_what_it_reports_alone() {
+    // A fault, so that the runs take their recovering paths too.
+    let config = CellConfig {
+        hours: 0.1,
+        seed: 3,
+        faults: vec!["robot:B@2m".parse().unwrap()],
+        ..CellConfig::default()
+    };
+    let comparison = compare(&config);
+    let order: Vec<_> = comparison.runs.iter().map(|(policy, _)| *policy).collect();
+    assert_eq!(order, POLICIES);
+    for (policy, compared) in &comparison.runs {
+        let compared = report(compared.as_ref().unwrap());
+        let alone = report(
+            &run(&CellConfig {
+                feeder: *policy,
+                ..config.clone()
+            })
+            .unwrap(),
+        );
+        assert_eq!(compared.policy, *policy);
+        assert_eq!(compared, alone, "{policy:?}");
+        assert_eq!(compared.to_string(), alone.to_string(), "{policy:?}");
+    }
+}
