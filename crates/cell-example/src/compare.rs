@@ -8,7 +8,7 @@ use std::thread;
 use std::time::Duration;
 
 use crate::chip::FeederPolicy;
-use crate::run::{CellConfig, RunError, RunRecord, run};
+use crate::run::{CellConfig, RunError, RunRecord, refused, run};
 
 /// The policies in the order the side-by-side table shows them.
 pub const POLICIES: [FeederPolicy; 3] = [
@@ -20,7 +20,8 @@ pub const POLICIES: [FeederPolicy; 3] = [
 /// The runs of a comparison, and the cores they shared.
 #[derive(Debug)]
 pub struct Comparison {
-    /// Each policy's run, in the order of [`POLICIES`].
+    /// Each policy's run, in the order of [`POLICIES`]; or, where `config` is
+    /// [refused](crate::run::refused) before anything runs, its policy's refusal alone.
     pub runs: Vec<(FeederPolicy, Result<RunRecord, RunError>)>,
     /// How many cores ran them: those there are, at most one per run.
     pub cores: usize,
@@ -31,6 +32,12 @@ pub struct Comparison {
 /// recording or timeline. Not for a run across processes ([`CellConfig::processes`]), which
 /// needs the machine's cores to itself: [`run`] it alone.
 pub fn compare(config: &CellConfig) -> Comparison {
+    if let Some(refused) = refused(config) {
+        return Comparison {
+            runs: vec![(config.feeder, Err(refused))],
+            cores: 1,
+        };
+    }
     let configs = POLICIES.map(|policy| {
         if policy == config.feeder {
             config.clone()

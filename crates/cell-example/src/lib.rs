@@ -38,5 +38,5 @@ pub use compare::{Comparison, POLICIES, compare};
 pub use faults::{CellFault, CellFaultKind};
 pub use lateness::keeping_up_line;
 pub use report::{Report, speed_line};
-pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, TimelineConfig, run};
+pub use run::{CellConfig, MAX_HOURS, RunError, RunRecord, TimelineConfig, refused, run};
 pub use tally::Tally;

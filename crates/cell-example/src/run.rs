@@ -201,18 +201,32 @@ fn output(path: &Path, error: RecordError) -> RunError {
     }
 }
 
-/// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.
-pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
+/// What [`run`] refuses before it simulates anything: hours out of range, a fault set after
+/// the end, a recording that cannot be written. A comparison looks first, so that such a
+/// mistake is reported at once rather than after the other policies' runs.
+pub fn refused(config: &CellConfig) -> Option<RunError> {
     let hours_ok = config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS;
     if !hours_ok {
-        return Err(RunError::Hours(config.hours));
+        return Some(RunError::Hours(config.hours));
     }
     let end = Duration::from_secs_f64(config.hours * 3600.0);
     if let Some(late) = config.faults.iter().find(|fault| fault.at > end) {
-        return Err(RunError::FaultAfterEnd {
+        return Some(RunError::FaultAfterEnd {
             fault: late.to_string(),
             hours: config.hours,
         });
+    }
+    // Made and dropped: the run makes it again, from the start.
+    let path = config.record.as_ref()?;
+    Recorder::create(path)
+        .err()
+        .map(|error| output(path, error))
+}
+
+/// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.
+pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
+    if let Some(refused) = refused(config) {
+        return Err(refused);
     }
     if config.processes {
         return processes::run_world(config);

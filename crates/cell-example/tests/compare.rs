@@ -37,3 +37,22 @@ fn each_policy_compared_at_once_reports_what_it_reports_alone() {
         assert_eq!(compared.to_string(), alone.to_string(), "{policy:?}");
     }
 }
+
+#[test]
+fn a_recording_that_cannot_be_written_is_refused_before_any_policy_runs() {
+    let config = CellConfig {
+        hours: 8.0,
+        record: Some("/nonexistent-directory/cell.mcap".into()),
+        ..CellConfig::default()
+    };
+    let comparison = compare(&config);
+    // Only the chosen policy's refusal: the other two never started their eight hours.
+    assert_eq!(comparison.runs.len(), 1);
+    let (policy, refused) = &comparison.runs[0];
+    assert_eq!(*policy, config.feeder);
+    let refused = refused.as_ref().unwrap_err().to_string();
+    assert!(
+        refused.starts_with("/nonexistent-directory/cell.mcap: cannot be written"),
+        "{refused}"
+    );
+}
