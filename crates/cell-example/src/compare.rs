@@ -21,7 +21,7 @@ pub const POLICIES: [FeederPolicy; 3] = [
 #[derive(Debug)]
 pub struct Comparison {
     /// Each policy's run, in the order of [`POLICIES`]; or, where `config` is
-    /// [refused](crate::run::refused) before anything runs, its policy's refusal alone.
+    /// [refused] before anything runs, its policy's refusal alone.
     pub runs: Vec<(FeederPolicy, Result<RunRecord, RunError>)>,
     /// How many cores ran them: those there are, at most one per run.
     pub cores: usize,
