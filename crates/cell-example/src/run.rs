@@ -216,7 +216,11 @@ pub fn refused(config: &CellConfig) -> Option<RunError> {
             hours: config.hours,
         });
     }
-    // Made and dropped: the run makes it again, from the start.
+    // Made and dropped: the run makes it again, from the start. A run across processes
+    // refuses a recording by itself, and must leave no file behind.
+    if config.processes {
+        return None;
+    }
     let path = config.record.as_ref()?;
     Recorder::create(path)
         .err()

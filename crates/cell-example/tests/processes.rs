@@ -364,6 +364,8 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
         assert!(errors.contains("not with --processes"), "{errors}");
         assert!(errors.contains(named), "{errors}");
     }
+    // Refused before anything starts: no recording was begun.
+    assert!(!std::path::Path::new("x.mcap").exists());
     // A speed-up without processes, or one that means nothing, is a mistake of the flags.
     for flags in [
         &["--speed", "10"][..],
