@@ -152,3 +152,28 @@ impl<E: Record> fmt::Debug for Log<E> {
             .finish()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Clone)]
+    struct Tick;
+
+    impl Record for Tick {}
+
+    #[test]
+    fn a_log_is_wanted_while_it_keeps_records_or_has_a_subscriber() {
+        let log = Log::<Tick>::with_capacity(0);
+        assert!(!log.is_wanted(), "keeps nothing, streams to no one");
+        log.set_capacity(8);
+        assert!(log.is_wanted());
+        log.forget_events();
+        assert!(!log.is_wanted());
+        log.subscribe(|_| {});
+        assert!(log.is_wanted(), "a subscriber sees every record");
+        log.set_capacity(0);
+        assert!(log.is_wanted(), "still streamed to its subscriber");
+        assert!(Log::<Tick>::new().is_wanted(), "a new log keeps records");
+    }
+}
