@@ -8,7 +8,9 @@ use std::thread;
 use std::time::Duration;
 
 use crate::chip::FeederPolicy;
-use crate::run::{CellConfig, RunError, RunRecord, refused, run};
+use imrs_record::Recorder;
+
+use crate::run::{CellConfig, RunError, RunRecord, output, refused, run};
 
 /// The policies in the order the side-by-side table shows them.
 pub const POLICIES: [FeederPolicy; 3] = [
@@ -20,8 +22,8 @@ pub const POLICIES: [FeederPolicy; 3] = [
 /// The runs of a comparison, and the cores they shared.
 #[derive(Debug)]
 pub struct Comparison {
-    /// Each policy's run, in the order of [`POLICIES`]; or, where `config` is
-    /// [refused] before anything runs, its policy's refusal alone.
+    /// Each policy's run, in the order of [`POLICIES`]; or, where the chosen run is refused
+    /// before anything runs ([`refused`], or a recording it cannot write), that refusal alone.
     pub runs: Vec<(FeederPolicy, Result<RunRecord, RunError>)>,
     /// How many cores ran them: those there are, at most one per run.
     pub cores: usize,
@@ -32,7 +34,7 @@ pub struct Comparison {
 /// recording or timeline. Not for a run across processes ([`CellConfig::processes`]), which
 /// needs the machine's cores to itself: [`run`] it alone.
 pub fn compare(config: &CellConfig) -> Comparison {
-    if let Some(refused) = refused(config) {
+    if let Some(refused) = refused(config).or_else(|| unwritable_record(config)) {
         return Comparison {
             runs: vec![(config.feeder, Err(refused))],
             cores: 1,
@@ -81,6 +83,16 @@ pub fn compare(config: &CellConfig) -> Comparison {
         runs,
         cores: cores.min(POLICIES.len()),
     }
+}
+
+/// A recording the chosen run cannot write: that run would fail at its start, and the other
+/// policies would run for nothing before the error shows. The file is made and dropped; the
+/// chosen run makes it again.
+fn unwritable_record(config: &CellConfig) -> Option<RunError> {
+    let path = config.record.as_ref()?;
+    Recorder::create(path)
+        .err()
+        .map(|error| output(path, error))
 }
 
 impl Comparison {

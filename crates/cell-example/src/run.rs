@@ -194,16 +194,15 @@ impl From<CellError> for RunError {
     }
 }
 
-fn output(path: &Path, error: RecordError) -> RunError {
+pub(crate) fn output(path: &Path, error: RecordError) -> RunError {
     RunError::Output {
         path: path.to_path_buf(),
         error: error.to_string(),
     }
 }
 
-/// What [`run`] refuses before it simulates anything: hours out of range, a fault set after
-/// the end, a recording that cannot be written. A comparison looks first, so that such a
-/// mistake is reported at once rather than after the other policies' runs.
+/// What [`run`] refuses before it simulates anything: hours out of range, or a fault set
+/// after the end.
 pub fn refused(config: &CellConfig) -> Option<RunError> {
     let hours_ok = config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS;
     if !hours_ok {
@@ -216,15 +215,7 @@ pub fn refused(config: &CellConfig) -> Option<RunError> {
             hours: config.hours,
         });
     }
-    // Made and dropped: the run makes it again, from the start. A run across processes
-    // refuses a recording by itself, and must leave no file behind.
-    if config.processes {
-        return None;
-    }
-    let path = config.record.as_ref()?;
-    Recorder::create(path)
-        .err()
-        .map(|error| output(path, error))
+    None
 }
 
 /// Runs the cell as `config` says. Fails, naming every problem, if the cell is wired wrong.

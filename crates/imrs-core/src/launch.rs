@@ -176,21 +176,20 @@ fn too_many_users(
 ) -> Vec<CellError> {
     uses.iter()
         .filter_map(|port| {
-            let running = modules.users_of(port);
-            let others = running.iter().filter(|module| *module != name).count();
-            // Looked up only for a port that has users already: a first user always fits.
-            if others == 0 {
-                return None;
-            }
-            let capacity = wiring.port_info(port.as_str())?.capacity;
-            if others < capacity {
-                return None;
-            }
-            let mut users: Vec<Name> = running
+            let mut users: Vec<Name> = modules
+                .users_of(port)
                 .iter()
                 .filter(|module| *module != name)
                 .cloned()
                 .collect();
+            // Looked up only for a port that has users already: a first user always fits.
+            if users.is_empty() {
+                return None;
+            }
+            let capacity = wiring.port_info(port.as_str())?.capacity;
+            if users.len() < capacity {
+                return None;
+            }
             users.sort();
             users.push(name.clone());
             Some(CellError::TooManyUsers {
