@@ -82,8 +82,11 @@ impl<Req, Rep> Attachment<Req, Rep> {
     /// Registers the task to be woken when a request arrives for this end to serve.
     pub(crate) fn register_server(&self, cx: &mut Context<'_>) {
         match self.at {
-            SlotId::Owner => self.core.owner_waker.register_by_ref(cx.waker()),
-            SlotId::User(index) => self.core.users[index].waker.register_by_ref(cx.waker()),
+            SlotId::Owner => self.core.owner_wakers.server.register_by_ref(cx.waker()),
+            SlotId::User(index) => self.core.users[index]
+                .wakers
+                .server
+                .register_by_ref(cx.waker()),
         }
     }
 

@@ -92,9 +92,9 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
             // Post to everyone at once, or to no one: wait for earlier, abandoned requests
             // to be done with.
             let busy = users.clone().filter(attached).find(|&index| {
-                let slot = &core.users[index].slot;
-                slot.register_poster(cx.waker());
-                !slot.is_free()
+                let user = &core.users[index];
+                user.wakers.poster.register_by_ref(cx.waker());
+                !user.slot.is_free()
             });
             if busy.is_some() {
                 if deadline_passed(this.deadline.as_mut(), cx) {
@@ -118,7 +118,7 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
                 // every user slot, and it is borrowed mutably by this future.
                 if unsafe { user.slot.post(message.clone(), core.ticket(SlotId::Owner)) }.is_ok() {
                     user.in_broadcast.store(true, Ordering::Relaxed);
-                    user.waker.wake();
+                    user.wakers.server.wake();
                 }
             }
             *this.stage = Stage::Posted;

@@ -69,10 +69,22 @@ impl<T> std::ops::Deref for Padded<T> {
     }
 }
 
+/// The two wakers of one side of a port, on a line of their own, apart from the slot: a
+/// spinning poster reads the slot's state in a loop, and every write on that line while it
+/// does costs the writer a cross-core fetch. The peer that wakes writes here instead.
+#[derive(Default)]
+pub(crate) struct Wakers {
+    /// Wakes this side while it waits to serve (receive or respond), or, for the owner, for
+    /// a broadcast's answers.
+    pub(crate) server: AtomicWaker,
+    /// Wakes the poster of this side's slot while it waits for the slot to be free or for
+    /// its answer. For a user slot in a broadcast, that poster is the owner.
+    pub(crate) poster: AtomicWaker,
+}
+
 pub(crate) struct UserSlot<Req, Rep> {
     pub(crate) slot: Padded<Slot<Req, Rep>>,
-    /// Wakes the user while it waits to serve (receive or respond).
-    pub(crate) waker: Padded<AtomicWaker>,
+    pub(crate) wakers: Padded<Wakers>,
     attached: AtomicBool,
     /// Set by the owner while a broadcast of its awaits this user's answer.
     pub(crate) in_broadcast: AtomicBool,
@@ -85,7 +97,7 @@ impl<Req, Rep> UserSlot<Req, Rep> {
     pub(crate) fn new() -> Self {
         Self {
             slot: Padded(Slot::new()),
-            waker: Padded(AtomicWaker::new()),
+            wakers: Padded(Wakers::default()),
             attached: AtomicBool::new(false),
             in_broadcast: AtomicBool::new(false),
             holder: Mutex::default(),
@@ -100,8 +112,7 @@ pub(crate) struct Core<Req, Rep> {
     pub(crate) clock: SharedClock,
     next_ticket: Padded<AtomicU64>,
     pub(crate) owner_slot: Padded<Slot<Req, Rep>>,
-    /// Wakes the owner while it waits to serve, or for a broadcast's answers.
-    pub(crate) owner_waker: Padded<AtomicWaker>,
+    pub(crate) owner_wakers: Padded<Wakers>,
     owner_attached: AtomicBool,
     owner_holder: Mutex<Holder>,
     /// Wakes whoever waits for a user to attach (`End::peer_attached`): a waker of its own,
@@ -134,7 +145,7 @@ impl<Req, Rep> Core<Req, Rep> {
             clock,
             next_ticket: Padded(AtomicU64::new(0)),
             owner_slot: Padded(Slot::new()),
-            owner_waker: Padded(AtomicWaker::new()),
+            owner_wakers: Padded(Wakers::default()),
             owner_attached: AtomicBool::new(false),
             owner_holder: Mutex::default(),
             user_attached: AtomicWaker::new(),
@@ -157,6 +168,14 @@ impl<Req, Rep> Core<Req, Rep> {
         match id {
             SlotId::Owner => &self.owner_slot,
             SlotId::User(index) => &self.users[index].slot,
+        }
+    }
+
+    /// The waker of whoever posted into slot `id`.
+    pub(crate) fn poster(&self, id: SlotId) -> &AtomicWaker {
+        match id {
+            SlotId::Owner => &self.owner_wakers.poster,
+            SlotId::User(index) => &self.users[index].wakers.poster,
         }
     }
 
@@ -189,8 +208,8 @@ impl<Req, Rep> Core<Req, Rep> {
     /// The wake is lifted to the port's priority (see [`waking`](crate::transport::waking)).
     pub(crate) fn wake_servers_of(&self, poster: SlotId) {
         wake_at(self.meta.priority, || match poster {
-            SlotId::User(_) => self.owner_waker.wake(),
-            SlotId::Owner => self.users.iter().for_each(|user| user.waker.wake()),
+            SlotId::User(_) => self.owner_wakers.server.wake(),
+            SlotId::Owner => self.users.iter().for_each(|user| user.wakers.server.wake()),
         });
     }
 
@@ -301,11 +320,11 @@ impl<Req, Rep> Core<Req, Rep> {
 
     /// Wakes every waiter, so that each re-checks whether its peer is gone.
     pub(crate) fn wake_all(&self) {
-        self.owner_waker.wake();
-        self.owner_slot.wake_poster();
+        self.owner_wakers.server.wake();
+        self.owner_wakers.poster.wake();
         for user in self.users.iter() {
-            user.waker.wake();
-            user.slot.wake_poster();
+            user.wakers.server.wake();
+            user.wakers.poster.wake();
         }
     }
 }
@@ -314,7 +333,7 @@ impl<Req, Rep> Core<Req, Rep> {
 pub(crate) fn register_broadcast<Req, Rep>(core: &Core<Req, Rep>, waker: &Waker) {
     for user in core.users.iter() {
         if user.in_broadcast.load(Ordering::Relaxed) {
-            user.slot.register_poster(waker);
+            user.wakers.poster.register_by_ref(waker);
         }
     }
 }

@@ -175,7 +175,7 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
         }
 
         if *this.stage == Stage::Posting {
-            if slot.poll_free(cx).is_ready() {
+            if slot.poll_free(core.poster(attachment.at), cx).is_ready() {
                 let request = this.request.take().expect("a request waits to be posted");
                 // SAFETY: the end is its slot's only poster (one end per slot, borrowed
                 // mutably by this future).
@@ -219,7 +219,7 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
             attachment.parking();
         }
         // SAFETY: as above.
-        if let Poll::Ready(answer) = unsafe { slot.poll_answer(cx) } {
+        if let Poll::Ready(answer) = unsafe { slot.poll_answer(core.poster(attachment.at), cx) } {
             *this.stage = Stage::Done;
             return Poll::Ready(finish::<Req, Rep, O>(answer, port));
         }

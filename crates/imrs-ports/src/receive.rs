@@ -111,14 +111,14 @@ impl<Req: Send, Rep: Send> ReplyTarget<Rep> for Core<Req, Rep> {
             // SAFETY: a reply handle exists only for a request taken from slot `to`, and it
             // is consumed by its first answer, so this is the one answer of the server that
             // took it.
-            delivered = unsafe { self.slot(to).reply(reply) };
+            delivered = unsafe { self.slot(to).reply(self.poster(to), reply) };
         });
         delivered
     }
 
     fn unreplied(&self, to: SlotId) {
         // SAFETY: as in `reply`.
-        unsafe { self.slot(to).unreplied() }
+        unsafe { self.slot(to).unreplied(self.poster(to)) }
     }
 
     fn port(&self) -> &Name {

@@ -50,7 +50,6 @@ pub(crate) struct Slot<Req, Rep> {
     ticket: AtomicU64,
     request: UnsafeCell<MaybeUninit<Req>>,
     reply: UnsafeCell<MaybeUninit<Rep>>,
-    poster: AtomicWaker,
 }
 
 // SAFETY: the cells are only reached through the state machine above, which hands each cell
@@ -65,7 +64,6 @@ impl<Req, Rep> Slot<Req, Rep> {
             ticket: AtomicU64::new(0),
             request: UnsafeCell::new(MaybeUninit::uninit()),
             reply: UnsafeCell::new(MaybeUninit::uninit()),
-            poster: AtomicWaker::new(),
         }
     }
 
@@ -74,12 +72,12 @@ impl<Req, Rep> Slot<Req, Rep> {
         self.state.load(Ordering::Acquire) == EMPTY
     }
 
-    /// Poster: waits until the slot is free.
-    pub(crate) fn poll_free(&self, cx: &mut Context<'_>) -> Poll<()> {
+    /// Poster: waits until the slot is free, registered in `poster` meanwhile.
+    pub(crate) fn poll_free(&self, poster: &AtomicWaker, cx: &mut Context<'_>) -> Poll<()> {
         if self.is_free() {
             return Poll::Ready(());
         }
-        self.poster.register_by_ref(cx.waker());
+        poster.register_by_ref(cx.waker());
         if self.is_free() {
             Poll::Ready(())
         } else {
@@ -126,7 +124,7 @@ impl<Req, Rep> Slot<Req, Rep> {
         )
     }
 
-    /// Server: answers the request it took.
+    /// Server: answers the request it took, and wakes the poster registered in `poster`.
     ///
     /// # Safety
     ///
@@ -134,7 +132,7 @@ impl<Req, Rep> Slot<Req, Rep> {
     ///
     /// Hands the reply back if the poster had given up (timed out, or its module died):
     /// nobody would read it, and the server is told so.
-    pub(crate) unsafe fn reply(&self, reply: Rep) -> Result<(), Rep> {
+    pub(crate) unsafe fn reply(&self, poster: &AtomicWaker, reply: Rep) -> Result<(), Rep> {
         // SAFETY: while TAKEN or ABANDONED the reply cell belongs to the server (the poster
         // reads it only in REPLIED), and the caller is that server.
         self.reply.with_mut(|cell| unsafe { (*cell).write(reply) });
@@ -155,7 +153,7 @@ impl<Req, Rep> Slot<Req, Rep> {
                     Some(late)
                 }
             };
-        self.poster.wake();
+        poster.wake();
         match late {
             None => Ok(()),
             Some(reply) => Err(reply),
@@ -167,7 +165,7 @@ impl<Req, Rep> Slot<Req, Rep> {
     /// # Safety
     ///
     /// As for [`Slot::reply`].
-    pub(crate) unsafe fn unreplied(&self) {
+    pub(crate) unsafe fn unreplied(&self, poster: &AtomicWaker) {
         if let Err(state) =
             self.state
                 .compare_exchange(TAKEN, UNREPLIED, Ordering::AcqRel, Ordering::Acquire)
@@ -175,7 +173,7 @@ impl<Req, Rep> Slot<Req, Rep> {
             debug_assert_eq!(state, ABANDONED);
             self.state.store(EMPTY, Ordering::Release);
         }
-        self.poster.wake();
+        poster.wake();
     }
 
     /// Poster: the answer to its request, once there is one; frees the slot.
@@ -183,12 +181,16 @@ impl<Req, Rep> Slot<Req, Rep> {
     /// # Safety
     ///
     /// The caller is the only poster of this slot and has a request in it.
-    pub(crate) unsafe fn poll_answer(&self, cx: &mut Context<'_>) -> Poll<Answer<Rep>> {
+    pub(crate) unsafe fn poll_answer(
+        &self,
+        poster: &AtomicWaker,
+        cx: &mut Context<'_>,
+    ) -> Poll<Answer<Rep>> {
         // SAFETY: forwarded from the caller.
         if let Some(answer) = unsafe { self.try_answer() } {
             return Poll::Ready(answer);
         }
-        self.poster.register_by_ref(cx.waker());
+        poster.register_by_ref(cx.waker());
         // SAFETY: forwarded from the caller.
         match unsafe { self.try_answer() } {
             Some(answer) => Poll::Ready(answer),
@@ -292,17 +294,5 @@ impl<Req, Rep> Drop for Slot<Req, Rep> {
                 .with_mut(|cell| unsafe { (*cell).assume_init_drop() }),
             _ => {}
         }
-    }
-}
-
-impl<Req, Rep> Slot<Req, Rep> {
-    /// Wakes the poster, e.g. so that it notices its peer is gone.
-    pub(crate) fn wake_poster(&self) {
-        self.poster.wake();
-    }
-
-    /// Registers the poster's waker without looking at the state (the caller re-checks).
-    pub(crate) fn register_poster(&self, waker: &std::task::Waker) {
-        self.poster.register_by_ref(waker);
     }
 }

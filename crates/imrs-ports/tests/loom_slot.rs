@@ -19,6 +19,29 @@ use ::loom::sync::Arc;
 use ::loom::thread;
 use slot::{Answer, Slot, Withdrawn};
 
+/// A slot with its poster's waker, which the port keeps on another cache line.
+struct Paired {
+    slot: Slot<Counted, Counted>,
+    poster: ::loom::future::AtomicWaker,
+}
+
+impl Paired {
+    fn new() -> Self {
+        Self {
+            slot: Slot::new(),
+            poster: ::loom::future::AtomicWaker::new(),
+        }
+    }
+}
+
+impl std::ops::Deref for Paired {
+    type Target = Slot<Counted, Counted>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.slot
+    }
+}
+
 /// A payload that counts its live copies, to catch a leak or a double drop.
 #[derive(Debug)]
 struct Counted(u32, StdArc<()>);
@@ -41,19 +64,21 @@ fn take_eventually(slot: &Slot<Counted, Counted>) -> Counted {
 fn a_reply_reaches_the_waiting_poster() {
     ::loom::model(|| {
         let live = StdArc::new(());
-        let slot = Arc::new(Slot::<Counted, Counted>::new());
+        let slot = Arc::new(Paired::new());
         let server = {
             let (slot, live) = (Arc::clone(&slot), live.clone());
             thread::spawn(move || {
                 let request = take_eventually(&slot);
                 // SAFETY: this thread took the request and answers it once.
-                let _ = unsafe { slot.reply(counted(request.0 + 1, &live)) };
+                let _ = unsafe { slot.slot.reply(&slot.poster, counted(request.0 + 1, &live)) };
             })
         };
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(1, &live), 0) }.unwrap();
         // SAFETY: as above; the request is in the slot.
-        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe { slot.poll_answer(cx) }));
+        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe {
+            slot.slot.poll_answer(&slot.poster, cx)
+        }));
         match answer {
             Answer::Replied(reply) => assert_eq!(reply.0, 2),
             Answer::Unreplied => panic!("the server replied"),
@@ -73,19 +98,21 @@ fn a_reply_reaches_the_waiting_poster() {
 fn a_dropped_request_unblocks_the_poster() {
     ::loom::model(|| {
         let live = StdArc::new(());
-        let slot = Arc::new(Slot::<Counted, Counted>::new());
+        let slot = Arc::new(Paired::new());
         let server = {
             let slot = Arc::clone(&slot);
             thread::spawn(move || {
                 drop(take_eventually(&slot));
                 // SAFETY: this thread took the request and answers it once.
-                unsafe { slot.unreplied() };
+                unsafe { slot.slot.unreplied(&slot.poster) };
             })
         };
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(1, &live), 0) }.unwrap();
         // SAFETY: as above.
-        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe { slot.poll_answer(cx) }));
+        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe {
+            slot.slot.poll_answer(&slot.poster, cx)
+        }));
         assert!(matches!(answer, Answer::Unreplied));
         server.join().unwrap();
         assert!(slot.is_free());
@@ -98,7 +125,7 @@ fn a_dropped_request_unblocks_the_poster() {
 fn a_withdrawal_racing_a_take_and_reply_loses_and_duplicates_nothing() {
     ::loom::model(|| {
         let live = StdArc::new(());
-        let slot = Arc::new(Slot::<Counted, Counted>::new());
+        let slot = Arc::new(Paired::new());
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(7, &live), 0) }.unwrap();
         let server = {
@@ -108,7 +135,10 @@ fn a_withdrawal_racing_a_take_and_reply_loses_and_duplicates_nothing() {
                     return false;
                 };
                 // SAFETY: this thread took the request and answers it once.
-                let _ = unsafe { slot.reply(counted(request.0 * 10, &live)) };
+                let _ = unsafe {
+                    slot.slot
+                        .reply(&slot.poster, counted(request.0 * 10, &live))
+                };
                 true
             })
         };
@@ -143,7 +173,7 @@ fn a_withdrawal_racing_a_take_and_reply_loses_and_duplicates_nothing() {
 fn two_servers_never_both_take_one_request() {
     ::loom::model(|| {
         let live = StdArc::new(());
-        let slot = Arc::new(Slot::<Counted, Counted>::new());
+        let slot = Arc::new(Paired::new());
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(1, &live), 0) }.unwrap();
         let servers: Vec<_> = (0..2)
@@ -152,7 +182,7 @@ fn two_servers_never_both_take_one_request() {
                 thread::spawn(move || {
                     let request = slot.take()?;
                     // SAFETY: this thread took the request and answers it once.
-                    unsafe { slot.unreplied() };
+                    unsafe { slot.slot.unreplied(&slot.poster) };
                     Some(request.0)
                 })
             })
