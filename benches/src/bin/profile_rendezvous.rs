@@ -4,18 +4,24 @@
 //! trips are queries into a response handler of an idle module, as in
 //! `query/responder_idle`; with `ctx`, two modules talking through `ctx.send` and
 //! `ctx.receive`, as in `ctx_same_thread/ctx`; with `ring`, hops around a ring of 1 000
-//! modules on one thread, as in `ring_1000/imrs/1_threads`.
+//! modules on one thread, as in `ring_1000/imrs/1_threads`; with `prioritized` and
+//! `unprioritized`, the round trips of `rendezvous_same_thread/imrs_one_processor_prioritized`
+//! and of the same without priorities; with `tight`, TIGHT round trips across two threads,
+//! as in `rendezvous_tight/imrs`, for `perf record` (their cost is in the cache lines that
+//! cross between cores, which callgrind does not see).
 //!
 //! ```text
 //! cargo build --release -p imrs-benches --bin profile_rendezvous
-//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query|ctx|ring]
+//! valgrind --tool=callgrind target/release/profile_rendezvous 100000 [query|ctx|ring|prioritized|unprioritized]
+//! perf record -g target/release/profile_rendezvous 2000000 tight
 //! ```
 
 use std::hint::black_box;
 
 use imrs_benches::current_thread;
+use imrs_benches::rendezvous::{imrs_cross_thread, imrs_on_processor};
 use imrs_core::prelude::*;
-use imrs_ports::RealClock;
+use imrs_ports::{ProcessType, RealClock};
 
 fn main() {
     let round_trips: u64 = std::env::args()
@@ -29,6 +35,15 @@ fn main() {
         black_box(imrs_benches::imrs_ring(1_000, round_trips, 1));
     } else if mode.as_deref() == Some("ctx") {
         black_box(imrs_benches::ctx_on_processor(round_trips));
+    } else if let Some(prioritized @ ("prioritized" | "unprioritized")) = mode.as_deref() {
+        let on = prioritized == "prioritized";
+        black_box(imrs_on_processor::<8>(round_trips, None, on));
+    } else if mode.as_deref() == Some("tight") {
+        black_box(imrs_cross_thread::<8>(
+            round_trips,
+            ProcessType::Tight,
+            None,
+        ));
     } else {
         rendezvous(round_trips);
     }
