@@ -4,12 +4,14 @@
 //! | seed | port | from → to |
 //! |---|---|---|
 //! | request to move in a shared zone; position (stopped inside); zone release; trajectory end | `TO_COORDINATOR`, a [`Message`], answered [`Answer::Grant`] or [`Answer::Sleep`] | robot → coordinator |
+//! | position information (where its links are); a trajectory's next points to check against the other robots; an alternative trajectory round the robots in the way | `SPACE`, a [`Geometry`], answered with what the coordinator [`Seen`] | robot → coordinator |
 //! | alarm | `ALARM` (priority 1: served before everything else) | robot → coordinator |
 //! | wake up (and back off, to resolve a deadlock) | `WAKE_<ROBOT>`, a [`Wake`] | coordinator → robot |
 //! | alarm: an emergency stop reaches every robot | `EMERGENCY`, a `sendall` | coordinator → every robot |
 //!
 //! After every sleep it looks for a deadlock among exclusive resources; the victim is told
-//! to back off.
+//! to back off. A robot's way is checked against the other robots where *they said* they
+//! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -17,7 +19,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use imrs_core::prelude::*;
 use imrs_ports::{AnyUser, End, Name, Port, PortSpec, SharedClock, select, usage};
 
-use crate::zones::{Answer, Resources, ZoneError};
+use crate::zones::{Answer, Pose, Positions, Resources, Sweep, ZoneError};
 
 /// What a robot tells the coordinator.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -31,6 +33,43 @@ pub enum Message {
     /// The trajectory has ended: the robot is stopped.
     TrajectoryEnd,
 }
+
+/// What a robot tells or asks the coordinator about space.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Geometry {
+    /// Position information: its links are here now.
+    At(Pose),
+    /// Its links at the next points of its trajectory: do they keep clear of every other
+    /// robot?
+    Check(Sweep),
+    /// Its straight way from `from` to `to` is blocked by the robots `around`: an
+    /// alternative trajectory round them.
+    Alternative {
+        /// Where the tool is.
+        from: [f32; 2],
+        /// Where it goes.
+        to: [f32; 2],
+        /// The robots in the way.
+        around: Vec<Name>,
+    },
+}
+
+/// What the coordinator answers about space.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Seen {
+    /// The position is noted.
+    Noted,
+    /// The way is clear of every other robot: continue.
+    Clear,
+    /// These robots are in the way, where they last said they were.
+    Blocked(Vec<Name>),
+    /// Continue with this alternative trajectory (the whole way, its start first), or, if
+    /// `None`, there is none within reach.
+    Alternative(Option<Vec<[f32; 2]>>),
+}
+
+/// How far to the side an alternative trajectory may go.
+pub const ALTERNATIVE_REACH: f32 = 0.25;
 
 /// What the coordinator tells a sleeping robot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +90,8 @@ pub struct CoordinatorPorts {
     /// `TO_COORDINATOR`: requests, positions, releases, trajectory ends.
     pub to_coordinator:
         Port<(Name, Message), Result<Answer, String>, usage::Receive, AnyUser, MAX_ROBOTS>,
+    /// `SPACE`: positions, checks of the way ahead, alternative trajectories.
+    pub space: Port<(Name, Geometry), Result<Seen, String>, usage::Receive, AnyUser, MAX_ROBOTS>,
     /// `ALARM`.
     pub alarm: Port<(Name, String), (), usage::Receive, AnyUser, MAX_ROBOTS>,
     /// `EMERGENCY`: the emergency stop, to every robot.
@@ -65,6 +106,7 @@ impl CoordinatorPorts {
         let spec = |port: String| PortSpec::new(port, name).clock(clock.clone());
         Self {
             to_coordinator: Port::new(spec("TO_COORDINATOR".into()).priority(2)),
+            space: Port::new(spec("SPACE".into()).priority(2)),
             alarm: Port::new(spec("ALARM".into()).priority(1)),
             emergency: Port::new(spec("EMERGENCY".into()).priority(1)),
             wake: robots
@@ -88,6 +130,7 @@ impl CoordinatorPorts {
         Ok(RobotLink {
             robot: robot.into(),
             to: self.to_coordinator.user_named(robot)?,
+            space: self.space.user_named(robot)?,
             alarm: self.alarm.user_named(robot)?,
             wake: wake.user_named(robot)?,
             emergency: self.emergency.user_named(robot)?,
@@ -108,6 +151,7 @@ pub enum Refused {
 pub struct RobotLink {
     robot: Name,
     to: End<(Name, Message), Result<Answer, String>, usage::Send>,
+    space: End<(Name, Geometry), Result<Seen, String>, usage::Send>,
     alarm: End<(Name, String), (), usage::Send>,
     wake: End<Wake, (), usage::Receive>,
     emergency: End<String, (), usage::Receive>,
@@ -125,10 +169,30 @@ impl RobotLink {
 
     /// Asks for `zone` (or a tool) until granted, sleeping at the border meanwhile.
     pub async fn acquire(&mut self, zone: &str) -> Result<(), Refused> {
+        self.acquire_giving_up(zone, &[]).await.map(drop)
+    }
+
+    /// Asks for `zone` (or a tool) until granted, as [`acquire`](Self::acquire) does; but
+    /// the robot moves in the shared zones `moving_in`, and if it must sleep at the border,
+    /// it first gives up its right to move in each of them, with a position message (it is
+    /// stopped inside): the seed's reason why shared zones cannot deadlock. Returns the
+    /// zones it gave up, for it to ask again before it moves.
+    pub async fn acquire_giving_up(
+        &mut self,
+        zone: &str,
+        moving_in: &[Name],
+    ) -> Result<Vec<Name>, Refused> {
+        let mut given_up = Vec::new();
         loop {
             match self.tell(Message::Request(zone.into())).await? {
-                Answer::Grant => return Ok(()),
+                Answer::Grant => return Ok(given_up),
                 Answer::Sleep => {
+                    for shared in moving_in {
+                        if !given_up.contains(shared) {
+                            self.tell(Message::Position(shared.clone())).await?;
+                            given_up.push(shared.clone());
+                        }
+                    }
                     let (wake, reply) = self
                         .wake
                         .receive()
@@ -140,6 +204,43 @@ impl RobotLink {
                     }
                 }
             }
+        }
+    }
+
+    /// Asks the coordinator about space; its answer.
+    async fn ask(&mut self, geometry: Geometry) -> Result<Seen, Refused> {
+        self.space
+            .send((self.robot.clone(), geometry))
+            .await
+            .map_err(|error| Refused::Failed(error.to_string()))?
+            .map_err(Refused::Failed)
+    }
+
+    /// Tells the coordinator where its links are now (position information).
+    pub async fn at(&mut self, pose: Pose) -> Result<(), Refused> {
+        self.ask(Geometry::At(pose)).await.map(drop)
+    }
+
+    /// The robots in the way of its links at the next points of its trajectory, where they
+    /// last told the coordinator they were: none when the way is clear.
+    pub async fn check(&mut self, sweep: Sweep) -> Result<Vec<Name>, Refused> {
+        match self.ask(Geometry::Check(sweep)).await? {
+            Seen::Blocked(robots) => Ok(robots),
+            _ => Ok(Vec::new()),
+        }
+    }
+
+    /// The coordinator's alternative trajectory from `from` to `to` round the robots
+    /// `around`: the whole way, `from` first, or `None` if there is none.
+    pub async fn alternative(
+        &mut self,
+        from: [f32; 2],
+        to: [f32; 2],
+        around: Vec<Name>,
+    ) -> Result<Option<Vec<[f32; 2]>>, Refused> {
+        match self.ask(Geometry::Alternative { from, to, around }).await? {
+            Seen::Alternative(way) => Ok(way),
+            _ => Ok(None),
         }
     }
 
@@ -176,22 +277,33 @@ pub struct CoordinatorLog {
     pub alarms: Vec<(Name, String)>,
     /// Messages it could not take (unknown zone or robot), named.
     pub refused: Vec<String>,
+    /// Ways ahead it checked against the robots' told positions.
+    pub checked: u32,
+    /// Of those, ways it found blocked by another robot.
+    pub blocked: u32,
+    /// Alternative trajectories it computed, and of those, how many it found.
+    pub alternatives: (u32, u32),
 }
 
-/// The coordinator module `name`: answers every message from `table`'s bookkeeping, wakes
-/// sleepers, resolves deadlocks, and passes alarms on to every robot. Its log is shared.
+/// The coordinator module `name`: answers every message from `table`'s bookkeeping and the
+/// robots' told `positions`, wakes sleepers, resolves deadlocks, and passes alarms on to
+/// every robot. Its log is shared.
 pub fn coordinator(
     name: &str,
     table: Resources,
+    positions: Positions,
     ports: &CoordinatorPorts,
     log: Arc<Mutex<CoordinatorLog>>,
 ) -> ModuleSpec<()> {
     let ports = ports.clone();
     let table = Arc::new(Mutex::new(table));
+    let positions = Arc::new(Mutex::new(positions));
     ModuleSpec::new(name, ()).task(name, move |_ctx| {
         let (ports, table, log) = (ports.clone(), Arc::clone(&table), Arc::clone(&log));
+        let positions = Arc::clone(&positions);
         async move {
             let mut to = ports.to_coordinator.owner()?;
+            let mut space = ports.space.owner()?;
             let mut alarm = ports.alarm.owner()?;
             let mut emergency = ports.emergency.owner()?;
             let mut wake: BTreeMap<Name, End<Wake, (), usage::Send>> = BTreeMap::new();
@@ -206,6 +318,11 @@ pub fn coordinator(
                         Message,
                         imrs_ports::ReplyHandle<Result<Answer, String>>,
                     ),
+                    Space(
+                        Name,
+                        Geometry,
+                        imrs_ports::ReplyHandle<Result<Seen, String>>,
+                    ),
                 }
                 let event = select()
                     .or(&mut alarm, |((robot, text), reply)| {
@@ -215,8 +332,18 @@ pub fn coordinator(
                     .or(&mut to, |((robot, message), reply)| {
                         Event::Message(robot, message, reply)
                     })
+                    .or(&mut space, |((robot, geometry), reply)| {
+                        Event::Space(robot, geometry, reply)
+                    })
                     .await?;
                 match event {
+                    Event::Space(robot, geometry, reply) => {
+                        let seen = see(&mut lock(&positions), &mut lock(&log), &robot, geometry);
+                        if let Err(error) = &seen {
+                            lock(&log).refused.push(error.to_string());
+                        }
+                        reply.reply(seen.map_err(|error| error.to_string()));
+                    }
                     Event::Alarm(robot, text) => {
                         lock(&log).alarms.push((robot.clone(), text.clone()));
                         // Every robot that takes it stops; one that does not is not waited for.
@@ -261,6 +388,39 @@ pub fn coordinator(
                     }
                 }
             }
+        }
+    })
+}
+
+/// The answer to one question about space, from the robots' told positions; a position
+/// told is noted.
+fn see(
+    positions: &mut Positions,
+    log: &mut CoordinatorLog,
+    robot: &Name,
+    geometry: Geometry,
+) -> Result<Seen, ZoneError> {
+    let robot = robot.as_str();
+    Ok(match geometry {
+        Geometry::At(pose) => {
+            positions.tell(robot, pose)?;
+            Seen::Noted
+        }
+        Geometry::Check(sweep) => {
+            log.checked += 1;
+            let blocking = positions.blockers(robot, &sweep)?;
+            if blocking.is_empty() {
+                Seen::Clear
+            } else {
+                log.blocked += 1;
+                Seen::Blocked(blocking)
+            }
+        }
+        Geometry::Alternative { from, to, around } => {
+            let way = positions.alternative(robot, from, to, &around, ALTERNATIVE_REACH)?;
+            log.alternatives.0 += 1;
+            log.alternatives.1 += u32::from(way.is_some());
+            Seen::Alternative(way)
         }
     })
 }

@@ -1,6 +1,7 @@
-//! The coordination layer of a multiple-arm cell, after Jiménez, Sevillano, Civit-Balcells,
-//! Díaz and Civit-Breu, *RISC-based architectures for multiple robot systems* (1992): arms
-//! that share space and tools, a coordinator, and the network that carries their messages.
+//! The coordination layer of a multiple-arm cell, after G. Jiménez, J. L. Sevillano,
+//! A. Civit-Balcells, F. Díaz and A. Civit-Breu, *RISC-based architectures for multiple robot
+//! systems* (1992; seed 003): arms that share space and tools, a coordinator, and the network
+//! that carries their messages.
 //!
 //! Built so far:
 //! - [`network`]: the worst-case delay of a deterministic CSMA/DCR bus for a given cell
@@ -9,8 +10,10 @@
 //!   modules are placed on stations;
 //! - [`scheduler`]: the run-time task scheduler, against static assignments;
 //! - [`zones`]: zones and tools as resources, the coordinator's table of them, deadlock
-//!   detection among exclusive resources and its resolution, the alternative trajectory
-//!   round a stopped robot, and the arm's pipeline of points checked ahead;
+//!   detection among exclusive resources and its resolution, the robots' positions as they
+//!   told them, against which the coordinator checks a robot's way ahead and computes the
+//!   alternative trajectory round a stopped robot, and the arm's pipeline of points checked
+//!   ahead;
 //! - [`coordinator`]: the zone coordinator as a module, speaking the seed's message set over
 //!   typed ports.
 //!

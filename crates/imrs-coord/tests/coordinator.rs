@@ -1,12 +1,14 @@
 //! The zone coordinator as a module, with robot modules talking to it through its ports on
 //! virtual time: an exclusive zone taken in turn, a deadlock resolved, an alarm that stops
-//! every robot, a bad name refused.
+//! every robot, a bad name refused, a robot stopped at a border giving up its right to move
+//! in the shared zone it is in, and a robot's way checked against where the others told the
+//! coordinator they are, with an alternative round them.
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, Message, Refused, coordinator};
-use imrs_coord::zones::{Resources, ZoneDef, ZoneKind};
+use imrs_coord::zones::{Pose, Positions, Resources, ZoneDef, ZoneKind};
 use imrs_core::prelude::*;
 
 const ROBOTS: [&str; 3] = ["ROBOT_A", "ROBOT_B", "ROBOT_C"];
@@ -24,6 +26,12 @@ fn table() -> Resources {
                 "TRAY",
                 ZoneKind::Exclusive,
                 [0.5, 0.0, 0.2],
+                [0.1, 0.1, 0.2],
+            ),
+            ZoneDef::boxed(
+                "PASSAGE",
+                ZoneKind::Shared,
+                [1.0, 0.0, 0.2],
                 [0.1, 0.1, 0.2],
             ),
         ],
@@ -47,6 +55,7 @@ fn start() -> (
     cell.start(coordinator(
         "COORDINATOR",
         table(),
+        Positions::new(ROBOTS, 0.035, 0.03),
         &ports,
         Arc::clone(&log),
     ))
@@ -204,4 +213,188 @@ async fn an_alarm_stops_every_robot_and_a_bad_name_is_refused() {
     let log = log.lock().unwrap();
     assert_eq!(log.alarms.len(), 1);
     assert_eq!(log.refused.len(), 1);
+}
+
+/// An arm along the x axis at height `y`, from x = 0 to 0.5.
+fn along(y: f32) -> Pose {
+    [[0.0, y], [0.25, y], [0.5, y]]
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_way_is_checked_against_where_the_others_said_they_are() {
+    let (cell, clock, ports, log) = start();
+    // ROBOT_A says where it is, later that it moved; ROBOT_B checks its way each time.
+    let a = {
+        let ports = ports.clone();
+        ModuleSpec::new("ROBOT_A", ()).task("ROBOT_A", move |ctx| {
+            let ports = ports.clone();
+            async move {
+                let mut link = ports.link("ROBOT_A")?;
+                // Its arm reaches across the line y = 0.05, its tool at (0.5, 0).
+                let across = [[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]];
+                link.at(across).await.map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(2)).await;
+                link.at(along(1.0)).await.map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let b = {
+        let seen = Arc::clone(&seen);
+        ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
+            let (ports, seen) = (ports.clone(), Arc::clone(&seen));
+            async move {
+                let mut link = ports.link("ROBOT_B")?;
+                let way = vec![along(0.05)];
+                let refused = |e| format!("{e:?}");
+                ctx.delay(Duration::from_secs(1)).await;
+                let blocked = link.check(way.clone()).await.map_err(refused)?;
+                let round = link
+                    .alternative([0.0, 0.05], [1.0, 0.05], blocked.clone())
+                    .await
+                    .map_err(refused)?;
+                ctx.delay(Duration::from_secs(2)).await;
+                let later = link.check(way).await.map_err(refused)?;
+                let nowhere = link
+                    .at([[f32::NAN, 0.0], [0.0, 0.0], [0.0, 0.0]])
+                    .await
+                    .unwrap_err();
+                seen.lock().unwrap().push((blocked, round, later, nowhere));
+                Ok(())
+            }
+        })
+    };
+    let mut robots = [cell.start(a).unwrap(), cell.start(b).unwrap()];
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(5))).await;
+    for robot in &mut robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+    let (blocked, round, later, nowhere) = seen.lock().unwrap().pop().expect("B checked");
+    // Where A said it was, it blocked B's way; the alternative goes round it.
+    assert_eq!(blocked, ["ROBOT_A"]);
+    let round = round.expect("a way round ROBOT_A");
+    assert_eq!(round.first(), Some(&[0.0, 0.05]));
+    assert_eq!(round.last(), Some(&[1.0, 0.05]));
+    assert!(round.len() > 2, "the straight way was blocked: {round:?}");
+    // Once A said it had moved, the same way was clear.
+    assert!(later.is_empty(), "{later:?}");
+    // A position that is no place is refused by name, and kept out of the books.
+    assert_eq!(
+        nowhere,
+        Refused::Failed("robot ROBOT_B gave a position that is no place (not finite)".into())
+    );
+    let log = log.lock().unwrap();
+    assert_eq!((log.checked, log.blocked, log.alternatives), (2, 1, (1, 1)));
+}
+
+/// ROBOT_C holds FIXTURE for 2 s. ROBOT_A moves in the shared PASSAGE and asks for FIXTURE;
+/// ROBOT_B asks to move in PASSAGE at 0.5 s. Returns when B was granted PASSAGE, and what A
+/// gave up while it slept at FIXTURE's border.
+async fn border_sleep(give_up: bool) -> (f64, Vec<String>) {
+    let (cell, clock, ports, log) = start();
+    let granted = Arc::new(Mutex::new(None));
+    let given_up = Arc::new(Mutex::new(Vec::new()));
+    let c = {
+        let ports = ports.clone();
+        ModuleSpec::new("ROBOT_C", ()).task("ROBOT_C", move |ctx| {
+            let ports = ports.clone();
+            async move {
+                let mut link = ports.link("ROBOT_C")?;
+                link.acquire("FIXTURE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(2)).await;
+                link.tell(Message::Release("FIXTURE".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let a = {
+        let (ports, given_up) = (ports.clone(), Arc::clone(&given_up));
+        ModuleSpec::new("ROBOT_A", ()).task("ROBOT_A", move |ctx| {
+            let (ports, given_up) = (ports.clone(), Arc::clone(&given_up));
+            async move {
+                let mut link = ports.link("ROBOT_A")?;
+                ctx.delay(Duration::from_millis(100)).await;
+                link.acquire("PASSAGE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                let moving_in = if give_up {
+                    vec!["PASSAGE".into()]
+                } else {
+                    Vec::new()
+                };
+                let gave = link
+                    .acquire_giving_up("FIXTURE", &moving_in)
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                // It asks again for what it gave up before it moves on.
+                for zone in &gave {
+                    link.acquire(zone.as_str())
+                        .await
+                        .map_err(|e| format!("{e:?}"))?;
+                }
+                given_up
+                    .lock()
+                    .unwrap()
+                    .extend(gave.iter().map(ToString::to_string));
+                for zone in ["FIXTURE", "PASSAGE"] {
+                    link.tell(Message::Release(zone.into()))
+                        .await
+                        .map_err(|e| format!("{e:?}"))?;
+                }
+                Ok(())
+            }
+        })
+    };
+    let b = {
+        let granted = Arc::clone(&granted);
+        ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
+            let (ports, granted) = (ports.clone(), Arc::clone(&granted));
+            async move {
+                let mut link = ports.link("ROBOT_B")?;
+                ctx.delay(Duration::from_millis(500)).await;
+                link.acquire("PASSAGE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                *granted.lock().unwrap() = Some(seconds(&ctx));
+                ctx.delay(Duration::from_millis(500)).await;
+                link.tell(Message::Release("PASSAGE".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let mut robots = [
+        cell.start(c).unwrap(),
+        cell.start(a).unwrap(),
+        cell.start(b).unwrap(),
+    ];
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
+    for robot in &mut robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+    assert!(log.lock().unwrap().refused.is_empty());
+    let granted = granted.lock().unwrap().expect("B was granted PASSAGE");
+    let given_up = given_up.lock().unwrap().clone();
+    (granted, given_up)
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_robot_asleep_at_a_border_gives_up_moving_in_its_shared_zone() {
+    // A gives up PASSAGE while it sleeps at FIXTURE's border: B moves there at once.
+    let (granted, given_up) = border_sleep(true).await;
+    assert_eq!(given_up, ["PASSAGE"]);
+    assert!(granted < 0.6, "B waited for PASSAGE until {granted} s");
+    // Without giving it up, B waits until A has FIXTURE and leaves PASSAGE: after 2 s.
+    let (granted, given_up) = border_sleep(false).await;
+    assert!(given_up.is_empty());
+    assert!(
+        granted >= 2.0,
+        "B moved in PASSAGE at {granted} s, beside A"
+    );
 }

@@ -1,7 +1,10 @@
 //! An arm of the table cell as a module: it asks the scheduler for work, and carries each
 //! job out through the coordinator — its trajectory's points checked ahead in the
 //! pipeline (zones requested before the arm reaches them, released once it has left them),
-//! and its links checked against the other arms' before every step.
+//! its position told after every step, and its links at the next points checked by the
+//! coordinator, against where the other arms told it they are, before every step. An arm
+//! holds its own arm of the table and nothing else of it: it cannot see another arm but
+//! through the coordinator.
 //!
 //! The seed's messages between an arm's two controllers, here:
 //!
@@ -20,15 +23,14 @@ use std::time::Duration;
 use imrs_core::prelude::*;
 use imrs_ports::Name;
 use imrs_sim::scara::Scara;
-use imrs_sim::table::{GRIPPER_RADIUS, Table, TableArm, WORK_Z};
+use imrs_sim::table::{ArmSpec, GRIPPER_RADIUS, TableArm, WORK_Z};
 use nalgebra::Point2;
 
-use super::clearance::{blockers, obstacles};
 use super::layout::{RACK, SCREWDRIVER};
 use super::schedule::{JobAsker, JobPort};
 use super::{CellStats, lock};
 use imrs_coord::coordinator::{CoordinatorPorts, Message, Refused, RobotLink};
-use imrs_coord::zones::{Answer, Next, Pipeline, ZoneDef, ZoneKind, detour};
+use imrs_coord::zones::{Answer, Next, Pipeline, Pose, Sweep, ZoneDef, ZoneKind};
 
 /// Points of a trajectory, this far apart.
 const SPACING: f32 = 0.02;
@@ -37,7 +39,7 @@ const DECELERATION: f32 = 2.5;
 /// How many points ahead an arm checks its links against the others'.
 const LOOKAHEAD: usize = 5;
 /// How far apart two arms' links are kept.
-const MARGIN: f32 = 0.03;
+pub(crate) const MARGIN: f32 = 0.03;
 /// How often a blocked or idle arm looks again.
 const RETRY: Duration = Duration::from_millis(200);
 /// How long an arm waits for a stopped arm in its way before it goes round it.
@@ -61,7 +63,7 @@ struct Driver {
     arm: TableArm,
     scara: Scara,
     speed: f32,
-    table: Table,
+    home: Point2<f32>,
     link: RobotLink,
     zones: Arc<Vec<ZoneDef>>,
     ctx: Ctx<()>,
@@ -70,39 +72,38 @@ struct Driver {
     yield_after_back_off: bool,
 }
 
-/// The arm module for `name` (the scheduler's robot `index`).
+/// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`).
 pub(crate) fn arm_module(
-    name: &str,
+    arm: TableArm,
+    spec: &ArmSpec,
     index: usize,
-    table: &Table,
     coordinator: &CoordinatorPorts,
     jobs: &JobPort,
     zones: Arc<Vec<ZoneDef>>,
     stats: Arc<Mutex<CellStats>>,
 ) -> ModuleSpec<()> {
-    let (table, coordinator, jobs) = (table.clone(), coordinator.clone(), jobs.clone());
-    let module: Name = name.into();
-    ModuleSpec::new(name, ()).task(name, move |ctx| {
-        let (table, coordinator, jobs) = (table.clone(), coordinator.clone(), jobs.clone());
+    let (spec, coordinator, jobs) = (spec.clone(), coordinator.clone(), jobs.clone());
+    let module: Name = arm.name().clone();
+    ModuleSpec::new(module.as_str(), ()).task(module.as_str(), move |ctx| {
+        let (arm, spec) = (arm.clone(), spec.clone());
+        let (coordinator, jobs) = (coordinator.clone(), jobs.clone());
         let (name, zones, stats) = (module.clone(), Arc::clone(&zones), Arc::clone(&stats));
         async move {
-            let arm = table.arm(name.as_str())?;
-            let spec = table.layout().arms[index].clone();
             let mut driver = Driver {
                 link: coordinator.link(name.as_str())?,
                 name: name.clone(),
                 index,
                 scara: spec.arm,
                 speed: spec.speed,
+                home: spec.home,
                 arm,
-                table,
                 zones,
                 ctx,
                 stats: Arc::clone(&stats),
                 yield_after_back_off: false,
             };
             let mut ask = jobs.user_named(name.as_str())?;
-            let result = driver.work(&mut ask, spec.home).await;
+            let result = driver.work(&mut ask).await;
             if let Err(why) = &result {
                 lock(&stats).failures.push(format!("{name}: {why}"));
             }
@@ -112,8 +113,9 @@ pub(crate) fn arm_module(
 }
 
 impl Driver {
-    async fn work(&mut self, ask: &mut JobAsker, home: Point2<f32>) -> Result<(), String> {
+    async fn work(&mut self, ask: &mut JobAsker) -> Result<(), String> {
         let mut finished = None;
+        self.tell_position().await?;
         loop {
             let job = ask
                 .send((self.index, finished.take()))
@@ -136,12 +138,45 @@ impl Driver {
                 self.arm.put_tool().map_err(|error| error.to_string())?;
                 self.tell(Message::Release(SCREWDRIVER.into())).await?;
             }
-            self.go(home).await?;
+            self.go(self.home).await?;
             let mut stats = lock(&self.stats);
             stats.jobs[self.index] += 1;
             stats.busy[self.index] += self.ctx.now().saturating_duration_since(started);
             finished = Some((job.unit, job.task));
         }
+    }
+
+    /// Its links with the tool at `tool`, if it reaches there.
+    fn pose(&self, tool: &Point2<f32>) -> Option<Pose> {
+        let joints = self.scara.joints(tool)?;
+        Some(joints.map(|joint| [joint.x, joint.y]))
+    }
+
+    /// Its links at each of `points` it reaches.
+    fn sweep(&self, points: &[Point2<f32>]) -> Sweep {
+        points.iter().filter_map(|point| self.pose(point)).collect()
+    }
+
+    /// Tells the coordinator where its links are now (position information).
+    async fn tell_position(&mut self) -> Result<(), String> {
+        let here = self.arm.at();
+        let pose = self
+            .pose(&here)
+            .ok_or_else(|| format!("{}: its tool at {here} is out of its reach", self.name))?;
+        self.link
+            .at(pose)
+            .await
+            .map_err(|refused| format!("{refused:?}"))
+    }
+
+    /// The arms in the way of its links at `points`, where they told the coordinator
+    /// they are.
+    async fn blockers(&mut self, points: &[Point2<f32>]) -> Result<Vec<Name>, String> {
+        let sweep = self.sweep(points);
+        self.link
+            .check(sweep)
+            .await
+            .map_err(|refused| format!("{refused:?}"))
     }
 
     fn zones_at(&self, point: Point2<f32>) -> Vec<Name> {
@@ -168,17 +203,31 @@ impl Driver {
 
     /// Asks for a zone or the tool until granted, stopped meanwhile (STOP_C).
     async fn acquire(&mut self, resource: &Name) -> Result<(), String> {
-        match self.link.acquire(resource.as_str()).await {
-            Ok(()) => Ok(()),
-            // Every arm takes the tool before any zone and frees the zones it holds
-            // before it waits on another arm, so no cycle of waits can form here; a
-            // back-off would mean the coordinator found one, and is reported as such.
-            Err(Refused::BackOff) => Err(format!(
-                "told to back off while asking for {resource}: a deadlock the cell's \
-                 order of requests should have made impossible"
-            )),
-            Err(Refused::Failed(why)) => Err(why),
+        self.acquire_moving_in(resource, &[]).await
+    }
+
+    /// Asks for a zone or the tool until granted, as [`acquire`](Self::acquire) does, while
+    /// it moves in the shared zones `moving_in`. Stopped at the border, it gives up its
+    /// right to move in them (a position message each), and asks for them again once
+    /// granted, before it moves on.
+    async fn acquire_moving_in(
+        &mut self,
+        resource: &Name,
+        moving_in: &[Name],
+    ) -> Result<(), String> {
+        let given_up = self
+            .link
+            .acquire_giving_up(resource.as_str(), moving_in)
+            .await
+            .map_err(|refused| unexpected(resource, refused))?;
+        lock(&self.stats).rights_given_up += given_up.len() as u32;
+        for shared in given_up {
+            self.link
+                .acquire(shared.as_str())
+                .await
+                .map_err(|refused| unexpected(&shared, refused))?;
         }
+        Ok(())
     }
 
     /// Moves the tool to `to`, going round or backing off from arms in the way.
@@ -233,7 +282,15 @@ impl Driver {
             };
             match pipeline.next(zones_at) {
                 Next::Request(zone) => {
-                    self.acquire(&zone).await?;
+                    // The shared zones it is in and moves in now: refused at the border,
+                    // it gives them up while it waits.
+                    let inside = self.zones_at(self.arm.at());
+                    let moving_in: Vec<Name> = pipeline
+                        .holding()
+                        .filter(|held| inside.contains(held) && self.is_shared(held))
+                        .cloned()
+                        .collect();
+                    self.acquire_moving_in(&zone, &moving_in).await?;
                     pipeline.granted(zone);
                 }
                 Next::Move { point, release } => {
@@ -246,6 +303,7 @@ impl Driver {
                         .move_to(Point2::new(point[0], point[1]))
                         .await
                         .map_err(|error| error.to_string())?;
+                    self.tell_position().await?;
                     // Only now, at the point, has the gripper left these zones.
                     for zone in release {
                         self.tell(Message::Release(zone)).await?;
@@ -266,7 +324,8 @@ impl Driver {
         }
     }
 
-    /// Waits until the arm's links at `ahead` keep clear of every other arm, freeing
+    /// Waits until the arm's links at `ahead` keep clear of every other arm (as the
+    /// coordinator checks them against where the others told it they are), freeing
     /// meanwhile what it holds but is not inside (and its right to move in a shared zone
     /// it is in), so that whoever is in its way can move; asks for them again before it
     /// goes on. Or gives up the leg: round the arms in the way, or back.
@@ -280,8 +339,7 @@ impl Driver {
         let mut freed: Vec<Name> = Vec::new();
         let mut waited = Duration::ZERO;
         loop {
-            let others = self.table.joints();
-            let blocking = blockers(&self.name, &self.scara, ahead, &others, MARGIN);
+            let blocking = self.blockers(ahead).await?;
             if blocking.is_empty() {
                 if freed.is_empty() {
                     return Ok(None);
@@ -313,7 +371,7 @@ impl Driver {
                 }
             }
             if waited >= DETOUR_AFTER
-                && let Some(points) = self.round(&blocking, &others, leg_end)
+                && let Some(points) = self.round(&blocking, leg_end).await?
             {
                 lock(&self.stats).detours += 1;
                 return Ok(Some(Leg::Via(points)));
@@ -325,7 +383,7 @@ impl Driver {
             if waited >= BACK_OFF_AFTER
                 && may_back_off
                 && my_turn
-                && let Some(point) = self.back_point(&others)
+                && let Some(point) = self.back_point().await?
             {
                 lock(&self.stats).back_offs += 1;
                 return Ok(Some(Leg::BackOff(point)));
@@ -335,20 +393,24 @@ impl Driver {
         }
     }
 
-    /// An alternative trajectory round the arms in the way, from here to the leg's end,
-    /// whose every point keeps this arm's links clear of every other arm.
-    fn round(
-        &self,
+    /// The coordinator's alternative trajectory round the arms in the way, from here to the
+    /// leg's end, if this arm reaches its every point and the coordinator finds its links
+    /// clear of every other arm all the way.
+    async fn round(
+        &mut self,
         blocking: &[Name],
-        others: &[(Name, [Point2<f32>; 3])],
         leg_end: &Point2<f32>,
-    ) -> Option<Vec<Point2<f32>>> {
+    ) -> Result<Option<Vec<Point2<f32>>>, String> {
         let here = self.arm.at();
-        let end = *leg_end;
-        let path = [[here.x, here.y, 0.0], [end.x, end.y, 0.0]];
-        let radius = imrs_sim::table::LINK_RADIUS;
-        let around = detour(&path, radius, &obstacles(blocking, others), MARGIN, 0.25)?;
-        let points: Vec<Point2<f32>> = around.iter().map(|p| Point2::new(p[0], p[1])).collect();
+        let way = self
+            .link
+            .alternative([here.x, here.y], [leg_end.x, leg_end.y], blocking.to_vec())
+            .await
+            .map_err(|refused| format!("{refused:?}"))?;
+        let Some(way) = way else {
+            return Ok(None);
+        };
+        let points: Vec<Point2<f32>> = way.iter().map(|p| Point2::new(p[0], p[1])).collect();
         // Check the whole way, every spacing, links and all.
         let sampled: Vec<Point2<f32>> = points
             .windows(2)
@@ -357,24 +419,24 @@ impl Driver {
                 (0..=n).map(move |i| pair[0] + (pair[1] - pair[0]) * (i as f32 / n as f32))
             })
             .collect();
-        let reachable = sampled.iter().all(|p| self.scara.reaches(p));
-        (reachable && blockers(&self.name, &self.scara, &sampled, others, MARGIN).is_empty())
-            .then(|| points[1..].to_vec())
+        if !sampled.iter().all(|p| self.scara.reaches(p)) {
+            return Ok(None);
+        }
+        let clear = self.blockers(&sampled).await?.is_empty();
+        Ok(clear.then(|| points[1..].to_vec()))
     }
 
-    /// Where to back off to: home, if the first steps there are clear.
-    fn back_point(&self, others: &[(Name, [Point2<f32>; 3])]) -> Option<Point2<f32>> {
+    /// Where to back off to: home, if the coordinator finds the first steps there clear.
+    async fn back_point(&mut self) -> Result<Option<Point2<f32>>, String> {
         let here = self.arm.at();
-        let home = self.table.layout().arms[self.index].home;
-        let towards = home - here;
+        let towards = self.home - here;
         if towards.norm() < SPACING {
-            return None;
+            return Ok(None);
         }
         let step = towards.normalize() * SPACING;
         let first: Vec<Point2<f32>> = (1..=LOOKAHEAD).map(|i| here + step * i as f32).collect();
-        blockers(&self.name, &self.scara, &first, others, MARGIN)
-            .is_empty()
-            .then_some(home)
+        let clear = self.blockers(&first).await?.is_empty();
+        Ok(clear.then_some(self.home))
     }
 
     /// Gives up a leg part-way: frees what it holds but is not inside.
@@ -387,5 +449,19 @@ impl Driver {
         }
         self.tell(Message::TrajectoryEnd).await?;
         Ok(())
+    }
+}
+
+/// What an arm reports of a request the coordinator refused.
+fn unexpected(resource: &Name, refused: Refused) -> String {
+    match refused {
+        // Every arm takes the tool before any zone and frees the zones it holds before it
+        // waits on another arm, so no cycle of waits can form here; a back-off would mean
+        // the coordinator found one, and is reported as such.
+        Refused::BackOff => format!(
+            "told to back off while asking for {resource}: a deadlock the cell's \
+             order of requests should have made impossible"
+        ),
+        Refused::Failed(why) => why,
     }
 }

@@ -13,10 +13,13 @@
 //! asks the `SCHEDULER` for its next job on `NEXT_JOB`, and the `COORDINATOR` for zones and
 //! the tool on the seed's message set. An arm's trajectory runs through its pipeline: points
 //! computed ahead, a zone requested before the arm reaches it (a *sleep* stops the arm
-//! short of the border, STOP_C), released once the arm has left it. Before every step the
-//! arm also checks its links a few points ahead against where the other arms are: a stopped
-//! arm in the way is waited for, then gone round (the alternative trajectory), and two arms
-//! in each other's way are parted by the later-named one backing off.
+//! short of the border, STOP_C), released once the arm has left it. Every arm tells the
+//! coordinator where its links are after every step (position information), and before
+//! every step asks it to check its links a few points ahead against where the other arms
+//! told it they are: a stopped arm in the way is waited for, then gone round on the
+//! alternative trajectory the coordinator computes, and two arms in each other's way are
+//! parted by the later-named one backing off. No arm reads another's state from the
+//! simulation: an arm module holds its own arm of the table, and nothing else of it.
 //!
 //! Rapier measures the outcome: collisions between arms, the closest they came, zone
 //! conflicts (two grippers in the fixture, two moving in the tray) and grasps of a tool that
@@ -33,7 +36,6 @@
 //! ```
 
 mod arm;
-mod clearance;
 mod layout;
 mod report;
 mod schedule;
@@ -45,17 +47,17 @@ use std::time::Duration;
 use imrs_coord::zones::ZoneKind;
 use imrs_core::prelude::*;
 use imrs_ports::{Instant, SharedClock, VirtualClock};
-use imrs_sim::table::{Table, TableError, ZoneSpec, ZoneUse};
+use imrs_sim::table::{LINK_RADIUS, Table, TableError, ZoneSpec, ZoneUse};
 
 pub use self::layout::{FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell};
 pub use self::report::Report;
 pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
 
-use self::arm::arm_module;
+use self::arm::{MARGIN, arm_module};
 use self::schedule::{job_port, scheduler};
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
 use imrs_coord::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
-use imrs_coord::zones::{Resources, ZoneDef};
+use imrs_coord::zones::{Positions, Resources, ZoneDef};
 
 /// The coordinator module's name.
 pub const COORDINATOR: &str = "COORDINATOR";
@@ -133,6 +135,9 @@ pub struct CellStats {
     pub detours: u32,
     /// Times one of two arms in each other's way backed off.
     pub back_offs: u32,
+    /// Rights to move in a shared zone given up by an arm stopped at the border of
+    /// another zone, and asked for again once that zone was granted.
+    pub rights_given_up: u32,
     /// Arms that stopped working, and why.
     pub failures: Vec<String>,
 }
@@ -197,6 +202,7 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
     start(coordinator(
         COORDINATOR,
         Resources::new(zones.iter().cloned(), [SCREWDRIVER], names.iter().copied()),
+        Positions::new(names.iter().copied(), LINK_RADIUS, MARGIN),
         &coordinator_ports,
         Arc::clone(&coordinator_log),
     ))?;
@@ -206,11 +212,11 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         policy,
         Arc::clone(&completions),
     ))?;
-    for (index, name) in names.iter().enumerate() {
+    for (index, spec) in layout.arms.iter().enumerate() {
         start(arm_module(
-            name,
+            table.arm(spec.name.as_str()).map_err(CellError::Table)?,
+            spec,
             index,
-            &table,
             &coordinator_ports,
             &jobs,
             Arc::clone(&zones),

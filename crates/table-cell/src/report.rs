@@ -107,6 +107,17 @@ impl fmt::Display for Report {
              two in each other's way parted by a back-off {}",
             stats.geometric_blocks, stats.detours, stats.back_offs
         )?;
+        writeln!(
+            f,
+            "  ways ahead checked by the coordinator against the arms' told positions {}, \
+             blocked {}; alternative trajectories computed {} of {} asked",
+            log.checked, log.blocked, log.alternatives.1, log.alternatives.0
+        )?;
+        writeln!(
+            f,
+            "  rights to move in a shared zone given up by an arm stopped at a border  {}",
+            stats.rights_given_up
+        )?;
         for (a, b, at) in measured.collisions.iter().take(5) {
             writeln!(f, "  COLLISION {a} and {b} at {at}")?;
         }

@@ -67,6 +67,11 @@ fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
         assert!(report.stats.back_offs > 0, "{report}");
         // A stopped arm in the way: gone round on the alternative trajectory.
         assert!(report.stats.detours > 0, "{report}");
+        // The coordinator did the geometric work, from the positions the arms told it:
+        // every step's way ahead checked, blocks found, alternatives computed.
+        let log = &report.coordinator;
+        assert!(log.checked > 10_000 && log.blocked > 100, "{report}");
+        assert!(log.alternatives.1 >= report.stats.detours, "{report}");
     }
     let per_hour: Vec<f64> = reports.iter().map(Report::per_hour).collect();
     println!("units per hour over ten seeds: {per_hour:?}");

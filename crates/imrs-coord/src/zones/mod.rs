@@ -9,9 +9,10 @@
 //! tools are always exclusive. The [`Resources`] table answers each request as the seed's
 //! coordinator does — a grant, or *sleep* (stop at the border) — and wakes sleepers when a
 //! resource frees. Exclusive zones and tools can deadlock: [`Resources::deadlock`] finds the
-//! cycle and [`Resources::resolve`] makes one robot back off. A stopped robot in the way of
-//! one that may move is a geometric deadlock: [`detour`] computes the alternative
-//! trajectory round it.
+//! cycle and [`Resources::resolve`] makes one robot back off. Robots say where their links
+//! are ([`Positions`]), and the coordinator checks a robot's way ahead against that alone. A
+//! stopped robot in the way of one that may move is a geometric deadlock: [`detour`]
+//! computes the alternative trajectory round it.
 //!
 //! ```
 //! use imrs_coord::zones::{Answer, Resources, ZoneDef, ZoneKind};
@@ -33,6 +34,7 @@
 mod deadlock;
 mod detour;
 mod pipeline;
+mod positions;
 mod space;
 mod sweep;
 mod table;
@@ -40,5 +42,6 @@ mod table;
 pub use deadlock::Deadlock;
 pub use detour::{Obstacle, detour, first_blocked};
 pub use pipeline::{Command, Next, Pipeline};
+pub use positions::{Pose, Positions};
 pub use sweep::{Reservations, Sweep};
 pub use table::{Answer, Resources, ZoneDef, ZoneError, ZoneKind};

@@ -21,7 +21,8 @@ pub struct Reservations {
     waiting: VecDeque<(Name, Space)>,
 }
 
-fn space(sweep: &Sweep, radius: f32) -> Space {
+/// The space of the links of every pose of `sweep`, each `radius` thick.
+pub(super) fn space(sweep: &[[[f32; 2]; 3]], radius: f32) -> Space {
     let links = sweep
         .iter()
         .flat_map(|&[base, elbow, tool]| [(base, elbow), (elbow, tool)]);

@@ -73,6 +73,9 @@ pub enum ZoneError {
     UnknownRobot(Name),
     /// Zones change only while every robot is stopped: these are moving.
     RobotsMoving(Vec<Name>),
+    /// This robot told a position, or asked about a way, that is no place: a coordinate
+    /// that is not a finite number.
+    NoPlace(Name),
 }
 
 impl fmt::Display for ZoneError {
@@ -80,6 +83,12 @@ impl fmt::Display for ZoneError {
         match self {
             Self::Unknown(name) => write!(f, "no zone or tool {name} was defined before start"),
             Self::UnknownRobot(name) => write!(f, "no robot {name} in the cell"),
+            Self::NoPlace(name) => {
+                write!(
+                    f,
+                    "robot {name} gave a position that is no place (not finite)"
+                )
+            }
             Self::RobotsMoving(robots) => {
                 write!(
                     f,
