@@ -1,5 +1,6 @@
-//! Schemas, assemblages and task-units: the port-automata model of Lyons & Arbib (seed
-//! 004), on the synchronous ports of
+//! Schemas, assemblages and task-units: the port-automata model of Damian Lyons and Michael
+//! Arbib, *A Task-Level Model of Distributed Computation for Sensory-Based Control of
+//! Complex Robot Systems* (1985; seed 004), on the synchronous ports of
 //! [`imrs_ports::synchronous`], with the special
 //! schemas of a simulated dextrous hand.
 //!

@@ -1,11 +1,13 @@
 //! The model's rules, tried from outside: instantiation and numbering, FORALL, STOP,
 //! assemblages and task-units ending as the seed says, connections by name, the mean of
-//! several `Jmotor_i`, visual continuity of SEFs, and reproducible runs.
+//! several `Jmotor_i`, visual continuity of SEFs, virtual fingers of their own however many,
+//! and reproducible runs.
 
 use std::sync::Arc;
 use std::time::Duration;
 
 use imrs_ports::{Clock, VirtualClock};
+use imrs_schema::seed::Vf;
 use imrs_schema::special::{Jmotor, Sef, Vision};
 use imrs_schema::{Behavior, Cx, Declare, Ending, Flow, Kind, Network, Schema, SchemaError, ports};
 use imrs_sim::hand::{Hand, HandConfig, finger_joints};
@@ -161,6 +163,25 @@ async fn numbers_are_local_to_the_assemblage_and_an_explicit_one_is_never_taken_
     let numbers: Vec<u32> = net.forall::<Count>().iter().map(|c| c.number()).collect();
     assert_eq!(numbers, [1, 2, 3], "FORALL");
     assert!(net.forall::<Sink>().is_empty());
+}
+
+#[tokio::test(start_paused = true)]
+async fn every_virtual_finger_has_a_name_of_its_own_and_forall_tells_them_apart() {
+    let names = [
+        Vf::<1>::NAME,
+        Vf::<5>::NAME,
+        Vf::<12>::NAME,
+        Vf::<4_294_967_295>::NAME,
+    ];
+    assert_eq!(names, ["VF_1", "VF_5", "VF_12", "VF_4294967295"]);
+    let (net, _clock) = network();
+    // Physical finger 1 belongs to virtual fingers 5 and 6, finger 2 to 6 alone.
+    net.instantiate_as(1, Vf::<5>).unwrap();
+    net.instantiate_as(1, Vf::<6>).unwrap();
+    net.instantiate_as(2, Vf::<6>).unwrap();
+    let five: Vec<u32> = net.forall::<Vf<5>>().iter().map(|f| f.number()).collect();
+    let six: Vec<u32> = net.forall::<Vf<6>>().iter().map(|f| f.number()).collect();
+    assert_eq!((five, six), (vec![1], vec![1, 2]));
 }
 
 #[tokio::test(start_paused = true)]

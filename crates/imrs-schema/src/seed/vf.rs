@@ -10,14 +10,39 @@ use crate::{Behavior, Cx, Declare, Flow, Kind, Schema, SchemaError, ports};
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Vf<const K: u32>;
 
-impl<const K: u32> Schema for Vf<K> {
-    const NAME: &'static str = match K {
-        1 => "VF_1",
-        2 => "VF_2",
-        3 => "VF_3",
-        4 => "VF_4",
-        _ => "VF",
+/// `VF_` and `K` in decimal, built when the schema is compiled, so that every virtual
+/// finger has a name of its own, however many a hand has.
+struct VfName<const K: u32>;
+
+impl<const K: u32> VfName<K> {
+    /// `VF_`, then up to ten digits (a `u32` has no more).
+    const BYTES: ([u8; 13], usize) = {
+        let mut bytes = [0u8; 13];
+        bytes[0] = b'V';
+        bytes[1] = b'F';
+        bytes[2] = b'_';
+        let mut digits = 1;
+        let mut rest = K / 10;
+        while rest > 0 {
+            digits += 1;
+            rest /= 10;
+        }
+        let (mut at, mut rest) = (3 + digits, K);
+        while at > 3 {
+            at -= 1;
+            bytes[at] = b'0' + (rest % 10) as u8;
+            rest /= 10;
+        }
+        (bytes, 3 + digits)
     };
+    const NAME: &'static str = match std::str::from_utf8(Self::BYTES.0.split_at(Self::BYTES.1).0) {
+        Ok(name) => name,
+        Err(_) => panic!("a virtual finger's name is ASCII"),
+    };
+}
+
+impl<const K: u32> Schema for Vf<K> {
+    const NAME: &'static str = VfName::<K>::NAME;
     type Ports = ();
 
     fn set_up(&mut self, _: &Cx) -> Result<(), SchemaError> {
