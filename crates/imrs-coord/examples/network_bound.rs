@@ -1,12 +1,16 @@
 //! The seed's worst case: ten stations (a coordinator and nine robots) on a 100 m bus, the
 //! coordinator's longest packet a five-point trajectory (148 B), each robot's a position
 //! (51 B). Prints `D_max` with IEEE 802.3's 10 Mb/s parameters, each parameter and its
-//! source, and the difference from the 604 µs the seed reports; then the variants the seed
-//! suggests. Run: `cargo run --release --example network_bound`.
+//! source, and the difference from the 604 µs the seed reports; what each unstated parameter
+//! would have to be, alone, to account for that difference; then the variants the seed
+//! suggests; then the bus simulated slot by slot under the worst arrivals found. Run:
+//! `cargo run --release --example network_bound`.
 
 use std::time::Duration;
 
-use imrs_coord::network::{Bus, SEED_CASE, SEED_D_MAX};
+use imrs_coord::network::{
+    Bus, Offer, SEED_CASE, SEED_D_MAX, simulate, slot_bound, slot_time, worst_missed_slot,
+};
 
 fn us(d: Duration) -> f64 {
     d.as_secs_f64() * 1e6
@@ -45,6 +49,62 @@ fn main() {
         us(d) - us(seed),
         (us(d) - us(seed)) / us(seed) * 100.0
     );
+    // D_max is linear in each parameter: what each would have to be, alone, to make 604.
+    let gap = us(seed) - us(d);
+    let n = SEED_CASE.len() as f64;
+    let bits: f64 = SEED_CASE.iter().map(|&bytes| bytes as f64 * 8.0).sum();
+    println!(
+        "each parameter alone, as it would have to be for {:.0} µs:",
+        us(seed)
+    );
+    println!(
+        "  ε    × 1         : {:.2} µs instead of {:.2}",
+        us(bus.detection) + gap,
+        us(bus.detection)
+    );
+    println!(
+        "  jam  × 1         : {:.2} µs instead of {:.2}",
+        us(bus.jam) + gap,
+        us(bus.jam)
+    );
+    let tau = us(bus.propagation) + gap / (n + 3.0);
+    println!(
+        "  τ    × {:<2}        : {:.3} µs instead of {:.3} (100 m at {:.2} c)",
+        n + 3.0,
+        tau,
+        us(bus.propagation),
+        100.0 / (tau * 1e-6) / 299_792_458.0
+    );
+    println!(
+        "  IFS  × {:<2}        : {:.2} µs instead of {:.2}",
+        n + 1.0,
+        us(bus.ifs) + gap / (n + 1.0),
+        us(bus.ifs)
+    );
+    println!(
+        "  R    ({} bits)  : {:.3} Mb/s instead of {:.1}",
+        bits,
+        bits / (bits / bus.rate * 1e6 + gap),
+        bus.rate / 1e6
+    );
+    println!(
+        "  bytes a packet   : {:.2} more each, where a whole byte adds {:.1} µs",
+        gap / (n * 8.0 / bus.rate * 1e6),
+        n * 8.0 / bus.rate * 1e6
+    );
+    let floor: f64 = SEED_CASE
+        .iter()
+        .map(|&bytes| us(bus.turn(bytes)).max(us(slot_time(&bus))))
+        .sum::<f64>()
+        + us(bus.ifs + bus.gamma() + bus.propagation);
+    println!(
+        "  or every turn at least one slot time ({:.1} µs, so each robot's {:.1} µs turn \
+         counts {:.1}): {:.1} µs",
+        us(slot_time(&bus)),
+        us(bus.turn(SEED_CASE[1])),
+        us(slot_time(&bus)),
+        floor
+    );
     let padded = bus.padded().d_max(&SEED_CASE);
     println!(
         "with 802.3's minimum frame (X_p padded to 72 B): D_max = {:.1} µs ({:+.1} % of 604)",
@@ -65,4 +125,37 @@ fn main() {
          2 × D_max = {:.1} µs",
         us(2 * d)
     );
+
+    println!("simulated slot by slot (each station sending once while another waits):");
+    let everyone: Vec<Offer> = (0..SEED_CASE.len())
+        .map(|station| Offer {
+            at: Duration::ZERO,
+            station,
+        })
+        .collect();
+    let all = simulate(&bus, &SEED_CASE, slot_time(&bus), &everyone).expect("ten stations");
+    let worst = all.worst().expect("ten messages");
+    println!(
+        "  every station at once: the last waits {:.1} µs ({:.1} µs below D_max)",
+        us(worst.delay()),
+        us(d) - us(worst.delay())
+    );
+    let short = bus.jam + 2 * bus.propagation + Duration::from_nanos(1);
+    for (what, slot) in [
+        ("802.3's slot time", slot_time(&bus)),
+        ("a slot of jam + 2τ", short),
+    ] {
+        let worst = worst_missed_slot(&bus, &SEED_CASE, slot)
+            .expect("ten stations")
+            .expect("messages delivered");
+        println!(
+            "  a message that just misses its own empty slot, {what} ({:.1} µs): station {} \
+             waits {:.1} µs; D_max {:.1}, the model's bound {:.1}",
+            us(slot),
+            worst.offer.station,
+            us(worst.delay()),
+            us(d),
+            us(slot_bound(&bus, &SEED_CASE, slot))
+        );
+    }
 }
