@@ -66,6 +66,7 @@
 //! # }
 //! ```
 
+pub mod automaton;
 mod cx;
 mod error;
 mod instance;

@@ -10,13 +10,18 @@
 //! | `RObject`, `Reach` (Figure 4) | [`RObject`], [`Reach`] |
 //! | `Objtest`, `Object?` (Figure 5) | [`Objtest`], [`ObjectQ`] |
 //! | `VF_k`, `N = [T_i - F_i]`, `FORALL VF_k_i DO N(i) ENDFOR` | [`Vf`], [`Closefinger`], [`Grasp`] |
+//! | Grip and its `Closejoint_i` as port automata (§4), and a synchronized variant | [`grip_automata`], [`synchronized_grip_automata`] |
 
 mod grip;
+mod grip_automata;
 mod object;
 mod reach;
 mod vf;
 
 pub use grip::{Closejoint, Grip, TClosejoint, TClosejointPorts};
+pub use grip_automata::{
+    MAX_JOINTS, grip_automata, grip_done_port, grip_parts, synchronized_grip_automata,
+};
 pub use object::{Desired, ObjectQ, ObjectQPorts, Objtest, ObjtestPorts};
 pub use reach::{RObject, RObjectPorts, Reach, ReachPorts};
 pub use vf::{Closefinger, ClosefingerPorts, Grasp, Vf};
