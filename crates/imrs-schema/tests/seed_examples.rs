@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use imrs_ports::{Clock, VirtualClock};
-use imrs_schema::seed::{Desired, Grasp, Grip, ObjectQ, Reach, Vf};
+use imrs_schema::seed::{Desired, Grasp, Grip, ObjectQ, ObjectQOnce, Reach, Vf};
 use imrs_schema::special::Vision;
 use imrs_schema::{Ending, Network, Si};
 use imrs_sim::hand::{FINGERS, Hand, HandConfig, Shape, Touch, finger_joints};
@@ -198,6 +198,70 @@ async fn example_3_object_search_tests_every_sef_in_parallel_and_reaches_the_mat
     );
     assert_eq!(ended(&bench.net, "Object?_1"), Some(Ending::Stopped));
     assert_eq!(ended(&bench.net, "Reach_1"), Some(Ending::Stopped));
+    let error = bench.palm_error(ball, 0.2);
+    assert!(
+        error < 0.004,
+        "the palm is {error} m from its target over the ball"
+    );
+    assert_none_failed(&bench.net);
+}
+
+#[tokio::test(start_paused = true)]
+async fn example_3_second_precondition_the_matching_test_starts_the_task_unit_on_its_sef() {
+    let bench = Bench::new();
+    let ball = bench.index_of(Shape::Ball);
+    let hand = bench.hand.clone();
+    let desired = Desired {
+        shape: Shape::Ball,
+        size: 0.06,
+        tolerance: 0.005,
+    };
+    bench.run_for(0.1).await;
+    bench
+        .net
+        .instantiate(ObjectQOnce::new(desired, move |cx, sef| {
+            cx.instantiate(Reach::new(&hand, sef, 0.2)).map(drop)
+        }))
+        .unwrap();
+    bench.run_for(4.0).await;
+
+    let trace = bench.net.trace();
+    let made: Vec<&str> = trace
+        .iter()
+        .filter(|e| e.ended.is_none())
+        .map(|e| e.instance.as_str())
+        .collect();
+    let tests: Vec<&str> = made
+        .iter()
+        .copied()
+        .filter(|name| name.starts_with("Objtest_"))
+        .collect();
+    // One test per SEF, the ball's among them, and no more: Object? made them and died.
+    assert_eq!(tests.len(), bench.hand.objects().len(), "{made:?}");
+    assert!(tests.contains(&format!("Objtest_{}", bench.sef_of(ball)).as_str()));
+    assert_eq!(ended(&bench.net, "Object?_1"), Some(Ending::Stopped));
+    let object_died = trace
+        .iter()
+        .position(|e| e.instance == "Object?_1" && e.ended.is_some())
+        .unwrap();
+    let first_test_ended = trace
+        .iter()
+        .position(|e| e.instance.as_str().starts_with("Objtest_") && e.ended.is_some())
+        .unwrap();
+    assert!(
+        object_died < first_test_ended,
+        "Object? waited for its tests"
+    );
+    // Each test died after testing; only the match started the task-unit, on its SEF.
+    for test in &tests {
+        assert_eq!(ended(&bench.net, test), Some(Ending::Stopped), "{test}");
+    }
+    let reaches: Vec<&str> = made
+        .iter()
+        .copied()
+        .filter(|name| name.starts_with("Reach_") && !name.contains('/'))
+        .collect();
+    assert_eq!(reaches.len(), 1, "{made:?}");
     let error = bench.palm_error(ball, 0.2);
     assert!(
         error < 0.004,

@@ -9,6 +9,7 @@
 //! | `[Grip () () (Closejoint) (FOR i = 1…n DO Closejoint(i,10) ENDFOR) () ()]` | [`Grip`] |
 //! | `RObject`, `Reach` (Figure 4) | [`RObject`], [`Reach`] |
 //! | `Objtest`, `Object?` (Figure 5) | [`Objtest`], [`ObjectQ`] |
+//! | the second precondition: `Object?` creates the tests and dies, the matching `Objtest` creates the task-unit | [`ObjectQOnce`], [`ObjtestTrigger`] |
 //! | `VF_k`, `N = [T_i - F_i]`, `FORALL VF_k_i DO N(i) ENDFOR` | [`Vf`], [`Closefinger`], [`Grasp`] |
 //! | Grip and its `Closejoint_i` as port automata (§4), and a synchronized variant | [`grip_automata`], [`synchronized_grip_automata`] |
 
@@ -22,6 +23,8 @@ pub use grip::{Closejoint, Grip, TClosejoint, TClosejointPorts};
 pub use grip_automata::{
     MAX_JOINTS, grip_automata, grip_done_port, grip_parts, synchronized_grip_automata,
 };
-pub use object::{Desired, ObjectQ, ObjectQPorts, Objtest, ObjtestPorts};
+pub use object::{
+    Desired, ObjectQ, ObjectQOnce, ObjectQPorts, Objtest, ObjtestPorts, ObjtestTrigger, Starter,
+};
 pub use reach::{RObject, RObjectPorts, Reach, ReachPorts};
 pub use vf::{Closefinger, ClosefingerPorts, Grasp, Vf};

@@ -1,5 +1,7 @@
 //! Example III: a parallel search over every SEF, triggering a task-unit on the match.
 
+use std::sync::Arc;
+
 use imrs_sim::hand::Shape;
 use nalgebra::{Point3, UnitQuaternion};
 
@@ -141,6 +143,110 @@ impl Schema for ObjectQ {
         }
         cx.forall::<Objtest>().iter().for_each(|test| test.stop());
         (self.trigger)(cx, matched)?;
+        Ok(Flow::Stop)
+    }
+}
+
+/// What an [`ObjtestTrigger`] does on a match: instantiates the task-unit `T` for the SEF
+/// numbered, in the test's own context.
+pub type Starter = Arc<dyn Fn(&Cx, u32) -> Result<(), SchemaError> + Send + Sync>;
+
+/// The second precondition's `Objtest` (Lyons & Arbib 1985, §5, after Figure 5): tests
+/// the SEF it is connected to once; if it fails the test it dies, otherwise it creates the
+/// task-unit, connected to that SEF (the starter is given the SEF's number), and dies.
+#[derive(Clone)]
+pub struct ObjtestTrigger {
+    /// The object looked for.
+    pub desired: Desired,
+    start: Starter,
+}
+
+impl std::fmt::Debug for ObjtestTrigger {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ObjtestTrigger")
+            .field("desired", &self.desired)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Schema for ObjtestTrigger {
+    const NAME: &'static str = "Objtest";
+    type Ports = ObjtestPorts;
+
+    fn set_up(&mut self, cx: &Cx) -> Result<ObjtestPorts, SchemaError> {
+        Ok(Declare::declare(cx.me()))
+    }
+
+    async fn behavior(&mut self, p: &ObjtestPorts, cx: &Cx) -> Behavior {
+        let (_, _) = (p.f1.read().await?, p.f2.read().await?);
+        let (shape, size) = (p.f3.read().await?, p.f4.read().await?);
+        let d = self.desired;
+        if shape == d.shape && (size - d.size).abs() <= d.tolerance {
+            (self.start)(cx, cx.number())?;
+        }
+        Ok(Flow::Stop)
+    }
+}
+
+/// The second precondition (Lyons & Arbib 1985, §5, after Figure 5): waits until some
+/// SEF exists, then creates one [`ObjtestTrigger`] for each SEF, connected to it, and
+/// dies. The test that matches starts the task-unit, connected to the SEF that triggered
+/// it; the others die.
+#[derive(Clone)]
+pub struct ObjectQOnce {
+    desired: Desired,
+    start: Starter,
+}
+
+impl std::fmt::Debug for ObjectQOnce {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ObjectQOnce")
+            .field("desired", &self.desired)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ObjectQOnce {
+    /// Looks for `desired`; `start` instantiates the task-unit for the SEF numbered.
+    pub fn new(
+        desired: Desired,
+        start: impl Fn(&Cx, u32) -> Result<(), SchemaError> + Send + Sync + 'static,
+    ) -> Self {
+        Self {
+            desired,
+            start: Arc::new(start),
+        }
+    }
+}
+
+impl Schema for ObjectQOnce {
+    const NAME: &'static str = "Object?";
+    type Ports = ();
+
+    fn set_up(&mut self, _: &Cx) -> Result<(), SchemaError> {
+        Ok(())
+    }
+
+    async fn behavior(&mut self, _: &(), cx: &Cx) -> Behavior {
+        let sefs = cx.forall::<Sef>();
+        if sefs.is_empty() {
+            cx.delay(Vision::FRAME).await;
+            return Ok(Flow::Continue);
+        }
+        for sef in &sefs {
+            let test = cx.instantiate_as(
+                sef.number(),
+                ObjtestTrigger {
+                    desired: self.desired,
+                    start: Arc::clone(&self.start),
+                },
+            )?;
+            let (from, to) = (sef.ports(), test.ports());
+            cx.connect(&from.f1, &to.f1);
+            cx.connect(&from.f2, &to.f2);
+            cx.connect(&from.f3, &to.f3);
+            cx.connect(&from.f4, &to.f4);
+        }
         Ok(Flow::Stop)
     }
 }
