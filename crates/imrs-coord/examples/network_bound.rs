@@ -9,7 +9,7 @@
 use std::time::Duration;
 
 use imrs_coord::network::{
-    Bus, Offer, SEED_CASE, SEED_D_MAX, simulate, slot_bound, slot_time, worst_missed_slot,
+    Bus, Offer, SEED_CASE, SEED_D_MAX, simulate, slot_bound, worst_missed_slot,
 };
 
 fn us(d: Duration) -> f64 {
@@ -94,15 +94,15 @@ fn main() {
     );
     let floor: f64 = SEED_CASE
         .iter()
-        .map(|&bytes| us(bus.turn(bytes)).max(us(slot_time(&bus))))
+        .map(|&bytes| us(bus.turn(bytes)).max(us(bus.slot)))
         .sum::<f64>()
         + us(bus.ifs + bus.gamma() + bus.propagation);
     println!(
         "  or every turn at least one slot time ({:.1} µs, so each robot's {:.1} µs turn \
          counts {:.1}): {:.1} µs",
-        us(slot_time(&bus)),
+        us(bus.slot),
         us(bus.turn(SEED_CASE[1])),
-        us(slot_time(&bus)),
+        us(bus.slot),
         floor
     );
     let padded = bus.padded().d_max(&SEED_CASE);
@@ -133,7 +133,7 @@ fn main() {
             station,
         })
         .collect();
-    let all = simulate(&bus, &SEED_CASE, slot_time(&bus), &everyone).expect("ten stations");
+    let all = simulate(&bus, &SEED_CASE, bus.slot, &everyone).expect("ten stations");
     let worst = all.worst().expect("ten messages");
     println!(
         "  every station at once: the last waits {:.1} µs ({:.1} µs below D_max)",
@@ -142,7 +142,7 @@ fn main() {
     );
     let short = bus.jam + 2 * bus.propagation + Duration::from_nanos(1);
     for (what, slot) in [
-        ("802.3's slot time", slot_time(&bus)),
+        ("802.3's slot time", bus.slot),
         ("a slot of jam + 2τ", short),
     ] {
         let worst = worst_missed_slot(&bus, &SEED_CASE, slot)

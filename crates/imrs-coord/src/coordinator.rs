@@ -119,6 +119,16 @@ impl CoordinatorPorts {
         }
     }
 
+    /// Declares every port to `cell`, so that the cell checks their wiring and lists them
+    /// ([`Cell::ports`]).
+    pub fn declare_to(&self, cell: &Cell) -> Result<(), imrs_ports::WireError> {
+        cell.declare(&self.to_coordinator)?;
+        cell.declare(&self.space)?;
+        cell.declare(&self.alarm)?;
+        cell.declare(&self.emergency)?;
+        self.wake.values().try_for_each(|port| cell.declare(port))
+    }
+
     /// Robot `robot`'s ends of the ports.
     pub fn link(&self, robot: &str) -> Result<RobotLink, imrs_ports::WireError> {
         let wake = self.wake.get(&Name::from(robot)).ok_or_else(|| {

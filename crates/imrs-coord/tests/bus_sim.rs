@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use imrs_coord::network::{self, Bus, Offer, SEED_CASE, simulate, slot_bound, slot_time};
+use imrs_coord::network::{self, Bus, Offer, SEED_CASE, simulate, slot_bound};
 use proptest::prelude::*;
 
 fn micros(d: Duration) -> f64 {
@@ -35,7 +35,7 @@ fn every_station_at_once_is_within_the_seeds_d_max() {
             station,
         })
         .collect();
-    let out = simulate(&bus, &SEED_CASE, slot_time(&bus), &offers).unwrap();
+    let out = simulate(&bus, &SEED_CASE, bus.slot, &offers).unwrap();
     let worst = out.worst().unwrap().delay();
     let d_max = bus.d_max(&SEED_CASE);
     // The last station waits the collision and every turn but its own trailing IFS: the
@@ -56,7 +56,7 @@ fn a_message_that_misses_its_own_slot_is_within_the_slot_bound_not_the_formula()
     let bus = Bus::ieee_802_3(100.0);
     let d_max = bus.d_max(&SEED_CASE);
 
-    let standard = slot_time(&bus);
+    let standard = bus.slot;
     let worst = worst_missed_slot(&bus, standard);
     let bound = slot_bound(&bus, &SEED_CASE, standard);
     println!(
@@ -121,7 +121,7 @@ fn bursts() -> impl Strategy<Value = Vec<Offer>> {
 #[test]
 fn a_station_that_sends_twice_while_another_waits_delays_it_beyond_the_bound() {
     let bus = Bus::ieee_802_3(100.0);
-    let slot = slot_time(&bus);
+    let slot = bus.slot;
     let offers = [
         Offer {
             at: Duration::ZERO,
@@ -159,7 +159,7 @@ proptest! {
     #[test]
     fn random_bursts_stay_within_the_slot_bound(offers in bursts(), short in any::<bool>()) {
         let bus = Bus::ieee_802_3(100.0);
-        let slot = if short { short_slot(&bus) } else { slot_time(&bus) };
+        let slot = if short { short_slot(&bus) } else { bus.slot };
         let out = simulate(&bus, &SEED_CASE, slot, &offers).unwrap();
         prop_assert_eq!(out.deliveries.len(), offers.len());
         let bound = slot_bound(&bus, &SEED_CASE, slot);

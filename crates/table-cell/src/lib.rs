@@ -56,6 +56,7 @@ pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
 use self::arm::{MARGIN, arm_module};
 use self::schedule::{job_port, scheduler};
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
+use imrs_coord::network::{Bus, Placement, report};
 use imrs_coord::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
 use imrs_coord::zones::{Positions, Resources, ZoneDef};
 
@@ -193,6 +194,10 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         ..CellStats::default()
     }));
 
+    let declared = coordinator_ports
+        .declare_to(&cell)
+        .and_then(|()| cell.declare(&jobs));
+    declared.map_err(|error| CellError::Start(error.to_string()))?;
     table.spawn();
     let start = |spec: ModuleSpec<()>| {
         cell.start(spec)
@@ -224,6 +229,15 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         ))?;
     }
 
+    // The cell on the paper's bus: the coordinator and the scheduler on one station, each
+    // arm on a station of its own. Each port that crosses stations gets its worst case.
+    let placement = names.iter().enumerate().fold(
+        Placement::new().place(COORDINATOR, 0).place(SCHEDULER, 0),
+        |placement, (index, name)| placement.place(*name, index as u32 + 1),
+    );
+    let network = report(&cell.ports(), &placement, &Bus::ieee_802_3(100.0))
+        .map_err(|error| CellError::Start(error.to_string()))?;
+
     let end = Instant::from_start(Duration::from_secs_f64(config.hours * 3600.0));
     imrs_core::time::drive(&clock, end).await;
 
@@ -235,6 +249,7 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         measured: table.measured(),
         coordinator: lock(&coordinator_log).clone(),
         stats: lock(&stats).clone(),
+        network,
         wall: Duration::ZERO,
     })
 }

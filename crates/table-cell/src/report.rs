@@ -8,6 +8,7 @@ use imrs_sim::table::Measured;
 
 use super::{CellConfig, CellStats};
 use imrs_coord::coordinator::CoordinatorLog;
+use imrs_coord::network::PortBound;
 
 /// A run's report.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,6 +25,10 @@ pub struct Report {
     pub coordinator: CoordinatorLog,
     /// What the arms did.
     pub stats: CellStats,
+    /// Each port's worst case on the paper's bus (802.3, 100 m), the coordinator and the
+    /// scheduler on one station and each arm on its own: a port whose `TIMEOUT` is below
+    /// its worst round trip is a wiring warning.
+    pub network: Vec<PortBound>,
     /// How long the run took on the wall clock.
     pub wall: Duration,
 }
@@ -118,6 +123,22 @@ impl fmt::Display for Report {
             "  rights to move in a shared zone given up by an arm stopped at a border  {}",
             stats.rights_given_up
         )?;
+        let crossing: Vec<&PortBound> = self
+            .network
+            .iter()
+            .filter(|bound| bound.stations.len() > 1)
+            .collect();
+        if let Some(worst) = crossing.iter().map(|bound| bound.round_trip).max() {
+            writeln!(
+                f,
+                "on the cell bus  {} ports cross stations, worst round trip {:.1} µs",
+                crossing.len(),
+                worst.as_secs_f64() * 1e6
+            )?;
+        }
+        for bound in crossing.iter().filter(|bound| bound.timeout_too_short()) {
+            writeln!(f, "  WIRING {bound}")?;
+        }
         for (a, b, at) in measured.collisions.iter().take(5) {
             writeln!(f, "  COLLISION {a} and {b} at {at}")?;
         }

@@ -26,6 +26,8 @@ pub struct Bus {
     /// The shortest frame the bus carries, in bytes with the preamble; shorter packets are
     /// padded to it. `None`: packets go as they are (as the seed counts them).
     pub min_frame: Option<usize>,
+    /// How long a slot of a resolution period lasts when its station does not send.
+    pub slot: Duration,
 }
 
 impl Bus {
@@ -39,6 +41,7 @@ impl Bus {
     /// | `jam` | 32 bits = 3.2 µs | 802.3 `jamSize` |
     /// | `τ` | `length` / (0.77 c): 0.433 µs per 100 m | 802.3 10BASE5 coax, minimum propagation velocity 0.77 c |
     /// | `ε` | 0.9 µs | the 10BASE5 MAU's budget for signalling a collision (900 ns); the i82596's own figure is not at hand |
+    /// | slot | 512 bit times = 51.2 µs | 802.3 `slotTime`, the value the seed calls standard |
     ///
     /// No minimum frame: the seed counts a 51-byte position packet as 51 bytes, where
     /// 802.3 would pad it to 72 (64 plus the 8-byte preamble). [`Bus::padded`] pads.
@@ -51,6 +54,7 @@ impl Bus {
             propagation: Duration::from_secs_f64(length / (0.77 * C)),
             detection: Duration::from_nanos(900),
             min_frame: None,
+            slot: Duration::from_nanos(51_200),
         }
     }
 
@@ -77,6 +81,15 @@ impl Bus {
     /// One station's turn: `X/R + τ + IFS`.
     pub fn turn(&self, bytes: usize) -> Duration {
         self.transmission(bytes) + self.propagation + self.ifs
+    }
+
+    /// The longest a message waits for the bus under the simulated model
+    /// ([`simulate`](super::simulate)), for stations whose longest packets are `longest`:
+    /// [`slot_bound`](super::slot_bound) with this bus's slot. It is [`Bus::d_max`] or more;
+    /// more where an empty slot is longer than `IFS` or than a station's turn, as 802.3's
+    /// is.
+    pub fn worst_wait(&self, longest: &[usize]) -> Duration {
+        super::slot_bound(self, longest, self.slot).max(self.d_max(longest))
     }
 
     /// `D_max` for stations whose longest packets are `longest` (bytes, one per station):

@@ -31,6 +31,5 @@ pub use bus::{Bus, SEED_CASE, SEED_D_MAX};
 pub use queue::TransmitQueue;
 pub use report::{Placement, PlacementError, PortBound, report};
 pub use sim::{
-    Delivery, NoStation, Offer, Simulated, missed_slot, simulate, slot_bound, slot_time,
-    worst_missed_slot,
+    Delivery, NoStation, Offer, Simulated, missed_slot, simulate, slot_bound, worst_missed_slot,
 };

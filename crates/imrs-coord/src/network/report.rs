@@ -146,14 +146,14 @@ pub fn report(
         }
         spans.push((port, stations));
     }
-    let d_max = bus.d_max(&longest.values().copied().collect::<Vec<_>>());
+    let wait = bus.worst_wait(&longest.values().copied().collect::<Vec<_>>());
     Ok(spans
         .into_iter()
         .map(|(port, stations)| {
             // Behind at most the packet already in its station's FIFO, then its own turn:
             // `TransmitQueue::worst_wait` with nothing else queued.
             let one_way = if stations.len() > 1 {
-                2 * d_max
+                2 * wait
             } else {
                 Duration::ZERO
             };

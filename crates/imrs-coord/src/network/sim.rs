@@ -287,11 +287,6 @@ pub fn worst_missed_slot(
     Ok(worst)
 }
 
-/// 802.3's slot time, 512 bit times: 51.2 µs at 10 Mb/s.
-pub fn slot_time(bus: &Bus) -> Duration {
-    Duration::from_secs_f64(512.0 / bus.rate)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,7 +303,7 @@ mod tests {
             at: Duration::from_micros(5),
             station: 3,
         };
-        let out = simulate(&bus, &SEED_CASE, slot_time(&bus), &[offer]).unwrap();
+        let out = simulate(&bus, &SEED_CASE, bus.slot, &[offer]).unwrap();
         assert_eq!(out.collisions, 0);
         let delay = out.deliveries[0].delay();
         assert_eq!(delay, bus.transmission(51) + bus.propagation);
@@ -323,7 +318,7 @@ mod tests {
                 station,
             })
             .collect();
-        let out = simulate(&bus, &SEED_CASE, slot_time(&bus), &offers).unwrap();
+        let out = simulate(&bus, &SEED_CASE, bus.slot, &offers).unwrap();
         assert_eq!(out.collisions, 1);
         let order: Vec<usize> = out.deliveries.iter().map(|d| d.offer.station).collect();
         assert_eq!(order, (0..10).collect::<Vec<_>>());
@@ -341,7 +336,7 @@ mod tests {
             at: Duration::ZERO,
             station: 7,
         };
-        let refused = simulate(&bus, &[51, 51], slot_time(&bus), &[offer]).unwrap_err();
+        let refused = simulate(&bus, &[51, 51], bus.slot, &[offer]).unwrap_err();
         assert_eq!(refused, NoStation { offer, stations: 2 });
         assert!(
             refused
