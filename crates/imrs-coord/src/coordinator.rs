@@ -26,6 +26,10 @@ use crate::zones::{Answer, Pose, Positions, Resources, Sweep, ZoneError};
 pub enum Message {
     /// Request to move in a zone (or to take a tool).
     Request(Name),
+    /// Request to move in a zone (or to take a tool) from inside these shared zones, in
+    /// which it moves: if it must sleep at the border, it stops and gives up its right to
+    /// move in each, as a position message would say, in the same message.
+    RequestGivingUp(Name, Vec<Name>),
     /// Stopped inside this zone, away from the trajectory's end point.
     Position(Name),
     /// Left this zone (or put this tool down).
@@ -192,17 +196,20 @@ impl RobotLink {
         zone: &str,
         moving_in: &[Name],
     ) -> Result<Vec<Name>, Refused> {
-        let mut given_up = Vec::new();
+        let mut given_up: Vec<Name> = Vec::new();
         loop {
-            match self.tell(Message::Request(zone.into())).await? {
+            // One message: the coordinator never waits on a robot that is still telling it
+            // something (its wake-ups are rendezvous).
+            let giving_up: Vec<Name> = moving_in
+                .iter()
+                .filter(|shared| !given_up.contains(shared))
+                .cloned()
+                .collect();
+            let request = Message::RequestGivingUp(zone.into(), giving_up.clone());
+            match self.tell(request).await? {
                 Answer::Grant => return Ok(given_up),
                 Answer::Sleep => {
-                    for shared in moving_in {
-                        if !given_up.contains(shared) {
-                            self.tell(Message::Position(shared.clone())).await?;
-                            given_up.push(shared.clone());
-                        }
-                    }
+                    given_up.extend(giving_up);
                     let (wake, reply) = self
                         .wake
                         .receive()
@@ -236,7 +243,8 @@ impl RobotLink {
     pub async fn check(&mut self, sweep: Sweep) -> Result<Vec<Name>, Refused> {
         match self.ask(Geometry::Check(sweep)).await? {
             Seen::Blocked(robots) => Ok(robots),
-            _ => Ok(Vec::new()),
+            Seen::Clear => Ok(Vec::new()),
+            other => Err(Refused::Failed(format!("a check answered {other:?}"))),
         }
     }
 
@@ -250,7 +258,9 @@ impl RobotLink {
     ) -> Result<Option<Vec<[f32; 2]>>, Refused> {
         match self.ask(Geometry::Alternative { from, to, around }).await? {
             Seen::Alternative(way) => Ok(way),
-            _ => Ok(None),
+            other => Err(Refused::Failed(format!(
+                "an alternative answered {other:?}"
+            ))),
         }
     }
 
@@ -435,6 +445,15 @@ fn see(
     })
 }
 
+/// The table's answer to a request for `zone` (or a tool).
+fn request(table: &mut Resources, robot: &str, zone: &Name) -> Result<Answer, ZoneError> {
+    if table.is_tool(zone.as_str()) {
+        table.request_tool(robot, zone.as_str())
+    } else {
+        table.request_move(robot, zone.as_str())
+    }
+}
+
 /// The table's answer to one message, and who it wakes.
 fn answer(
     table: &mut Resources,
@@ -443,13 +462,16 @@ fn answer(
 ) -> Result<(Answer, Vec<Name>), ZoneError> {
     let robot = robot.as_str();
     Ok(match message {
-        Message::Request(zone) => {
-            let answer = if table.is_tool(zone.as_str()) {
-                table.request_tool(robot, zone.as_str())?
-            } else {
-                table.request_move(robot, zone.as_str())?
-            };
-            (answer, Vec::new())
+        Message::Request(zone) => (request(table, robot, zone)?, Vec::new()),
+        Message::RequestGivingUp(zone, moving_in) => {
+            let answer = request(table, robot, zone)?;
+            let mut woken = Vec::new();
+            if answer == Answer::Sleep {
+                for shared in moving_in {
+                    woken.extend(table.stopped_inside(robot, shared.as_str())?);
+                }
+            }
+            (answer, woken)
         }
         Message::Position(zone) => (Answer::Grant, table.stopped_inside(robot, zone.as_str())?),
         Message::Release(zone) => {

@@ -398,3 +398,52 @@ async fn a_robot_asleep_at_a_border_gives_up_moving_in_its_shared_zone() {
         "B moved in PASSAGE at {granted} s, beside A"
     );
 }
+
+/// The robot that closes a cycle, and is chosen to back off, is one that gives up its
+/// right to move in a shared zone as it sleeps: the coordinator must not wait on it.
+#[tokio::test(start_paused = true)]
+async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off() {
+    let (cell, clock, ports, log) = start();
+    let a = {
+        let ports = ports.clone();
+        ModuleSpec::new("ROBOT_A", ()).task("ROBOT_A", move |ctx| {
+            let ports = ports.clone();
+            async move {
+                let mut link = ports.link("ROBOT_A")?;
+                link.acquire("FIXTURE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(1)).await;
+                // Sleeps: ROBOT_B has TRAY; granted once B backs off.
+                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let outcome = Arc::new(Mutex::new(None));
+    let b = {
+        let outcome = Arc::clone(&outcome);
+        ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
+            let (ports, outcome) = (ports.clone(), Arc::clone(&outcome));
+            async move {
+                let mut link = ports.link("ROBOT_B")?;
+                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
+                link.acquire("PASSAGE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(2)).await;
+                // FIXTURE is A's, A waits for TRAY: B closes the cycle, and is its victim.
+                let asked = link.acquire_giving_up("FIXTURE", &["PASSAGE".into()]).await;
+                *outcome.lock().unwrap() = Some(asked);
+                Ok(())
+            }
+        })
+    };
+    let mut robots = [cell.start(a).unwrap(), cell.start(b).unwrap()];
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
+    for robot in &mut robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+    assert_eq!(*outcome.lock().unwrap(), Some(Err(Refused::BackOff)));
+    assert_eq!(log.lock().unwrap().deadlocks, ["ROBOT_B"]);
+}

@@ -242,3 +242,25 @@ async fn the_synchronized_schemas_hang_where_the_composition_deadlocks() {
         "{visited:?}"
     );
 }
+
+#[test]
+fn a_run_that_goes_round_for_ever_is_reported_not_ended() {
+    // A and B pass a value back and forth without end, reading nothing from outside.
+    let a = PortAutomaton::new("A", "send")
+        .write("send", "X", 1, "hear")
+        .read("hear", "Y", |_| "send");
+    let b = PortAutomaton::new("B", "hear")
+        .read("hear", "X", |_| "send")
+        .write("send", "Y", 2, "hear");
+    let network = Composition::new([a, b])
+        .unwrap()
+        .connect(("A", "X"), ("B", "X"))
+        .unwrap()
+        .connect(("B", "Y"), ("A", "Y"))
+        .unwrap();
+    let run = network.run(&[]).unwrap();
+    assert!(!run.ended);
+    assert_eq!(run.visited["A"], ["send", "hear", "send"]);
+    let found = network.explore().unwrap();
+    assert!(found.deadlock.is_none() && !found.always_ends);
+}

@@ -221,11 +221,23 @@ impl Driver {
             .await
             .map_err(|refused| unexpected(resource, refused))?;
         lock(&self.stats).rights_given_up += given_up.len() as u32;
-        for shared in given_up {
-            self.link
-                .acquire(shared.as_str())
+        self.reacquire_shared(given_up).await
+    }
+
+    /// Asks again for the rights to move in the shared zones `shared`, one after the
+    /// other; stopped at a border meanwhile, it gives up again those it has had back.
+    async fn reacquire_shared(&mut self, shared: Vec<Name>) -> Result<(), String> {
+        let mut held: Vec<Name> = Vec::new();
+        let mut pending: std::collections::VecDeque<Name> = shared.into();
+        while let Some(zone) = pending.pop_front() {
+            let given_up = self
+                .link
+                .acquire_giving_up(zone.as_str(), &held)
                 .await
-                .map_err(|refused| unexpected(&shared, refused))?;
+                .map_err(|refused| unexpected(&zone, refused))?;
+            held.retain(|h| !given_up.contains(h));
+            pending.extend(given_up);
+            held.push(zone);
         }
         Ok(())
     }
@@ -344,9 +356,16 @@ impl Driver {
                 if freed.is_empty() {
                     return Ok(None);
                 }
-                for zone in std::mem::take(&mut freed) {
+                // The exclusive zones and the tool first, while it moves in no shared zone;
+                // then the shared ones, so that it never sleeps at a border holding a
+                // right to move.
+                let (shared, exclusive): (Vec<Name>, Vec<Name>) = std::mem::take(&mut freed)
+                    .into_iter()
+                    .partition(|zone| self.is_shared(zone));
+                for zone in exclusive {
                     self.acquire(&zone).await?;
                 }
+                self.reacquire_shared(shared).await?;
                 // The others may have moved while this arm waited for its zones.
                 continue;
             }

@@ -68,10 +68,9 @@ fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
         // A stopped arm in the way: gone round on the alternative trajectory.
         assert!(report.stats.detours > 0, "{report}");
         // The coordinator did the geometric work, from the positions the arms told it:
-        // every step's way ahead checked, blocks found, alternatives computed.
+        // every step's way ahead checked, and blocks found.
         let log = &report.coordinator;
         assert!(log.checked > 10_000 && log.blocked > 100, "{report}");
-        assert!(log.alternatives.1 >= report.stats.detours, "{report}");
         // The cell on the paper's bus: every port between the coordinator, the scheduler
         // and the arms crosses stations and has its worst case; none times out sooner.
         let crossing = report.network.iter().filter(|b| b.stations.len() > 1);

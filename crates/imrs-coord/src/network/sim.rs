@@ -1,5 +1,5 @@
-//! The CSMA/DCR bus simulated slot by slot, to measure the delays that [`Bus::d_max`]
-//! bounds.
+//! The CSMA/DCR bus simulated slot by slot, to measure the delays that [`Bus::d_max`] is
+//! meant to bound, and to find where it does not.
 //!
 //! The model is the seed's ("Communications", Figure 5), with 802.3's timing:
 //!
@@ -8,16 +8,18 @@
 //!   has not yet heard it, and transmits too.
 //! - One transmitter: its packet is on the wire for `X/R`, and has reached every station `τ`
 //!   later; the bus is idle from then.
-//! - Two or more: a collision. All stations sense the bus idle `γ + τ` after it began.
+//! - Two or more: a collision. All stations sense the bus idle `γ + τ` after it began, and
+//!   wait `IFS` more.
 //! - Then a resolution period: one slot per station, in the stations' order. A station
 //!   with a message ready at the start of its slot transmits its oldest, and the slot lasts
-//!   its turn, `X/R + τ + IFS`; an empty slot lasts the slot time. After the last slot the
-//!   bus is idle, and the stations contend again.
+//!   its turn, `X/R + τ + IFS`; an empty slot lasts the bus's slot time. After the last slot
+//!   the bus is idle, and the stations contend again.
 //!
 //! A message's delay runs from the moment it is its station's next to send (offered, and
 //! every earlier message of its station sent) to the moment its packet has reached every
-//! station: the wait [`Bus::d_max`] bounds. Messages that queue behind their station's
-//! earlier ones wait in its transmit queue as well ([`TransmitQueue`](super::TransmitQueue)).
+//! station: the wait [`Bus::d_max`] is meant to bound. Messages that queue behind their
+//! station's earlier ones wait in its transmit queue as well
+//! ([`TransmitQueue`](super::TransmitQueue)). Times saturate at `Duration::MAX`.
 
 use std::collections::VecDeque;
 use std::time::Duration;
@@ -147,7 +149,7 @@ pub fn simulate(
             (None, None) => break,
         };
         // Everyone ready before they could hear it transmits too.
-        let deaf = start + bus.propagation;
+        let deaf = start.saturating_add(bus.propagation);
         arrive(&mut incoming, deaf, &mut pending);
         let contenders: Vec<usize> = (0..packets.len())
             .filter(|&station| pending[station].front().is_some_and(|&at| at <= deaf))
@@ -156,26 +158,33 @@ pub fn simulate(
             let at = pending[station]
                 .pop_front()
                 .expect("a contender has a message");
-            let delivered = start + bus.transmission(packets[station]) + bus.propagation;
+            let delivered = start
+                .saturating_add(bus.transmission(packets[station]))
+                .saturating_add(bus.propagation);
             deliver(&mut out, at, station, delivered);
-            free = delivered + bus.ifs;
+            free = delivered.saturating_add(bus.ifs);
             continue;
         }
         // A collision, then one slot per station in order.
         out.collisions += 1;
-        let mut slot_start = start + bus.gamma() + bus.propagation;
+        let mut slot_start = start
+            .saturating_add(bus.gamma())
+            .saturating_add(bus.propagation)
+            .saturating_add(bus.ifs);
         for (station, &bytes) in packets.iter().enumerate() {
             arrive(&mut incoming, slot_start, &mut pending);
             match pending[station].front().copied() {
                 Some(at) if at <= slot_start => {
                     pending[station].pop_front();
-                    let delivered = slot_start + bus.transmission(bytes) + bus.propagation;
+                    let delivered = slot_start
+                        .saturating_add(bus.transmission(bytes))
+                        .saturating_add(bus.propagation);
                     deliver(&mut out, at, station, delivered);
-                    slot_start = delivered + bus.ifs;
+                    slot_start = delivered.saturating_add(bus.ifs);
                 }
                 _ => {
                     out.empty_slots += 1;
-                    slot_start += slot;
+                    slot_start = slot_start.saturating_add(slot);
                 }
             }
         }
@@ -186,19 +195,19 @@ pub fn simulate(
 
 /// A bound on every message's delay under this model, where [`Bus::d_max`] is not one.
 ///
-/// The seed's formula counts one turn per station, its own included, and one `IFS` before
-/// the collision. But a message that becomes its station's next just after the station's
-/// own slot began, empty, waits that slot out (up to `slot`), then every other station's
-/// slot, whichever period it falls in, then the collision, then its own packet. Each other
-/// station's share is the longer of its turn and an empty slot. So, for the worst station
-/// `k`:
+/// The seed's formula counts one turn per station, its own included, and one `IFS` (here,
+/// after the collision). But a message that becomes its station's next just after the
+/// station's own slot began, empty, waits that slot out (up to `slot`), where the formula's
+/// own turn leaves room for an `IFS` only; then every other station's slot, whichever period
+/// it falls in; then the collision and its `IFS`; then its own packet. Each other station's
+/// share is the longer of its turn and an empty slot. So, for the worst station `k`:
 ///
 /// ```text
-/// B = max_k [ max(slot, IFS) + Σ_{j≠k} max(turn_j, slot) + γ + τ + X_k/R + τ ]
+/// B = max_k [ max(slot, IFS) + Σ_{j≠k} max(turn_j, slot) + γ + τ + IFS + X_k/R + τ ]
 /// ```
 ///
 /// Where an empty slot is no longer than `IFS` and no turn is shorter than a slot, this is
-/// at most [`Bus::d_max`]; with 802.3's 51.2 µs slot time it is not.
+/// [`Bus::d_max`]; with 802.3's 51.2 µs slot time it is more.
 ///
 /// Like the seed's formula, it holds for traffic in which no station sends more than one
 /// message while another message waits (the seed's robots send one position per sampling
@@ -214,6 +223,7 @@ pub fn slot_bound(bus: &Bus, packets: &[usize], slot: Duration) -> Duration {
                 + (all - share(bytes))
                 + bus.gamma()
                 + bus.propagation
+                + bus.ifs
                 + bus.transmission(bytes)
                 + bus.propagation
         })
@@ -238,7 +248,7 @@ pub fn missed_slot(
             slot
         }
     };
-    let slot_start = bus.gamma() + bus.propagation + (0..k).map(share).sum::<Duration>();
+    let slot_start = bus.gamma() + bus.propagation + bus.ifs + (0..k).map(share).sum::<Duration>();
     let mut offers = vec![Offer {
         at: slot_start + Duration::from_nanos(1),
         station: k,
@@ -251,14 +261,27 @@ pub fn missed_slot(
     offers
 }
 
+/// The most stations [`worst_missed_slot`] searches: it runs 2^N patterns a station.
+pub const MAX_SEARCHED: usize = 16;
+
 /// The longest wait [`missed_slot`] gives, over every station and every set of two or more
-/// others (2^N patterns a station: meant for the seed's ten), with the pattern's delivery.
+/// others, with the pattern's delivery. A bus of more than [`MAX_SEARCHED`] stations is
+/// refused, naming its last station, which is past the search.
 pub fn worst_missed_slot(
     bus: &Bus,
     packets: &[usize],
     slot: Duration,
 ) -> Result<Option<Delivery>, NoStation> {
     let n = packets.len();
+    if n > MAX_SEARCHED {
+        return Err(NoStation {
+            offer: Offer {
+                at: Duration::ZERO,
+                station: n - 1,
+            },
+            stations: MAX_SEARCHED,
+        });
+    }
     let mut worst: Option<Delivery> = None;
     for k in 0..n {
         for mask in 0u64..(1 << n) {
@@ -322,9 +345,9 @@ mod tests {
         assert_eq!(out.collisions, 1);
         let order: Vec<usize> = out.deliveries.iter().map(|d| d.offer.station).collect();
         assert_eq!(order, (0..10).collect::<Vec<_>>());
-        // The last: the collision, then every turn, less its own trailing IFS.
+        // The last: the collision and its IFS, then every turn, less its own trailing IFS.
         let turns: Duration = SEED_CASE.iter().map(|&b| bus.turn(b)).sum();
-        let expected = bus.gamma() + bus.propagation + turns - bus.ifs;
+        let expected = bus.gamma() + bus.propagation + turns;
         assert_eq!(out.worst().unwrap().delay(), expected);
         assert!(us(expected) < us(bus.d_max(&SEED_CASE)));
     }

@@ -86,7 +86,9 @@ impl Positions {
 
     /// An alternative for `robot`'s straight way from `from` to `to`, round the links of the
     /// robots `around` where they last said they were: the whole way, `from` first, or
-    /// `None` if no side-step within `reach` keeps the margin (see [`detour`]).
+    /// `None` if no side-step within `reach` keeps the margin (see [`detour`]), or if a
+    /// robot in the way never said where it is. A point that is no place, or a robot the
+    /// coordinator does not know, is refused by name.
     pub fn alternative(
         &self,
         robot: &str,
@@ -96,6 +98,15 @@ impl Positions {
         reach: f32,
     ) -> Result<Option<Vec<[f32; 2]>>, ZoneError> {
         self.known(robot)?;
+        if from.iter().chain(&to).any(|c| !c.is_finite()) {
+            return Err(ZoneError::NoPlace(robot.into()));
+        }
+        for other in around {
+            self.known(other.as_str())?;
+        }
+        if around.iter().any(|other| !self.poses.contains_key(other)) {
+            return Ok(None);
+        }
         let obstacles: Vec<Obstacle> = around
             .iter()
             .filter_map(|other| self.poses.get(other))
@@ -151,6 +162,24 @@ mod tests {
         );
         // The pose told before is kept.
         assert_eq!(positions.told("A"), Some(arm(0.0)));
+    }
+
+    #[test]
+    fn an_alternative_round_a_robot_that_never_told_or_to_no_place_is_refused() {
+        let positions = Positions::new(["A", "B"], 0.035, 0.03);
+        // B never said where it is: no way round it is offered.
+        assert_eq!(
+            positions.alternative("A", [0.0, 0.0], [1.0, 0.0], &["B".into()], 0.5),
+            Ok(None)
+        );
+        assert_eq!(
+            positions.alternative("A", [f32::NAN, 0.0], [1.0, 0.0], &[], 0.5),
+            Err(ZoneError::NoPlace("A".into()))
+        );
+        assert_eq!(
+            positions.alternative("A", [0.0, 0.0], [1.0, 0.0], &["Z".into()], 0.5),
+            Err(ZoneError::UnknownRobot("Z".into()))
+        );
     }
 
     #[test]

@@ -26,7 +26,9 @@ pub struct Composition {
     sinks: Vec<(usize, &'static str)>,
 }
 
-/// A reachable state where nothing can move and not every automaton has stopped.
+/// A reachable state where nothing can move and not every automaton has stopped: a global
+/// deadlock. (Automata blocked for ever while others go on are not one; such a run shows
+/// as one that does not end.)
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Stuck {
     /// The moves from the start to it.
@@ -294,7 +296,9 @@ impl Composition {
     }
 
     /// One run, the environment writing each input the values `script` gives it in turn
-    /// (and nothing once they are spent), until nothing can move.
+    /// (and nothing once they are spent), until nothing can move, or until the run comes
+    /// back to a state it was in with the same values left to write: it would go round for
+    /// ever, and is reported as not ended.
     pub fn run(&self, script: &[(At<'_>, Vec<Value>)]) -> Result<Run, AutomatonError> {
         let mut queues: BTreeMap<(usize, &'static str), VecDeque<Value>> = BTreeMap::new();
         for (at, values) in script {
@@ -307,7 +311,12 @@ impl Composition {
             .iter()
             .map(|a| (a.name().to_string(), vec![a.start().to_string()]))
             .collect();
+        let mut seen: std::collections::HashSet<(Global, Vec<usize>)> = Default::default();
         loop {
+            let left: Vec<usize> = queues.values().map(VecDeque::len).collect();
+            if !seen.insert((global.clone(), left)) {
+                break;
+            }
             let moves = self.moves(&global, Some(&queues))?;
             // Each automaton's own states depend only on the values it reads, so which
             // move goes first does not change them: take the first.

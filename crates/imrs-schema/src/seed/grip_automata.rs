@@ -1,5 +1,11 @@
-//! The guarded move as port automata: Grip and its `Closejoint_i`, declared as the seed's
-//! formal model so that the composition can be explored, and a variant built to deadlock.
+//! The guarded move as port automata: a bounded abstraction of Grip and its `Closejoint_i`
+//! in the seed's formal model, so that the composition can be explored, and a variant built
+//! to deadlock.
+//!
+//! The abstraction adds to the seed's Grip what "ends" needs: in the seed `TClosejoint`
+//! runs as long as its task-unit exists and Grip has no ports. Here each `Closejoint_i`
+//! stops when it touches or reaches its limit and says so on a `Done` port, and Grip waits
+//! for each `Done` in turn (as an assemblage ends when its components have).
 
 use crate::automaton::{AutomatonError, Composition, PortAutomaton};
 
@@ -101,10 +107,10 @@ pub fn grip_automata(n: u32, limit: u32) -> Result<Composition, AutomatonError> 
     Ok(composition)
 }
 
-/// Built to deadlock: as [`grip_automata`], but each `Closejoint_i` synchronized with the
-/// others in a ring (the seed's "each instance of Closejoint is synchronized with every
-/// other instance"), each writing its step to the next before it reads the previous one's.
-/// Every write waits for a read that waits behind a write.
+/// Built to deadlock: as [`grip_automata`], but the `Closejoint_i` linked in a ring, each
+/// writing its step to the next before it reads the previous one's. Every write waits for a
+/// read that waits behind a write. It is not the seed's option of synchronizing every
+/// instance with every other, which can be written so that it works.
 pub fn synchronized_grip_automata(n: u32, limit: u32) -> Result<Composition, AutomatonError> {
     let mut composition = Composition::new(grip_parts(n, limit, true)?)?;
     for i in 1..=n {
