@@ -1,12 +1,15 @@
 //! The four examples of Lyons & Arbib 1985, §5, judged by their physical outcome in rapier: contact
 //! reached and fingers stopped; the wrist at the object; the matching object chosen; the
-//! virtual finger's fingers moved and no other.
+//! virtual finger's fingers moved and no other; and the guarded move over port arrays, two
+//! joints on one sensor and one joint on two sensors.
 
 use std::sync::Arc;
 use std::time::Duration;
 
 use imrs_ports::{Clock, VirtualClock};
-use imrs_schema::seed::{Desired, Grasp, Grip, ObjectQ, ObjectQOnce, Reach, Vf};
+use imrs_schema::seed::{
+    Closefinger, Desired, Grasp, Grip, GuardedMove, ObjectQ, ObjectQOnce, Reach, Vf,
+};
 use imrs_schema::special::Vision;
 use imrs_schema::{Ending, Network, Si};
 use imrs_sim::hand::{FINGERS, Hand, HandConfig, Shape, Touch, finger_joints};
@@ -309,5 +312,72 @@ async fn example_4_a_virtual_finger_moves_its_fingers_and_no_other() {
         "finger 3 moved: {still:?}"
     );
     assert_eq!(bench.hand.touch(3).unwrap(), None);
+    assert_none_failed(&bench.net);
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_guarded_move_over_port_arrays_closes_two_joints_on_one_sensor() {
+    let bench = Bench::new();
+    let cube = bench.index_of(Shape::Cube);
+    bench.reach(cube).await;
+    // Finger 1's two joints, guarded by its tip: Tin_1, Pin_1…2, Pout_1…2.
+    let guarded = bench
+        .net
+        .instantiate(GuardedMove::new(&bench.hand, [1], finger_joints(1), 0.01))
+        .unwrap();
+    assert_eq!(guarded.ports().tin.names(), ["Tin_1"]);
+    assert_eq!(guarded.ports().pout.names(), ["Pout_1", "Pout_2"]);
+    bench.run_for(3.0).await;
+    let [proximal, distal] = bench.angles(1);
+    assert!(proximal > 0.02 && distal > 0.02, "{proximal} {distal}");
+    assert_eq!(bench.hand.touch(1).unwrap(), Some(Touch::Object(cube)));
+    // Held where it touched.
+    let held = bench.angles(1);
+    bench.run_for(1.0).await;
+    let after = bench.angles(1);
+    assert!((after[0] - held[0]).abs() < 0.005 && (after[1] - held[1]).abs() < 0.005);
+    assert!(
+        bench.angles(3).iter().all(|a| a.abs() < 0.005),
+        "finger 3 moved"
+    );
+    assert_none_failed(&bench.net);
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_guarded_move_over_port_arrays_holds_one_joint_once_either_sensor_touches() {
+    let bench = Bench::new();
+    let cube = bench.index_of(Shape::Cube);
+    bench.reach(cube).await;
+    // Finger 4 closes on the cube first.
+    bench
+        .net
+        .instantiate_as(4, Closefinger::new(&bench.hand, 0.01))
+        .unwrap();
+    bench.run_for(3.0).await;
+    assert_eq!(bench.hand.touch(4).unwrap(), Some(Touch::Object(cube)));
+    let joint = finger_joints(2)[0];
+    let before = bench.hand.position(joint).unwrap();
+    // Finger 2's first joint, guarded by finger 2's tip and finger 4's: 4 touches, so it
+    // holds, though its own finger touches nothing.
+    let both = bench
+        .net
+        .instantiate(GuardedMove::new(&bench.hand, [2, 4], [joint], 0.01))
+        .unwrap();
+    bench.run_for(1.0).await;
+    let held = bench.hand.position(joint).unwrap();
+    assert!(
+        (held - before).abs() < 0.005,
+        "moved from {before} to {held}"
+    );
+    assert_eq!(bench.hand.touch(2).unwrap(), None);
+    // Guarded by its own tip alone, the same joint closes.
+    both.stop();
+    bench
+        .net
+        .instantiate(GuardedMove::new(&bench.hand, [2], [joint], 0.01))
+        .unwrap();
+    bench.run_for(2.0).await;
+    let moved = bench.hand.position(joint).unwrap();
+    assert!(moved > before + 0.02, "stayed at {moved}");
     assert_none_failed(&bench.net);
 }

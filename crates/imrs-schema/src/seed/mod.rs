@@ -7,6 +7,7 @@
 //! | `TClosejoint`, the r-schema of the guarded move | [`TClosejoint`] |
 //! | the `Closejoint_i` task-unit (Figure 3) | [`Closejoint`] |
 //! | `[Grip () () (Closejoint) (FOR i = 1…n DO Closejoint(i,10) ENDFOR) () ()]` | [`Grip`] |
+//! | the guarded move with port arrays, "any number of joints based on one sensor, or one joint on any number of sensors" | [`GuardedMove`] |
 //! | `RObject`, `Reach` (Figure 4) | [`RObject`], [`Reach`] |
 //! | `Objtest`, `Object?` (Figure 5) | [`Objtest`], [`ObjectQ`] |
 //! | the second precondition: `Object?` creates the tests and dies, the matching `Objtest` creates the task-unit | [`ObjectQOnce`], [`ObjtestTrigger`] |
@@ -15,6 +16,7 @@
 
 mod grip;
 mod grip_automata;
+mod guarded;
 mod object;
 mod reach;
 mod vf;
@@ -23,6 +25,7 @@ pub use grip::{Closejoint, Grip, TClosejoint, TClosejointPorts};
 pub use grip_automata::{
     MAX_JOINTS, grip_automata, grip_done_port, grip_parts, synchronized_grip_automata,
 };
+pub use guarded::{GuardedMove, GuardedMovePorts};
 pub use object::{
     Desired, ObjectQ, ObjectQOnce, ObjectQPorts, Objtest, ObjtestPorts, ObjtestTrigger, Starter,
 };
