@@ -142,8 +142,14 @@ async fn a_deadlock_between_two_robots_is_resolved_by_the_coordinator() {
                     ctx.delay(Duration::from_secs(1)).await;
                     match link.acquire(second).await {
                         Ok(()) => break,
-                        // The victim gave up what it held; it waits, then tries again.
-                        Err(Refused::BackOff) => ctx.delay(Duration::from_secs(3)).await,
+                        // The victim gets out of what it holds, says so, waits, and tries
+                        // again.
+                        Err(Refused::BackOff) => {
+                            link.tell(Message::Release(first.into()))
+                                .await
+                                .map_err(|e| format!("{e:?}"))?;
+                            ctx.delay(Duration::from_secs(3)).await;
+                        }
                         Err(other) => return Err(format!("{other:?}").into()),
                     }
                 }
@@ -435,6 +441,10 @@ async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off()
                 // FIXTURE is A's, A waits for TRAY: B closes the cycle, and is its victim.
                 let asked = link.acquire_giving_up("FIXTURE", &["PASSAGE".into()]).await;
                 *outcome.lock().unwrap() = Some(asked);
+                // Backed off: it gets out of TRAY and says so.
+                link.tell(Message::Release("TRAY".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
                 Ok(())
             }
         })

@@ -130,8 +130,11 @@ fn a_zone_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
     let deadlock = t.deadlock().expect("the cycle A → B → A");
     assert_eq!(deadlock.cycle.len(), 2);
     assert_eq!(deadlock.victim, "ARM_B");
-    assert_eq!(t.resolve(&deadlock)?, ["ARM_A"]);
+    // B stops waiting: the cycle is broken, but TRAY is B's until it has left it.
+    assert!(t.resolve(&deadlock)?.is_empty());
     assert_eq!(t.deadlock(), None);
+    assert_eq!(t.request_move("ARM_A", "TRAY")?, Answer::Sleep);
+    assert_eq!(t.release("ARM_B", "TRAY")?, ["ARM_A"]);
     assert_eq!(t.request_move("ARM_A", "TRAY")?, Answer::Grant);
     Ok(())
 }
@@ -145,8 +148,36 @@ fn a_tool_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
     assert_eq!(t.request_tool("ARM_C", "SCREWDRIVER")?, Answer::Sleep);
     let deadlock = t.deadlock().expect("a tool cycle");
     assert_eq!(deadlock.victim, "ARM_C");
-    assert_eq!(t.resolve(&deadlock)?, ["ARM_A"]);
+    // C stops waiting; the gripper is C's until it has put it down.
+    assert!(t.resolve(&deadlock)?.is_empty());
+    assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Sleep);
+    assert_eq!(t.release_tool("ARM_C", "GRIPPER")?, ["ARM_A"]);
     assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Grant);
+    Ok(())
+}
+
+/// A robot that keeps its right to move in a shared zone while it sleeps at an exclusive
+/// zone's border closes a mixed cycle with the robot inside that zone, which waits to move
+/// in the shared one: the wait-for graph has the movement right, so it is found. The victim
+/// stops waiting and, stopped, moves nowhere.
+#[test]
+fn a_mixed_shared_and_exclusive_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
+    let mut t = table();
+    assert_eq!(t.request_move("ARM_A", "FEEDERS")?, Answer::Grant);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Grant);
+    // A keeps moving in FEEDERS while it sleeps at FIXTURE's border.
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Sleep);
+    assert_eq!(t.deadlock(), None);
+    assert_eq!(t.request_move("ARM_B", "FEEDERS")?, Answer::Sleep);
+    let deadlock = t
+        .deadlock()
+        .expect("A waits for B's zone, B for A's movement");
+    assert_eq!(deadlock.victim, "ARM_B");
+    assert!(t.resolve(&deadlock)?.is_empty());
+    assert_eq!(t.deadlock(), None);
+    // B leaves FIXTURE: A has it.
+    assert_eq!(t.release("ARM_B", "FIXTURE")?, ["ARM_A"]);
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Grant);
     Ok(())
 }
 

@@ -1,5 +1,8 @@
 //! Deadlock among exclusive resources: exclusive zones and tools meet every condition for
 //! it, so the coordinator looks for a cycle of robots each sleeping on what the next holds.
+//! A right to move in a shared zone is in the graph too: a robot that keeps it while it
+//! sleeps at another border (instead of giving it up, as the seed's robots do) can close a
+//! mixed cycle.
 
 use std::collections::BTreeMap;
 
@@ -18,10 +21,15 @@ pub struct Deadlock {
 }
 
 impl Resources {
-    /// The first cycle in the wait-for graph of exclusive zones and tools, if any.
+    /// The first cycle in the wait-for graph of exclusive zones, tools and shared-zone
+    /// movement rights, if any.
     pub fn deadlock(&self) -> Option<Deadlock> {
         let mut waits_for: BTreeMap<Name, Vec<Name>> = BTreeMap::new();
-        for (_, holders, sleepers) in self.exclusive_waits() {
+        for (_, holders, sleepers) in self
+            .exclusive_waits()
+            .into_iter()
+            .chain(self.shared_waits())
+        {
             for sleeper in &sleepers {
                 waits_for
                     .entry(sleeper.clone())
@@ -40,10 +48,12 @@ impl Resources {
         None
     }
 
-    /// Resolves `deadlock`: its victim backs off (gives up what it holds and its place in
-    /// every queue). Returns who is woken.
+    /// Resolves `deadlock`: its victim stops waiting (leaves every queue, and, stopped,
+    /// moves in no shared zone), which breaks the cycle. What it is inside and the tools it
+    /// holds are freed only when it says it has left them or put them down: the books
+    /// follow the robot, which must first get out. Returns who is woken.
     pub fn resolve(&mut self, deadlock: &Deadlock) -> Result<Vec<Name>, ZoneError> {
-        self.back_off(deadlock.victim.as_str())
+        self.stop_waiting(deadlock.victim.as_str())
     }
 }
 

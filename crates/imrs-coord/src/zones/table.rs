@@ -345,8 +345,50 @@ impl Resources {
             .collect()
     }
 
-    /// Takes `robot` out of every queue and resource it holds, as when it backs off to
-    /// resolve a deadlock; returns who is woken.
+    /// Movement rights in shared zones, as waits: for each shared zone, the robot that
+    /// moves there and the robots asleep at its border.
+    pub(crate) fn shared_waits(&self) -> Vec<(Name, Vec<Name>, Vec<Name>)> {
+        self.held
+            .iter()
+            .filter(|(name, _)| {
+                self.zones
+                    .iter()
+                    .any(|z| z.name == **name && z.kind == ZoneKind::Shared)
+            })
+            .map(|(name, held)| {
+                (
+                    name.clone(),
+                    held.moving.iter().cloned().collect(),
+                    held.sleeping.iter().cloned().collect(),
+                )
+            })
+            .collect()
+    }
+
+    /// `robot` backs off to resolve a deadlock: it waits for nothing any more (out of every
+    /// queue) and is stopped (it moves in no shared zone), but the zones it is inside and
+    /// the tools it holds stay its own until it says it has left them or put them down
+    /// ([`release`](Self::release), [`release_tool`](Self::release_tool)), as it really
+    /// has. Returns who is woken.
+    pub fn stop_waiting(&mut self, robot: &str) -> Result<Vec<Name>, ZoneError> {
+        let robot = self.robot(robot)?;
+        self.robots.insert(robot.clone(), false);
+        let names: Vec<Name> = self.held.keys().cloned().collect();
+        let mut woken = Vec::new();
+        for name in names {
+            let held = self.held(name.as_str())?;
+            held.sleeping.retain(|r| *r != robot);
+            if held.moving.as_ref() == Some(&robot) {
+                held.moving = None;
+                woken.extend(self.wake(name.as_str()));
+            }
+        }
+        Ok(woken)
+    }
+
+    /// Takes `robot` out of every queue and resource it holds at once, as when it is taken
+    /// out of the cell; returns who is woken. A robot that backs off from a deadlock still
+    /// holds what it is inside: see [`stop_waiting`](Self::stop_waiting).
     pub fn back_off(&mut self, robot: &str) -> Result<Vec<Name>, ZoneError> {
         let robot = self.robot(robot)?;
         let names: Vec<Name> = self.held.keys().cloned().collect();
