@@ -13,7 +13,7 @@
 //! to back off. A robot's way is checked against the other robots where *they said* they
 //! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use imrs_core::prelude::*;
@@ -330,6 +330,10 @@ pub fn coordinator(
             for (robot, port) in &ports.wake {
                 wake.insert(robot.clone(), port.owner()?);
             }
+            // The robots told to sleep and not woken since. A wake-up is a rendezvous, and
+            // a robot woken once is on its way to ask again, not waiting for another: one
+            // sent to it then would wait for it while it waits to be heard.
+            let mut asleep: BTreeSet<Name> = BTreeSet::new();
             loop {
                 enum Event {
                     Alarm(Name, String),
@@ -382,26 +386,28 @@ pub fn coordinator(
                         };
                         match answer {
                             Answer::Grant => lock(&log).granted += 1,
-                            Answer::Sleep => lock(&log).slept += 1,
+                            Answer::Sleep => {
+                                lock(&log).slept += 1;
+                                asleep.insert(robot.clone());
+                            }
                         }
                         reply.reply(Ok(answer));
                         for robot in woken {
-                            if let Some(end) = wake.get_mut(&robot) {
-                                let _ = end.send(Wake::WakeUp).await;
-                            }
+                            wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
                         }
                         if answer == Answer::Sleep {
                             let found = lock(&table).deadlock();
-                            if let Some(deadlock) = found {
+                            // A victim already woken asks again, and the cycle is looked
+                            // for again when it sleeps.
+                            if let Some(deadlock) = found
+                                && asleep.contains(&deadlock.victim)
+                            {
                                 let woken = lock(&table).resolve(&deadlock).unwrap_or_default();
                                 lock(&log).deadlocks.push(deadlock.victim.clone());
-                                if let Some(end) = wake.get_mut(&deadlock.victim) {
-                                    let _ = end.send(Wake::BackOff).await;
-                                }
+                                let victim = &deadlock.victim;
+                                wake_up(&mut wake, &mut asleep, victim, Wake::BackOff).await;
                                 for robot in woken {
-                                    if let Some(end) = wake.get_mut(&robot) {
-                                        let _ = end.send(Wake::WakeUp).await;
-                                    }
+                                    wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
                                 }
                             }
                         }
@@ -410,6 +416,20 @@ pub fn coordinator(
             }
         }
     })
+}
+
+/// Wakes `robot` with `why`, if it sleeps: a robot already woken is not waited for again.
+async fn wake_up(
+    wake: &mut BTreeMap<Name, End<Wake, (), usage::Send>>,
+    asleep: &mut BTreeSet<Name>,
+    robot: &Name,
+    why: Wake,
+) {
+    if asleep.remove(robot)
+        && let Some(end) = wake.get_mut(robot)
+    {
+        let _ = end.send(why).await;
+    }
 }
 
 /// The answer to one question about space, from the robots' told positions; a position

@@ -457,3 +457,56 @@ async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off()
     assert_eq!(*outcome.lock().unwrap(), Some(Err(Refused::BackOff)));
     assert_eq!(log.lock().unwrap().deadlocks, ["ROBOT_B"]);
 }
+
+/// A robot woken once is on its way to ask again: a second event that would wake it (here
+/// a release of the zone it waits for, by a robot that was not in it) must not make the
+/// coordinator wait for it, or neither would move again.
+#[tokio::test(start_paused = true)]
+async fn a_robot_woken_twice_before_it_asks_again_is_not_waited_for() {
+    let (cell, clock, ports, _log) = start();
+    let moved = Arc::new(Mutex::new(None));
+    let spec = |robot: &'static str| {
+        let (ports, moved) = (ports.clone(), Arc::clone(&moved));
+        ModuleSpec::new(robot, ()).task(robot, move |ctx| {
+            let (ports, moved) = (ports.clone(), Arc::clone(&moved));
+            async move {
+                let mut link = ports.link(robot)?;
+                let refused = |e| format!("{e:?}");
+                match robot {
+                    // Moves in PASSAGE, and at 1 s stops inside it.
+                    "ROBOT_A" => {
+                        link.acquire("PASSAGE").await.map_err(refused)?;
+                        ctx.delay(Duration::from_secs(1)).await;
+                        link.tell(Message::Position("PASSAGE".into()))
+                            .await
+                            .map_err(refused)?;
+                    }
+                    // At 1 s too, just after A, says it left PASSAGE, which it was never
+                    // in: its timer is set later than A's for the same instant.
+                    "ROBOT_B" => {
+                        ctx.delay(Duration::from_millis(500)).await;
+                        ctx.delay(Duration::from_millis(500)).await;
+                        link.tell(Message::Release("PASSAGE".into()))
+                            .await
+                            .map_err(refused)?;
+                    }
+                    // Waits to move in PASSAGE.
+                    _ => {
+                        ctx.delay(Duration::from_millis(100)).await;
+                        link.acquire("PASSAGE").await.map_err(refused)?;
+                        *moved.lock().unwrap() = Some(seconds(&ctx));
+                    }
+                }
+                Ok(())
+            }
+        })
+    };
+    let mut robots = ROBOTS.map(|robot| cell.start(spec(robot)).unwrap());
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(5))).await;
+    // Frozen, no robot would finish: fail then, rather than wait for ever.
+    for robot in &mut robots {
+        let finished = tokio::time::timeout(Duration::from_secs(60), robot.finished()).await;
+        assert_eq!(finished.ok(), Some(ModuleOutcome::Finished));
+    }
+    assert_eq!(*moved.lock().unwrap(), Some(1.0));
+}
