@@ -294,7 +294,9 @@ impl Table {
         })
     }
 
-    /// The joints of every arm now (base, elbow, tool), by name.
+    /// The joints of every arm now (base, elbow, tool), by name: the simulation's own view,
+    /// for measuring and showing the cell. A module of the cell is given its own arm
+    /// ([`Table::arm`]) and learns where the others are only from them, through its ports.
     pub fn joints(&self) -> Vec<(Name, [Point2<f32>; 3])> {
         let now = self.shared.clock.now();
         let world = self.world();
