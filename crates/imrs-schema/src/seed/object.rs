@@ -5,7 +5,7 @@ use std::sync::Arc;
 use imrs_sim::hand::Shape;
 use nalgebra::{Point3, UnitQuaternion};
 
-use crate::special::{Sef, Vision};
+use crate::special::{Sef, SefPorts, Vision};
 use crate::{Behavior, Cx, Declare, Flow, Schema, SchemaError, ports};
 
 /// `DF1 … DF4`: the features of the object sought. Position and orientation may be anything;
@@ -49,10 +49,7 @@ impl Schema for Objtest {
     }
 
     async fn behavior(&mut self, p: &ObjtestPorts, cx: &Cx) -> Behavior {
-        let (_, _) = (p.f1.read().await?, p.f2.read().await?);
-        let (shape, size) = (p.f3.read().await?, p.f4.read().await?);
-        let d = self.desired;
-        let matches = shape == d.shape && (size - d.size).abs() <= d.tolerance;
+        let matches = judge(&self.desired, p).await?;
         p.judgement
             .write(if matches { cx.number() } else { 0 })
             .await?;
@@ -125,12 +122,8 @@ impl Schema for ObjectQ {
                 Err(SchemaError::InstanceExists { .. }) => continue,
                 Err(error) => return Err(error),
             };
-            let (from, to) = (sef.ports(), test.ports());
-            cx.connect(&from.f1, &to.f1);
-            cx.connect(&from.f2, &to.f2);
-            cx.connect(&from.f3, &to.f3);
-            cx.connect(&from.f4, &to.f4);
-            cx.connect(&to.judgement, &p.result);
+            connect_sef(cx, sef.ports(), test.ports());
+            cx.connect(&test.ports().judgement, &p.result);
         }
         let matched = match p.result.read().await {
             Ok(matched) => matched,
@@ -178,10 +171,7 @@ impl Schema for ObjtestTrigger {
     }
 
     async fn behavior(&mut self, p: &ObjtestPorts, cx: &Cx) -> Behavior {
-        let (_, _) = (p.f1.read().await?, p.f2.read().await?);
-        let (shape, size) = (p.f3.read().await?, p.f4.read().await?);
-        let d = self.desired;
-        if shape == d.shape && (size - d.size).abs() <= d.tolerance {
+        if judge(&self.desired, p).await? {
             (self.start)(cx, cx.number())?;
         }
         Ok(Flow::Stop)
@@ -241,12 +231,23 @@ impl Schema for ObjectQOnce {
                     start: Arc::clone(&self.start),
                 },
             )?;
-            let (from, to) = (sef.ports(), test.ports());
-            cx.connect(&from.f1, &to.f1);
-            cx.connect(&from.f2, &to.f2);
-            cx.connect(&from.f3, &to.f3);
-            cx.connect(&from.f4, &to.f4);
+            connect_sef(cx, sef.ports(), test.ports());
         }
         Ok(Flow::Stop)
     }
+}
+
+/// Whether the features an `Objtest` reads from its SEF describe `desired`.
+async fn judge(desired: &Desired, p: &ObjtestPorts) -> Result<bool, SchemaError> {
+    let (_, _) = (p.f1.read().await?, p.f2.read().await?);
+    let (shape, size) = (p.f3.read().await?, p.f4.read().await?);
+    Ok(shape == desired.shape && (size - desired.size).abs() <= desired.tolerance)
+}
+
+/// `Objtest(F1 … F4) ← SEF_i(F1 … F4)`.
+fn connect_sef(cx: &Cx, from: &SefPorts, to: &ObjtestPorts) {
+    cx.connect(&from.f1, &to.f1);
+    cx.connect(&from.f2, &to.f2);
+    cx.connect(&from.f3, &to.f3);
+    cx.connect(&from.f4, &to.f4);
 }
