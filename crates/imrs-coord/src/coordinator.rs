@@ -9,8 +9,8 @@
 //! | wake up (and back off, to resolve a deadlock) | `WAKE_<ROBOT>`, a [`Wake`] | coordinator → robot |
 //! | alarm: an emergency stop reaches every robot | `EMERGENCY`, a `sendall` | coordinator → every robot |
 //!
-//! After every sleep it looks for a deadlock among exclusive resources; the victim is told
-//! to back off. A robot's way is checked against the other robots where *they said* they
+//! After every sleep it looks for deadlocks among the robots asleep, over exclusive zones,
+//! tools and rights to move in shared zones; each victim is told to back off. A robot's way is checked against the other robots where *they said* they
 //! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -80,7 +80,9 @@ pub const ALTERNATIVE_REACH: f32 = 0.25;
 pub enum Wake {
     /// The resource it slept on may be free: ask again.
     WakeUp,
-    /// It is the victim of a deadlock: give up what it holds, and ask again later.
+    /// It is the victim of a deadlock: it waits for nothing any more. It gets out of the
+    /// zones it is in and puts down the tool it holds, says so (each a release: the books
+    /// keep them its own until then), and asks again later.
     BackOff,
 }
 
@@ -395,20 +397,24 @@ pub fn coordinator(
                         for robot in woken {
                             wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
                         }
-                        if answer == Answer::Sleep {
-                            let found = lock(&table).deadlock();
-                            // A victim already woken asks again, and the cycle is looked
-                            // for again when it sleeps.
-                            if let Some(deadlock) = found
-                                && asleep.contains(&deadlock.victim)
-                            {
-                                let woken = lock(&table).resolve(&deadlock).unwrap_or_default();
-                                lock(&log).deadlocks.push(deadlock.victim.clone());
-                                let victim = &deadlock.victim;
-                                wake_up(&mut wake, &mut asleep, victim, Wake::BackOff).await;
-                                for robot in woken {
-                                    wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
-                                }
+                        // Every cycle among the robots asleep, each resolved in turn. A robot
+                        // already woken waits for nothing yet: it is looked at again when it
+                        // sleeps.
+                        let mut look = answer == Answer::Sleep;
+                        while look {
+                            // The table's lock ends with this statement, before any wake-up.
+                            let found = lock(&table).deadlock_among(|r| asleep.contains(r));
+                            look = found.is_some();
+                            let Some(deadlock) = found else {
+                                break;
+                            };
+                            let woken = lock(&table).resolve(&deadlock).unwrap_or_default();
+                            lock(&log).deadlocks.push(deadlock.victim.clone());
+                            let victim = &deadlock.victim;
+                            // The victim leaves `asleep` here, so the loop ends.
+                            wake_up(&mut wake, &mut asleep, victim, Wake::BackOff).await;
+                            for robot in woken {
+                                wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
                             }
                         }
                     }
@@ -484,6 +490,11 @@ fn answer(
     Ok(match message {
         Message::Request(zone) => (request(table, robot, zone)?, Vec::new()),
         Message::RequestGivingUp(zone, moving_in) => {
+            // Every zone given up is checked before anything changes: a request refused
+            // halfway would leave the robot queued with nobody to wake it.
+            for shared in moving_in {
+                table.check_zone(shared.as_str())?;
+            }
             let answer = request(table, robot, zone)?;
             let mut woken = Vec::new();
             if answer == Answer::Sleep {

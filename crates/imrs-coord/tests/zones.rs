@@ -352,3 +352,32 @@ fn reservations_grant_sweeps_that_keep_clear_and_queue_the_others() {
     assert_eq!(space.release("ARM_C"), ["ARM_D"]);
     assert_eq!(space.holders(), ["ARM_D"]);
 }
+
+/// Two cycles at once: one whose victim was woken and is on its way to ask again (not
+/// asleep), one of robots all asleep. Looking only among the robots asleep finds the
+/// second, so it is not left waiting behind the first.
+#[test]
+fn a_cycle_among_robots_asleep_is_found_beside_one_whose_victim_is_awake() -> Result<(), ZoneError>
+{
+    let mut t = table();
+    // ARM_A and ARM_B each hold a zone and want the other's.
+    t.request_move("ARM_A", "FIXTURE")?;
+    t.request_move("ARM_B", "TRAY")?;
+    t.request_move("ARM_A", "TRAY")?;
+    t.request_move("ARM_B", "FIXTURE")?;
+    // ARM_A and ARM_C each hold a tool and want the other's.
+    t.request_tool("ARM_C", "SCREWDRIVER")?;
+    t.request_tool("ARM_A", "GRIPPER")?;
+    t.request_tool("ARM_C", "GRIPPER")?;
+    t.request_tool("ARM_A", "SCREWDRIVER")?;
+    // Over every sleeper, the tools' cycle comes first; its victim is ARM_C.
+    assert_eq!(t.deadlock().map(|d| d.victim), Some("ARM_C".into()));
+    // ARM_C was woken: among the robots asleep, the zones' cycle is found, where looking
+    // at the first cycle only would have found ARM_C's again and left this one waiting.
+    let found = t
+        .deadlock_among(|r| *r != "ARM_C")
+        .expect("ARM_A and ARM_B wait for each other");
+    assert_eq!(found.victim, "ARM_B");
+    assert!(!found.cycle.contains(&"ARM_C".into()));
+    Ok(())
+}

@@ -294,12 +294,12 @@ impl Driver {
             };
             match pipeline.next(zones_at) {
                 Next::Request(zone) => {
-                    // The shared zones it is in and moves in now: refused at the border,
-                    // it gives them up while it waits.
-                    let inside = self.zones_at(self.arm.at());
+                    // Every right to move in a shared zone it holds, the one it is in and
+                    // those granted ahead: refused at the border, it gives them up while it
+                    // waits.
                     let moving_in: Vec<Name> = pipeline
                         .holding()
-                        .filter(|held| inside.contains(held) && self.is_shared(held))
+                        .filter(|held| self.is_shared(held))
                         .cloned()
                         .collect();
                     self.acquire_moving_in(&zone, &moving_in).await?;

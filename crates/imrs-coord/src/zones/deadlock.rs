@@ -24,13 +24,20 @@ impl Resources {
     /// The first cycle in the wait-for graph of exclusive zones, tools and shared-zone
     /// movement rights, if any.
     pub fn deadlock(&self) -> Option<Deadlock> {
+        self.deadlock_among(|_| true)
+    }
+
+    /// The first cycle among the sleepers for which `asleep` holds: a robot that was woken
+    /// and is on its way to ask again waits for nothing yet, and is looked at again when it
+    /// sleeps.
+    pub fn deadlock_among(&self, asleep: impl Fn(&Name) -> bool) -> Option<Deadlock> {
         let mut waits_for: BTreeMap<Name, Vec<Name>> = BTreeMap::new();
         for (_, holders, sleepers) in self
             .exclusive_waits()
             .into_iter()
             .chain(self.shared_waits())
         {
-            for sleeper in &sleepers {
+            for sleeper in sleepers.iter().filter(|sleeper| asleep(sleeper)) {
                 waits_for
                     .entry(sleeper.clone())
                     .or_default()

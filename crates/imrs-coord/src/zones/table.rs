@@ -150,6 +150,11 @@ impl Resources {
         }
     }
 
+    /// Whether `name` is a zone defined before start: refused by name if not.
+    pub fn check_zone(&self, name: &str) -> Result<(), ZoneError> {
+        self.zone(name).map(drop)
+    }
+
     fn zone(&self, name: &str) -> Result<usize, ZoneError> {
         self.zones
             .iter()
@@ -330,10 +335,9 @@ impl Resources {
             .iter()
             .filter(|(name, _)| {
                 self.tools.contains(*name)
-                    || self
-                        .zones
-                        .iter()
-                        .any(|z| z.name == **name && z.kind == ZoneKind::Exclusive)
+                    || self.zones.iter().zip(&self.active).any(|(z, &active)| {
+                        active && z.name == **name && z.kind == ZoneKind::Exclusive
+                    })
             })
             .map(|(name, held)| {
                 (
@@ -353,7 +357,8 @@ impl Resources {
             .filter(|(name, _)| {
                 self.zones
                     .iter()
-                    .any(|z| z.name == **name && z.kind == ZoneKind::Shared)
+                    .zip(&self.active)
+                    .any(|(z, &active)| active && z.name == **name && z.kind == ZoneKind::Shared)
             })
             .map(|(name, held)| {
                 (
@@ -377,9 +382,13 @@ impl Resources {
         let mut woken = Vec::new();
         for name in names {
             let held = self.held(name.as_str())?;
+            let was_first = held.sleeping.front() == Some(&robot);
             held.sleeping.retain(|r| *r != robot);
-            if held.moving.as_ref() == Some(&robot) {
+            let was_moving = held.moving.as_ref() == Some(&robot);
+            if was_moving {
                 held.moving = None;
+            }
+            if was_first || was_moving {
                 woken.extend(self.wake(name.as_str()));
             }
         }

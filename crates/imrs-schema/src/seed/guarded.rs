@@ -78,18 +78,24 @@ impl Schema for GuardedMove {
             });
         }
         let me = cx.me();
+        let number = |index: usize, what: &str| {
+            u32::try_from(index).map_err(|_| SchemaError::Failed {
+                instance: me.clone(),
+                reason: format!("{what} {index} is no instance number"),
+            })
+        };
         let ports = GuardedMovePorts {
             tin: PortArray::inputs("Tin", self.sensors.len(), me),
             pin: PortArray::inputs("Pin", self.joints.len(), me),
             pout: PortArray::outputs("Pout", self.joints.len(), me),
         };
         for (k, &finger) in self.sensors.iter().enumerate() {
-            let tactile = cx.instantiate_as(finger as u32, Tactile::new(&self.hand))?;
+            let tactile = cx.instantiate_as(number(finger, "sensor")?, Tactile::new(&self.hand))?;
             let tin = ports.tin.get(k + 1).expect("one input per sensor");
             cx.connect(&tactile.ports().contact, tin);
         }
         for (k, &joint) in self.joints.iter().enumerate() {
-            let joint = cx.instantiate_as(joint as u32, Joint::new(&self.hand))?;
+            let joint = cx.instantiate_as(number(joint, "joint")?, Joint::new(&self.hand))?;
             let (pin, pout) = (ports.pin.get(k + 1), ports.pout.get(k + 1));
             cx.connect(
                 &joint.ports().position,

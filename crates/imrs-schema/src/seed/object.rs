@@ -224,13 +224,18 @@ impl Schema for ObjectQOnce {
             return Ok(Flow::Continue);
         }
         for sef in &sefs {
-            let test = cx.instantiate_as(
+            let test = match cx.instantiate_as(
                 sef.number(),
                 ObjtestTrigger {
                     desired: self.desired,
                     start: Arc::clone(&self.start),
                 },
-            )?;
+            ) {
+                Ok(test) => test,
+                // A test of this SEF runs already (another precondition's): it judges it.
+                Err(SchemaError::InstanceExists { .. }) => continue,
+                Err(error) => return Err(error),
+            };
             connect_sef(cx, sef.ports(), test.ports());
         }
         Ok(Flow::Stop)
