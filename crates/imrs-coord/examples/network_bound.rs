@@ -127,12 +127,7 @@ fn main() {
     );
 
     println!("simulated slot by slot (each station sending once while another waits):");
-    let everyone: Vec<Offer> = (0..SEED_CASE.len())
-        .map(|station| Offer {
-            at: Duration::ZERO,
-            station,
-        })
-        .collect();
+    let everyone = Offer::everyone(SEED_CASE.len(), Duration::ZERO);
     let all = simulate(&bus, &SEED_CASE, bus.slot, &everyone).expect("ten stations");
     let worst = all.worst().expect("ten messages");
     println!(

@@ -28,13 +28,12 @@ fn worst_missed_slot(bus: &Bus, slot: Duration) -> Duration {
 #[test]
 fn every_station_at_once_is_within_the_seeds_d_max() {
     let bus = Bus::ieee_802_3(100.0);
-    let offers: Vec<Offer> = (0..SEED_CASE.len())
-        .map(|station| Offer {
-            at: Duration::ZERO,
-            station,
-        })
-        .collect();
+    let offers = Offer::everyone(SEED_CASE.len(), Duration::ZERO);
     let out = simulate(&bus, &SEED_CASE, bus.slot, &offers).unwrap();
+    // One collision, then each station in its slot, in order.
+    assert_eq!(out.collisions, 1);
+    let order: Vec<usize> = out.deliveries.iter().map(|d| d.offer.station).collect();
+    assert_eq!(order, (0..SEED_CASE.len()).collect::<Vec<_>>());
     let worst = out.worst().unwrap().delay();
     let d_max = bus.d_max(&SEED_CASE);
     // The last station waits the collision, its IFS, and every turn but its own trailing
