@@ -163,6 +163,9 @@ pub enum Refused {
     Failed(String),
 }
 
+/// A wake-up received, or why none could be.
+type Woken = Result<(Wake, imrs_ports::ReplyHandle<()>), imrs_ports::ReceiveError>;
+
 /// A robot's ends of the coordinator's ports.
 pub struct RobotLink {
     robot: Name,
@@ -224,6 +227,83 @@ impl RobotLink {
                 }
             }
         }
+    }
+
+    /// Asks for `zone` (or a tool) while the robot moves, as its pipeline asks for a point
+    /// ahead; granted, it goes on. Told to sleep, it stops (`stopped` halts it and resolves
+    /// once it stands still): an arm cannot stop at once, and keeps its right to move in the
+    /// shared zones `moving_in` while it brakes in them. Stopped, it gives each up with a
+    /// position message, as the seed's robot does, waits to be woken, and asks again.
+    /// Returns the zones it gave up, for it to ask again before it moves.
+    ///
+    /// From the sleep until the wake-up, every message it sends is sent while it listens for
+    /// the wake-up: the coordinator waits for a robot it wakes, and one that waited for the
+    /// coordinator in turn would leave both waiting.
+    pub async fn acquire_stopping<F: Future<Output = ()>>(
+        &mut self,
+        zone: &str,
+        moving_in: &[Name],
+        mut stopped: impl FnMut() -> F,
+    ) -> Result<Vec<Name>, Refused> {
+        let mut given_up: Vec<Name> = Vec::new();
+        let mut at_rest = false;
+        loop {
+            let giving_up: Vec<Name> = if at_rest {
+                moving_in
+                    .iter()
+                    .filter(|shared| !given_up.contains(shared))
+                    .cloned()
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let request = Message::RequestGivingUp(zone.into(), giving_up.clone());
+            if self.tell(request).await? == Answer::Grant {
+                return Ok(given_up);
+            }
+            given_up.extend(giving_up);
+            let woken = if at_rest {
+                self.wake.receive().await
+            } else {
+                let stop = stopped();
+                tokio::select! {
+                    biased;
+                    woken = self.wake.receive() => woken,
+                    () = stop => {
+                        at_rest = true;
+                        self.give_up_stopped(moving_in, &mut given_up).await?
+                    }
+                }
+            };
+            let (wake, reply) = woken.map_err(|error| Refused::Failed(error.to_string()))?;
+            reply.reply(());
+            if wake == Wake::BackOff {
+                return Err(Refused::BackOff);
+            }
+        }
+    }
+
+    /// Stopped while asleep: gives up the right to move in each of `moving_in`, a position
+    /// message each, listening for the wake-up meanwhile; then waits for it.
+    async fn give_up_stopped(
+        &mut self,
+        moving_in: &[Name],
+        given_up: &mut Vec<Name>,
+    ) -> Result<Woken, Refused> {
+        for shared in moving_in {
+            let position = (self.robot.clone(), Message::Position(shared.clone()));
+            tokio::select! {
+                biased;
+                told = self.to.send(position) => {
+                    told
+                        .map_err(|error| Refused::Failed(error.to_string()))?
+                        .map_err(Refused::Failed)?;
+                    given_up.push(shared.clone());
+                }
+                woken = self.wake.receive() => return Ok(woken),
+            }
+        }
+        Ok(self.wake.receive().await)
     }
 
     /// Asks the coordinator about space; its answer.

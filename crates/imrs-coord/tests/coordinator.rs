@@ -405,6 +405,123 @@ async fn a_robot_asleep_at_a_border_gives_up_moving_in_its_shared_zone() {
     );
 }
 
+/// ROBOT_C holds FIXTURE until `release` s. ROBOT_A moves in the shared PASSAGE and, at
+/// 0.1 s, asks for FIXTURE as it moves: told to sleep, it needs 0.3 s to stop. ROBOT_B
+/// asks to move in PASSAGE at `b_asks` s. Returns when B and A were granted PASSAGE and
+/// FIXTURE, and what A gave up.
+async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>) {
+    const BRAKING: Duration = Duration::from_millis(300);
+    let (cell, clock, ports, log) = start();
+    let granted = Arc::new(Mutex::new((None, None)));
+    let given_up = Arc::new(Mutex::new(Vec::new()));
+    let c = {
+        let ports = ports.clone();
+        ModuleSpec::new("ROBOT_C", ()).task("ROBOT_C", move |ctx| {
+            let ports = ports.clone();
+            async move {
+                let mut link = ports.link("ROBOT_C")?;
+                link.acquire("FIXTURE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs_f64(release)).await;
+                link.tell(Message::Release("FIXTURE".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let a = {
+        let (ports, given_up, granted) =
+            (ports.clone(), Arc::clone(&given_up), Arc::clone(&granted));
+        ModuleSpec::new("ROBOT_A", ()).task("ROBOT_A", move |ctx| {
+            let (ports, given_up, granted) =
+                (ports.clone(), Arc::clone(&given_up), Arc::clone(&granted));
+            async move {
+                let mut link = ports.link("ROBOT_A")?;
+                link.acquire("PASSAGE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_millis(100)).await;
+                let braking = &ctx;
+                let gave = link
+                    .acquire_stopping("FIXTURE", &["PASSAGE".into()], || braking.delay(BRAKING))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                granted.lock().unwrap().1 = Some(seconds(&ctx));
+                for zone in &gave {
+                    link.acquire(zone.as_str())
+                        .await
+                        .map_err(|e| format!("{e:?}"))?;
+                }
+                given_up
+                    .lock()
+                    .unwrap()
+                    .extend(gave.iter().map(ToString::to_string));
+                ctx.delay(Duration::from_millis(200)).await;
+                for zone in ["FIXTURE", "PASSAGE"] {
+                    link.tell(Message::Release(zone.into()))
+                        .await
+                        .map_err(|e| format!("{e:?}"))?;
+                }
+                Ok(())
+            }
+        })
+    };
+    let b = {
+        let granted = Arc::clone(&granted);
+        ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
+            let (ports, granted) = (ports.clone(), Arc::clone(&granted));
+            async move {
+                let mut link = ports.link("ROBOT_B")?;
+                ctx.delay(Duration::from_secs_f64(b_asks)).await;
+                link.acquire("PASSAGE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                granted.lock().unwrap().0 = Some(seconds(&ctx));
+                ctx.delay(Duration::from_millis(100)).await;
+                link.tell(Message::Release("PASSAGE".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let mut robots = [
+        cell.start(c).unwrap(),
+        cell.start(a).unwrap(),
+        cell.start(b).unwrap(),
+    ];
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
+    for robot in &mut robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+    assert!(log.lock().unwrap().refused.is_empty());
+    let (b, a) = *granted.lock().unwrap();
+    let given_up = given_up.lock().unwrap().clone();
+    (
+        b.expect("B was granted PASSAGE"),
+        a.expect("A was granted FIXTURE"),
+        given_up,
+    )
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_robot_told_to_sleep_keeps_its_right_to_move_until_it_has_stopped() {
+    // A brakes from 0.1 s to 0.4 s in PASSAGE: B, asking at 0.2 s, moves there only once A
+    // has stopped and given it up.
+    let (b, a, given_up) = stopping_at_border(2.0, 0.2).await;
+    assert_eq!(given_up, ["PASSAGE"]);
+    assert!((0.4..0.45).contains(&b), "B moved in PASSAGE at {b} s");
+    assert!(a >= 2.0, "A had FIXTURE at {a} s, before C left it");
+    // Woken while it still brakes, A is granted at once, and gives nothing up: B waits
+    // until A leaves PASSAGE.
+    let (b, a, given_up) = stopping_at_border(0.2, 0.25).await;
+    assert!(given_up.is_empty(), "{given_up:?}");
+    assert!((0.2..0.25).contains(&a), "A had FIXTURE at {a} s");
+    assert!(b >= a + 0.2, "B moved in PASSAGE at {b} s, beside A");
+}
+
 /// The robot that closes a cycle, and is chosen to back off, is one that gives up its
 /// right to move in a shared zone as it sleeps: the coordinator must not wait on it.
 #[tokio::test(start_paused = true)]

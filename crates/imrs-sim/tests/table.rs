@@ -22,6 +22,7 @@ fn arm(name: &str, base: [f32; 2], home: [f32; 2]) -> ArmSpec {
         },
         home: home.into(),
         speed: 0.5,
+        acceleration: 2.5,
     }
 }
 
@@ -184,6 +185,11 @@ fn what_cannot_be_is_refused_by_name() {
     let error = Table::new(stuck, Arc::clone(&clock)).err().unwrap();
     assert!(error.to_string().contains("RIGHT's speed"), "{error}");
 
+    let mut limp = layout(ZoneUse::Shared);
+    limp.arms[0].acceleration = 0.0;
+    let error = Table::new(limp, Arc::clone(&clock)).err().unwrap();
+    assert!(error.to_string().contains("LEFT's acceleration"), "{error}");
+
     let table = Table::new(layout(ZoneUse::Shared), clock).unwrap();
     assert!(matches!(table.arm("NOBODY"), Err(TableError::UnknownArm(name)) if name == "NOBODY"));
     runtime().block_on(async {
@@ -194,5 +200,75 @@ fn what_cannot_be_is_refused_by_name() {
             left.put_tool(),
             Err(TableError::NotHolding { .. })
         ));
+    });
+}
+
+/// Rapier's view of one arm driven towards the middle zone (its border at x = −0.15 m, the
+/// gripper touching it from x = −0.17 m) and allowed only as far as `allowed`: how long its
+/// gripper was in the zone, and where it stopped.
+fn drive_towards_the_zone(allowed: f32) -> (Duration, Point2<f32>) {
+    runtime().block_on(async {
+        let (clock, table, left, _) = start(ZoneUse::Exclusive);
+        let arm = left.clone();
+        let driving = tokio::spawn(async move {
+            arm.start_leg(Point2::new(0.0, 0.0))?;
+            arm.allow(Point2::new(allowed, 0.0));
+            while !arm.step().await.at_rest() {}
+            Ok::<_, TableError>(())
+        });
+        until(&clock, 3).await;
+        driving.await.unwrap().unwrap();
+        (table.measured().zone_time[0].1, left.at())
+    })
+}
+
+#[test]
+fn an_arm_cannot_stop_at_once_beyond_the_last_point_allowed_it_goes_on_by_its_stopping_distance() {
+    // At 0.5 m/s braking at 2.5 m/s² it needs 5 cm to stop.
+    let (inside, stopped) = drive_towards_the_zone(-0.19);
+    assert!(
+        inside > Duration::ZERO,
+        "allowed 2 cm short of the zone, it stopped at {stopped} and rapier saw it out"
+    );
+    assert!((stopped.x - -0.14).abs() < 0.01, "{stopped}");
+    // Allowed its stopping distance short of the zone, it stays out.
+    let (inside, stopped) = drive_towards_the_zone(-0.25);
+    assert_eq!(inside, Duration::ZERO, "stopped at {stopped}");
+}
+
+#[test]
+fn a_halted_arm_brakes_and_a_leg_starts_only_from_rest() {
+    runtime().block_on(async {
+        let (clock, _table, left, _) = start(ZoneUse::Shared);
+        let arm = left.clone();
+        let driving = tokio::spawn(async move {
+            arm.start_leg(Point2::new(-0.1, 0.0))?;
+            arm.allow(Point2::new(-0.1, 0.0));
+            let mut progress = arm.step().await;
+            while progress.speed < 0.4 {
+                progress = arm.step().await;
+            }
+            let moving = arm.start_leg(Point2::new(-0.3, 0.1));
+            arm.halt();
+            let at = progress.along;
+            while !progress.at_rest() {
+                progress = arm.step().await;
+            }
+            let braked = progress.along - at;
+            // Allowed again, it goes on to the end.
+            arm.allow(Point2::new(-0.1, 0.0));
+            while !arm.step().await.arrived() {}
+            Ok::<_, TableError>((moving, braked, arm.at()))
+        });
+        until(&clock, 3).await;
+        let (moving, braked, end) = driving.await.unwrap().unwrap();
+        let error = moving.unwrap_err();
+        assert!(
+            matches!(&error, TableError::Moving { arm, .. } if arm == "LEFT"),
+            "{error}"
+        );
+        assert!(error.to_string().contains("LEFT still moves"), "{error}");
+        assert!(braked > 0.02 && braked < 0.06, "{braked}");
+        assert!((end - Point2::new(-0.1, 0.0)).norm() < 1e-4, "{end}");
     });
 }

@@ -22,11 +22,7 @@ fn main() -> ExitCode {
 }
 
 fn cell() -> Result<(), Box<dyn std::error::Error>> {
-    let mut config = CellConfig {
-        seed: 1,
-        hours: 1.0,
-        assignment: Assignment::RunTime,
-    };
+    let mut config = CellConfig::new(1, 1.0);
     let mut compare = false;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {

@@ -11,12 +11,13 @@
 //! | seed | here |
 //! |---|---|
 //! | TRAJECTORY | a straight leg, its points spaced 2 cm |
-//! | TRAJECTORY_POINT (check a point) | [`Pipeline::next`] checking the point `offset` ahead |
-//! | STOP_C (an unavailable zone ahead) | the coordinator's *sleep*: the arm waits, short of the border |
-//! | CONTINUE | the grant that follows the wake-up |
+//! | TRAJECTORY_POINT (check a point) | [`Pipeline::next`] checking the point `offset` ahead of the one the controller is allowed to ([`TableArm::allow`]) |
+//! | STOP_C (an unavailable zone ahead) | the coordinator's *sleep*: the arm halts ([`TableArm::halt`]) and brakes, short of the border |
+//! | CONTINUE | the grant that follows the wake-up: the halt lifted |
 //! | STOP_D (the trajectory cannot be completed) | a leg given up for another arm in the way: round it, or back |
 //! | TRAJECTORY_END | [`Next::End`], told to the coordinator |
 
+use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -26,7 +27,7 @@ use imrs_sim::scara::Scara;
 use imrs_sim::table::{ArmSpec, GRIPPER_RADIUS, TableArm, WORK_Z};
 use nalgebra::Point2;
 
-use super::layout::{RACK, SCREWDRIVER};
+use super::layout::{ACCELERATION, RACK, SCREWDRIVER};
 use super::schedule::{JobAsker, JobPort};
 use super::{CellStats, lock};
 use imrs_coord::coordinator::{CoordinatorPorts, Message, Refused, RobotLink};
@@ -34,8 +35,8 @@ use imrs_coord::zones::{Answer, Next, Pipeline, Pose, Sweep, ZoneDef, ZoneKind};
 
 /// Points of a trajectory, this far apart.
 const SPACING: f32 = 0.02;
-/// The arms' deceleration: with their speeds, a stopping distance of 2 to 9 cm.
-const DECELERATION: f32 = 2.5;
+/// How near an allowed point the tool must come to have reached it.
+const REACHED: f32 = 1e-4;
 /// How many points ahead an arm checks its links against the others'.
 const LOOKAHEAD: usize = 5;
 /// How far apart two arms' links are kept.
@@ -70,17 +71,37 @@ struct Driver {
     stats: Arc<Mutex<CellStats>>,
     /// Whether it has just backed off, and lets the other pass before going on.
     yield_after_back_off: bool,
+    /// Which of the seed's mechanisms it uses.
+    mechanisms: Mechanisms,
+    /// Where it last told the coordinator it was.
+    last_told: Option<Point2<f32>>,
 }
 
-/// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`).
+/// Which of the seed's mechanisms an arm uses.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Mechanisms {
+    /// The pipeline's offset, if chosen rather than computed from the stopping distance.
+    pub(crate) offset: Option<usize>,
+    /// Whether it has the coordinator check its way ahead against the other arms, and
+    /// waits, goes round or backs off.
+    pub(crate) geometric: bool,
+}
+
+/// STOP_C: brakes the arm; resolves once it stands still.
+async fn stop(arm: TableArm) {
+    arm.halt();
+    while !arm.step().await.at_rest() {}
+}
+
+/// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`), in a
+/// cell of `zones` whose arms use `mechanisms`.
 pub(crate) fn arm_module(
-    arm: TableArm,
-    spec: &ArmSpec,
-    index: usize,
+    (arm, spec, index): (TableArm, &ArmSpec, usize),
     coordinator: &CoordinatorPorts,
     jobs: &JobPort,
     zones: Arc<Vec<ZoneDef>>,
     stats: Arc<Mutex<CellStats>>,
+    mechanisms: Mechanisms,
 ) -> ModuleSpec<()> {
     let (spec, coordinator, jobs) = (spec.clone(), coordinator.clone(), jobs.clone());
     let module: Name = arm.name().clone();
@@ -101,6 +122,8 @@ pub(crate) fn arm_module(
                 ctx,
                 stats: Arc::clone(&stats),
                 yield_after_back_off: false,
+                mechanisms,
+                last_told: None,
             };
             let mut ask = jobs.user_named(name.as_str())?;
             let result = driver.work(&mut ask).await;
@@ -160,6 +183,7 @@ impl Driver {
     /// Tells the coordinator where its links are now (position information).
     async fn tell_position(&mut self) -> Result<(), String> {
         let here = self.arm.at();
+        self.last_told = Some(here);
         let pose = self
             .pose(&here)
             .ok_or_else(|| format!("{}: its tool at {here} is out of its reach", self.name))?;
@@ -266,7 +290,10 @@ impl Driver {
         Ok(())
     }
 
-    /// One straight leg through the pipeline.
+    /// One straight leg through the pipeline, its three stages at once: the arm's
+    /// controller moves towards the points it was allowed (on the world's steps) while
+    /// this task computes the next point and checks it, `offset` points ahead of the one
+    /// the arm is allowed to.
     async fn leg(&mut self, to: Point2<f32>, may_back_off: bool) -> Result<Leg, String> {
         let from = self.arm.at();
         let count = ((to - from).norm() / SPACING).ceil().max(1.0) as usize;
@@ -279,11 +306,25 @@ impl Driver {
             self.name.clone(),
             points.iter().map(|p| [p.x, p.y, WORK_Z]),
             self.speed,
-            DECELERATION,
+            ACCELERATION,
             SPACING,
         );
-        let mut at = 0;
+        if let Some(offset) = self.mechanisms.offset {
+            pipeline = pipeline.with_offset(offset);
+        }
+        self.arm.start_leg(to).map_err(|error| error.to_string())?;
+        // The points allowed to the arm and not yet reached: how far along the leg each
+        // lies, and the zones the arm has left once there.
+        let mut allowed: VecDeque<(f32, Vec<Name>)> = VecDeque::new();
+        let mut next = 0;
         loop {
+            self.track(&mut allowed).await?;
+            // Two points allowed ahead: more than the arm moves in a step of the world, so
+            // that it never reaches the last before the next is allowed.
+            if allowed.len() >= 2 {
+                self.arm.step().await;
+                continue;
+            }
             let zones = Arc::clone(&self.zones);
             let zones_at = |point: [f32; 3]| -> Vec<Name> {
                 zones
@@ -295,34 +336,46 @@ impl Driver {
             match pipeline.next(zones_at) {
                 Next::Request(zone) => {
                     // Every right to move in a shared zone it holds, the one it is in and
-                    // those granted ahead: refused at the border, it gives them up while it
-                    // waits.
+                    // those granted ahead: refused at the border, it stops, and gives them
+                    // up while it waits.
                     let moving_in: Vec<Name> = pipeline
                         .holding()
                         .filter(|held| self.is_shared(held))
                         .cloned()
                         .collect();
-                    self.acquire_moving_in(&zone, &moving_in).await?;
+                    let arm = self.arm.clone();
+                    let given_up = self
+                        .link
+                        .acquire_stopping(zone.as_str(), &moving_in, || stop(arm.clone()))
+                        .await
+                        .map_err(|refused| unexpected(&zone, refused))?;
+                    lock(&self.stats).rights_given_up += given_up.len() as u32;
+                    self.reacquire_shared(given_up).await?;
                     pipeline.granted(zone);
+                    // CONTINUE, if it was stopped: where it stands allows nothing new.
+                    self.arm.allow(self.arm.at());
                 }
                 Next::Move { point, release } => {
-                    let ahead = &points[at..(at + LOOKAHEAD).min(points.len())];
-                    if let Some(leg) = self.clear(ahead, &to, &pipeline, may_back_off).await? {
-                        self.abandon(&pipeline).await?;
-                        return Ok(leg);
+                    if self.mechanisms.geometric {
+                        let reach = (next + pipeline.offset() + LOOKAHEAD).min(points.len());
+                        let ahead = &points[next..reach];
+                        if let Some(leg) = self.clear(ahead, &to, &pipeline, may_back_off).await? {
+                            self.abandon(&pipeline).await?;
+                            return Ok(leg);
+                        }
                     }
-                    self.arm
-                        .move_to(Point2::new(point[0], point[1]))
-                        .await
-                        .map_err(|error| error.to_string())?;
-                    self.tell_position().await?;
-                    // Only now, at the point, has the gripper left these zones.
-                    for zone in release {
-                        self.tell(Message::Release(zone)).await?;
-                    }
-                    at += 1;
+                    let point = Point2::new(point[0], point[1]);
+                    self.arm.allow(point);
+                    allowed.push_back(((point - from).norm(), release));
+                    next += 1;
                 }
                 Next::End => {
+                    // Allowed to its end, the controller stops there.
+                    while !self.arm.progress().arrived() {
+                        self.arm.step().await;
+                        self.track(&mut allowed).await?;
+                    }
+                    self.track(&mut allowed).await?;
                     // Stopped in a shared zone: another may move there now.
                     for zone in self.zones_at(to) {
                         if self.is_shared(&zone) {
@@ -334,6 +387,39 @@ impl Driver {
                 }
             }
         }
+    }
+
+    /// Tells the coordinator what the arm did since it last told: where its links are, if
+    /// it moved, and the zones it has left at each allowed point it reached.
+    async fn track(&mut self, allowed: &mut VecDeque<(f32, Vec<Name>)>) -> Result<(), String> {
+        if self.last_told != Some(self.arm.at()) {
+            self.tell_position().await?;
+        }
+        let along = self.arm.progress().along;
+        while allowed
+            .front()
+            .is_some_and(|(point, _)| along >= point - REACHED)
+        {
+            let Some((_, release)) = allowed.pop_front() else {
+                break;
+            };
+            for zone in release {
+                self.tell(Message::Release(zone)).await?;
+            }
+        }
+        Ok(())
+    }
+
+    /// STOP_C for an arm in the way: brakes, telling where it is as it goes.
+    async fn halt(&mut self) -> Result<(), String> {
+        self.arm.halt();
+        while !self.arm.progress().at_rest() {
+            self.arm.step().await;
+            if self.last_told != Some(self.arm.at()) {
+                self.tell_position().await?;
+            }
+        }
+        Ok(())
     }
 
     /// Waits until the arm's links at `ahead` keep clear of every other arm (as the
@@ -371,6 +457,9 @@ impl Driver {
             }
             if waited.is_zero() {
                 lock(&self.stats).geometric_blocks += 1;
+                // It cannot stop at once: it brakes along the points it was allowed, which
+                // were checked with its stopping distance to spare.
+                self.halt().await?;
             }
             // Whatever it holds and is not inside, and its right to move where it is in a
             // shared zone, it frees while it waits — every time it finds itself blocked,

@@ -26,6 +26,9 @@ const FORE: f32 = 0.35;
 const WORK_REACH: f64 = 0.7;
 /// The nominal tool speed (a robot of speed 1), in m/s.
 const NOMINAL_SPEED: f64 = 0.5;
+/// How fast every arm speeds up and brakes, in m/s²: stopping from its top speed takes it
+/// 3 to 9 cm.
+pub const ACCELERATION: f32 = 2.5;
 
 struct Side {
     name: &'static str,
@@ -88,6 +91,7 @@ pub fn layout() -> TableLayout {
                 },
                 home: home(side.base),
                 speed: (NOMINAL_SPEED * side.speed) as f32,
+                acceleration: ACCELERATION,
             })
             .collect(),
         zones: vec![
@@ -137,5 +141,6 @@ pub fn workcell() -> Workcell {
             radius: 0.08 * std::f64::consts::SQRT_2,
         }],
         travel: NOMINAL_SPEED,
+        acceleration: f64::from(ACCELERATION),
     }
 }

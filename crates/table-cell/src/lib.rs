@@ -27,14 +27,15 @@
 //! did, deadlocks included.
 //!
 //! ```no_run
-//! use table_cell::{Assignment, CellConfig, run};
+//! use table_cell::{CellConfig, run};
 //!
-//! let report = run(&CellConfig { seed: 1, hours: 1.0, assignment: Assignment::RunTime })?;
+//! let report = run(&CellConfig::new(1, 1.0))?;
 //! assert!(report.measured.collisions.is_empty());
 //! println!("{report}");
 //! # Ok::<(), table_cell::CellError>(())
 //! ```
 
+mod ablation;
 mod arm;
 mod layout;
 mod report;
@@ -49,11 +50,14 @@ use imrs_core::prelude::*;
 use imrs_ports::{Instant, SharedClock, VirtualClock};
 use imrs_sim::table::{LINK_RADIUS, Table, TableError, ZoneSpec, ZoneUse};
 
-pub use self::layout::{FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell};
+pub use self::ablation::{Ablation, AblationRow, ablation};
+pub use self::layout::{
+    ACCELERATION, FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell,
+};
 pub use self::report::Report;
 pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
 
-use self::arm::{MARGIN, arm_module};
+use self::arm::{MARGIN, Mechanisms, arm_module};
 use self::schedule::{job_port, scheduler};
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
 use imrs_coord::network::{Bus, Placement, report};
@@ -86,6 +90,46 @@ impl fmt::Display for Assignment {
     }
 }
 
+/// Which of the seed's mechanisms keep the arms apart: the rows of the ablation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coordination {
+    /// Zones only: an arm asks for a zone as it is about to move towards it (the pipeline's
+    /// offset 0), and nothing checks its way against the other arms.
+    ZonesOnly,
+    /// Zones through the pipeline, its offset computed from each arm's stopping distance;
+    /// nothing checks the way against the other arms.
+    Pipeline,
+    /// Zones through the pipeline with an offset chosen, in points, whatever the arm needs
+    /// to stop: a negative control.
+    PipelineOffset(usize),
+    /// The pipeline, and the coordinator checks each arm's way ahead against where the
+    /// others told it they are, and computes the alternative trajectory round them.
+    Full,
+}
+
+impl fmt::Display for Coordination {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::ZonesOnly => f.write_str("zones only"),
+            Self::Pipeline => f.write_str("zones + pipeline"),
+            Self::PipelineOffset(offset) => write!(f, "zones + pipeline, offset {offset}"),
+            Self::Full => f.write_str("zones + pipeline + geometric check"),
+        }
+    }
+}
+
+impl Coordination {
+    fn mechanisms(self) -> Mechanisms {
+        let (offset, geometric) = match self {
+            Self::ZonesOnly => (Some(0), false),
+            Self::Pipeline => (None, false),
+            Self::PipelineOffset(offset) => (Some(offset), false),
+            Self::Full => (None, true),
+        };
+        Mechanisms { offset, geometric }
+    }
+}
+
 /// A run of the table cell.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellConfig {
@@ -95,6 +139,21 @@ pub struct CellConfig {
     pub hours: f64,
     /// Who decides which arm does what.
     pub assignment: Assignment,
+    /// Which mechanisms keep the arms apart.
+    pub coordination: Coordination,
+}
+
+impl CellConfig {
+    /// A run of `hours` on the arrivals of `seed`, with every mechanism: the run-time
+    /// scheduler and [`Coordination::Full`].
+    pub fn new(seed: u64, hours: f64) -> Self {
+        Self {
+            seed,
+            hours,
+            assignment: Assignment::RunTime,
+            coordination: Coordination::Full,
+        }
+    }
 }
 
 /// Why a run could not be made.
@@ -219,13 +278,16 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
     ))?;
     for (index, spec) in layout.arms.iter().enumerate() {
         start(arm_module(
-            table.arm(spec.name.as_str()).map_err(CellError::Table)?,
-            spec,
-            index,
+            (
+                table.arm(spec.name.as_str()).map_err(CellError::Table)?,
+                spec,
+                index,
+            ),
             &coordinator_ports,
             &jobs,
             Arc::clone(&zones),
             Arc::clone(&stats),
+            config.coordination.mechanisms(),
         ))?;
     }
 

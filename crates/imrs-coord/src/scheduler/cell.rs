@@ -95,6 +95,20 @@ pub(crate) fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
+impl Workcell {
+    /// How long a robot of speed `speed` takes to travel `distance` m from rest to rest:
+    /// up to its top speed and down again at the cell's acceleration, or, on a move too
+    /// short to reach it, speeding up half the way and braking the other half.
+    pub fn travel_time(&self, distance: f64, speed: f64) -> f64 {
+        let (top, a) = (self.travel * speed, self.acceleration);
+        if distance >= top * top / a {
+            distance / top + top / a
+        } else {
+            2.0 * (distance / a).sqrt()
+        }
+    }
+}
+
 /// A cell: its robots, the tasks of one unit, the kinds of part, and its shared zones.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Workcell {
@@ -108,6 +122,8 @@ pub struct Workcell {
     pub zones: Vec<Zone>,
     /// How fast a robot of speed 1 travels, in m/s.
     pub travel: f64,
+    /// How fast a robot speeds up and brakes, in m/s² (infinite: at once).
+    pub acceleration: f64,
 }
 
 impl Workcell {
@@ -144,6 +160,7 @@ impl Workcell {
                 radius: 0.15,
             }],
             travel: 0.5,
+            acceleration: f64::INFINITY,
         }
     }
 }

@@ -100,7 +100,9 @@ impl<'a> State<'a> {
             &self.cell.robots[robot],
             &self.progress.robots[robot],
         );
-        let travel = distance(state.at, spec.at) / (self.cell.travel * who.speed);
+        let travel = self
+            .cell
+            .travel_time(distance(state.at, spec.at), who.speed);
         let arrive = self.progress.now.max(state.free_at) + travel;
         let start = match self.cell.zone_of(spec.at) {
             Some(zone) => arrive.max(self.progress.zone_free_at[zone]),

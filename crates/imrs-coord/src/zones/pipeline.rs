@@ -56,6 +56,14 @@ impl Pipeline {
         }
     }
 
+    /// The same pipeline with an offset chosen rather than computed from the arm's
+    /// stopping distance: 0 checks a point only as the arm is about to move towards it (a
+    /// zone asked for at its border), and one too small is a negative control.
+    pub fn with_offset(mut self, offset: usize) -> Self {
+        self.offset = offset;
+        self
+    }
+
     /// The points between the one acted on and the one checked.
     pub fn offset(&self) -> usize {
         self.offset

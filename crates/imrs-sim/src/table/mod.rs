@@ -1,8 +1,11 @@
 //! A table of SCARA arms sharing zones and a tool, in a rapier3d world stepped on the
 //! framework clock: the physical side of a coordinated cell (Jiménez et al. 1992).
 //!
-//! Each arm moves its tool in straight lines at its own speed; its links are placed by its
-//! kinematics ([`Scara`], on nalgebra) at every step. Rapier measures what the coordination
+//! Each arm drives its tool along straight legs at its own top speed, speeding up and
+//! braking at its own limit: its dynamic controller stops at a leg's end as planned, but
+//! goes only as far as it is allowed, and beyond the last point allowed it needs its
+//! stopping distance to stop ([`TableArm::allow`], [`TableArm::halt`]). Its links are
+//! placed by its kinematics ([`Scara`], on nalgebra) at every step. Rapier measures what the coordination
 //! must guarantee: whether the links of two arms touched, how close they came, and which
 //! grippers were inside which zone, moving or still — an exclusive zone with two grippers
 //! in it, or a shared zone with two moving in it, is a conflict. The tool is a body of its
@@ -25,6 +28,7 @@
 //!         arm: Scara { base: Point2::new(-0.6, 0.0), upper: 0.4, fore: 0.35, side: Elbow::Left },
 //!         home: Point2::new(-0.3, 0.0),
 //!         speed: 0.5,
+//!         acceleration: 2.5,
 //!     }],
 //!     zones: vec![ZoneSpec {
 //!         name: "FIXTURE".into(),
@@ -54,6 +58,7 @@
 //! # }
 //! ```
 
+mod drive;
 mod physics;
 mod world;
 
@@ -68,6 +73,7 @@ use tokio::sync::Notify;
 use self::world::TableWorld;
 use crate::scara::Scara;
 
+pub use self::drive::Progress;
 pub use self::physics::{GRIPPER_RADIUS, LINK_RADIUS, WORK_Z};
 
 /// The step of the table's world: 50 Hz, so that a tool at 1 m/s moves 2 cm a step.
@@ -84,8 +90,10 @@ pub struct ArmSpec {
     pub arm: Scara,
     /// Where its tool rests at the start.
     pub home: Point2<f32>,
-    /// Its tool's speed, in m/s.
+    /// Its tool's top speed, in m/s.
     pub speed: f32,
+    /// How fast it speeds up and brakes, in m/s².
+    pub acceleration: f32,
 }
 
 /// How a zone may be shared: what rapier counts as a conflict in it.
@@ -160,6 +168,13 @@ pub enum TableError {
         /// How far the gripper is from the tool, in metres.
         distance: f32,
     },
+    /// A leg was started while the arm still moved: a leg starts from rest.
+    Moving {
+        /// The arm.
+        arm: Name,
+        /// Its speed, in m/s.
+        speed: f32,
+    },
     /// The arm put down a tool it did not hold.
     NotHolding {
         /// The arm.
@@ -182,6 +197,10 @@ impl fmt::Display for TableError {
                 f,
                 "{arm} found no tool to grasp: it lies {distance:.3} m from the gripper"
             ),
+            Self::Moving { arm, speed } => write!(
+                f,
+                "{arm} still moves at {speed:.3} m/s: a leg starts from rest"
+            ),
             Self::NotHolding { arm } => write!(f, "{arm} holds no tool to put down"),
             Self::Layout(why) => write!(f, "the table's layout cannot be built: {why}"),
         }
@@ -201,11 +220,15 @@ struct Shared {
     world: Mutex<TableWorld>,
     clock: SharedClock,
     activity: Notify,
+    /// Each step taken, for arms waiting on their progress. (A `Notify`, whose waiters
+    /// wake in the order they came: a cell runs the same way every time.)
+    stepped: Notify,
 }
 
 impl Table {
     /// The table of `layout`, on `clock`; refused, naming what is wrong, if two arms share
-    /// a name, an arm's home is out of its reach, or a speed is not positive. Nothing moves
+    /// a name, an arm's home is out of its reach, or a speed or acceleration is not
+    /// positive. Nothing moves
     /// until [`Table::run`] runs.
     pub fn new(layout: TableLayout, clock: SharedClock) -> Result<Self, TableError> {
         for (index, arm) in layout.arms.iter().enumerate() {
@@ -230,6 +253,12 @@ impl Table {
                     arm.name, arm.speed
                 )));
             }
+            if !(arm.acceleration.is_finite() && arm.acceleration > 0.0) {
+                return Err(TableError::Layout(format!(
+                    "{}'s acceleration {} m/s² is not a positive number",
+                    arm.name, arm.acceleration
+                )));
+            }
         }
         Ok(Self {
             shared: Arc::new(Shared {
@@ -237,6 +266,7 @@ impl Table {
                 layout,
                 clock,
                 activity: Notify::new(),
+                stepped: Notify::new(),
             }),
         })
     }
@@ -270,6 +300,7 @@ impl Table {
             clock.sleep_until(next).await;
             let elapsed = last.map_or(STEP, |last| next.saturating_duration_since(last).min(STEP));
             self.world().step(next, elapsed);
+            self.shared.stepped.notify_waiters();
             last = Some(next);
         }
     }
@@ -298,13 +329,12 @@ impl Table {
     /// for measuring and showing the cell. A module of the cell is given its own arm
     /// ([`Table::arm`]) and learns where the others are only from them, through its ports.
     pub fn joints(&self) -> Vec<(Name, [Point2<f32>; 3])> {
-        let now = self.shared.clock.now();
         let world = self.world();
         world
             .arms
             .iter()
             .filter_map(|arm| {
-                let joints = arm.scara().joints(&arm.tool_at(now))?;
+                let joints = arm.scara().joints(&arm.tool())?;
                 Some((arm.spec.name.clone(), joints))
             })
             .collect()
@@ -340,26 +370,86 @@ impl TableArm {
 
     /// Where its tool is now.
     pub fn at(&self) -> Point2<f32> {
-        let now = self.table.shared.clock.now();
-        self.table.world().arms[self.index].tool_at(now)
+        self.table.world().arms[self.index].tool()
     }
 
-    /// Moves the tool in a straight line to `to` at the arm's speed; refused at once if `to`
-    /// is out of reach.
+    /// Moves the tool in a straight line to `to` and stops there: a leg allowed to its end
+    /// ([`TableArm::start_leg`], [`TableArm::allow`]). Refused at once if `to` is out of
+    /// reach or the arm still moves.
     pub async fn move_to(&self, to: Point2<f32>) -> Result<(), TableError> {
+        self.start_leg(to)?;
+        self.allow(to);
+        while !self.step().await.arrived() {}
+        Ok(())
+    }
+
+    /// Starts a straight leg from where the tool stands to `to`, allowed nowhere yet: the arm
+    /// moves once it is allowed points of it. Refused if `to` is out of reach, or if the
+    /// arm still moves (a leg starts from rest).
+    pub fn start_leg(&self, to: Point2<f32>) -> Result<(), TableError> {
         if !self.scara().reaches(&to) {
             return Err(TableError::OutOfReach {
                 arm: self.name().clone(),
                 target: [to.x, to.y],
             });
         }
-        let clock = &self.table.shared.clock;
-        let end = self.table.world().start_move(self.index, to, clock.now());
-        self.table.shared.activity.notify_one();
-        clock.sleep_until(end).await;
-        self.table.world().settle(self.index, end);
+        self.table
+            .world()
+            .start_leg(self.index, to)
+            .map_err(|speed| TableError::Moving {
+                arm: self.name().clone(),
+                speed,
+            })?;
         self.table.shared.activity.notify_one();
         Ok(())
+    }
+
+    /// Allows the arm as far as `point` of its leg (taken where it lies along the leg), and
+    /// lifts a halt: the seed's TRAJECTORY_POINT, and CONTINUE. It does not plan to stop at
+    /// the last point allowed: there it brakes, and goes on by its stopping distance.
+    pub fn allow(&self, point: Point2<f32>) {
+        if let Some(drive) = &mut self.table.world().arms[self.index].drive {
+            drive.allow(point);
+        }
+        self.table.shared.activity.notify_one();
+    }
+
+    /// STOP_C: the arm brakes at once, whatever it was allowed.
+    pub fn halt(&self) {
+        if let Some(drive) = &mut self.table.world().arms[self.index].drive {
+            drive.halt();
+        }
+    }
+
+    /// Its progress along the leg it drives; at rest at the end of its last leg if it
+    /// drives none.
+    pub fn progress(&self) -> Progress {
+        let world = self.table.world();
+        let state = &world.arms[self.index];
+        state.drive.map_or(
+            Progress {
+                along: 0.0,
+                length: 0.0,
+                speed: 0.0,
+                allowed: 0.0,
+                halted: false,
+            },
+            |drive| drive.progress(),
+        )
+    }
+
+    /// Its progress after the world's next step, or now if it stands still and may not
+    /// move (a step would not change it).
+    pub async fn step(&self) -> Progress {
+        // Woken by every step from its creation on, before it is first polled.
+        let stepped = self.table.shared.stepped.notified();
+        let can_move = self.table.world().arms[self.index]
+            .drive
+            .is_some_and(|drive| drive.can_move());
+        if can_move {
+            stepped.await;
+        }
+        self.progress()
     }
 
     /// Grasps the tool, if rapier finds it within [`GRASP_REACH`] of the gripper and no
@@ -367,7 +457,7 @@ impl TableArm {
     pub fn grasp_tool(&self) -> Result<(), TableError> {
         let now = self.table.shared.clock.now();
         let mut world = self.table.world();
-        world.place_arm(self.index, now);
+        world.place_arm(self.index);
         let distance = world.gripper_to_tool(self.index);
         let free = world.holder.is_none_or(|holder| holder == self.index);
         if distance > GRASP_REACH || !free {
@@ -386,14 +476,13 @@ impl TableArm {
 
     /// Puts the tool down where the gripper is.
     pub fn put_tool(&self) -> Result<(), TableError> {
-        let now = self.table.shared.clock.now();
         let mut world = self.table.world();
         if world.holder != Some(self.index) {
             return Err(TableError::NotHolding {
                 arm: self.name().clone(),
             });
         }
-        world.place_arm(self.index, now);
+        world.place_arm(self.index);
         world.holder = None;
         Ok(())
     }

@@ -7,38 +7,18 @@ use imrs_ports::{Instant, Name};
 use nalgebra::Point2;
 use rapier3d::prelude::ColliderHandle;
 
+use super::drive::Drive;
 use super::physics::TablePhysics;
 use super::{ArmSpec, Measured, TableLayout, ZoneUse};
 use crate::scara::Scara;
 
-/// A straight move of the tool at the arm's speed.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Motion {
-    from: Point2<f32>,
-    to: Point2<f32>,
-    start: Instant,
-    end: Instant,
-}
-
-impl Motion {
-    fn at(&self, now: Instant) -> Point2<f32> {
-        let total = self.end.saturating_duration_since(self.start).as_secs_f32();
-        if total <= 0.0 {
-            return self.to;
-        }
-        let share = (now.saturating_duration_since(self.start).as_secs_f32() / total).min(1.0);
-        self.from + (self.to - self.from) * share
-    }
-}
-
 pub(crate) struct TableArmState {
     pub(crate) spec: ArmSpec,
+    /// Where the tool rests when it drives no leg.
     tool: Point2<f32>,
-    motion: Option<Motion>,
-    /// Its moves that ended since the last step: (start, end).
-    ended: Vec<(Instant, Instant)>,
-    /// When it moved during the last step: its moves, cut to the step.
-    moving: Vec<(Instant, Instant)>,
+    pub(crate) drive: Option<Drive>,
+    /// Whether it moved during the last step.
+    moved: bool,
     links: [ColliderHandle; 2],
     gripper: ColliderHandle,
 }
@@ -48,8 +28,25 @@ impl TableArmState {
         self.spec.arm
     }
 
-    pub(crate) fn tool_at(&self, now: Instant) -> Point2<f32> {
-        self.motion.map_or(self.tool, |motion| motion.at(now))
+    pub(crate) fn tool(&self) -> Point2<f32> {
+        self.drive.map_or(self.tool, |drive| drive.tool())
+    }
+
+    fn can_move(&self) -> bool {
+        self.drive.is_some_and(|drive| drive.can_move())
+    }
+
+    /// One step of its controller; whether it moved. A leg driven to its end is done.
+    fn step(&mut self, dt: f32) -> bool {
+        let Some(drive) = &mut self.drive else {
+            return false;
+        };
+        let moved = drive.step(dt, self.spec.speed, self.spec.acceleration);
+        if drive.arrived() {
+            self.tool = drive.tool();
+            self.drive = None;
+        }
+        moved
     }
 }
 
@@ -83,9 +80,8 @@ impl TableWorld {
             .map(|spec| TableArmState {
                 spec: spec.clone(),
                 tool: spec.home,
-                motion: None,
-                ended: Vec::new(),
-                moving: Vec::new(),
+                drive: None,
+                moved: false,
                 links: [
                     physics.add_link(spec.arm.upper),
                     physics.add_link(spec.arm.fore),
@@ -123,40 +119,26 @@ impl TableWorld {
     }
 
     pub(crate) fn is_active(&self) -> bool {
-        self.dirty || self.arms.iter().any(|arm| arm.motion.is_some())
+        self.dirty || self.arms.iter().any(TableArmState::can_move)
     }
 
-    pub(crate) fn start_move(&mut self, arm: usize, to: Point2<f32>, now: Instant) -> Instant {
+    /// Starts arm `arm` on a leg to `to`, from where it stands; refused while it moves.
+    pub(crate) fn start_leg(&mut self, arm: usize, to: Point2<f32>) -> Result<(), f32> {
         let state = &mut self.arms[arm];
-        let from = state.tool_at(now);
-        let seconds = (to - from).norm() / state.spec.speed;
-        let end = now + Duration::from_secs_f32(seconds);
-        state.motion = Some(Motion {
-            from,
-            to,
-            start: now,
-            end,
-        });
-        self.dirty = true;
-        end
-    }
-
-    /// Ends arm `arm`'s move if its time is up.
-    pub(crate) fn settle(&mut self, arm: usize, now: Instant) {
-        let state = &mut self.arms[arm];
-        if let Some(motion) = state.motion.filter(|motion| motion.end <= now) {
-            state.tool = motion.to;
-            state.motion = None;
-            state.ended.push((motion.start, motion.end));
-            self.dirty = true;
+        if let Some(drive) = state.drive.filter(|drive| !drive.progress().at_rest()) {
+            return Err(drive.progress().speed);
         }
+        state.tool = state.tool();
+        state.drive = Some(Drive::new(state.tool, to));
+        self.dirty = true;
+        Ok(())
     }
 
     /// Places arm `arm`'s links and gripper as they are at `now`, and the tool with them if
     /// it holds it.
-    pub(crate) fn place_arm(&mut self, arm: usize, now: Instant) {
+    pub(crate) fn place_arm(&mut self, arm: usize) {
         let state = &self.arms[arm];
-        let tool = state.tool_at(now);
+        let tool = state.tool();
         // A straight path that grazes the dead zone round the base keeps the last
         // placement for that step; both its ends are within reach.
         if let Some([base, elbow, tool]) = state.spec.arm.joints(&tool) {
@@ -179,24 +161,15 @@ impl TableWorld {
         self.physics.distance(self.arms[arm].gripper, self.tool)
     }
 
-    /// Places every arm as it is at `now`, runs rapier's detection, and measures: links of
-    /// two arms touching, the closest they came, and zones in conflict.
+    /// Steps every arm's controller by `elapsed`, places the arms, runs rapier's detection,
+    /// and measures: links of two arms touching, the closest they came, and zones in
+    /// conflict.
     pub(crate) fn step(&mut self, now: Instant, elapsed: Duration) {
+        let dt = elapsed.as_secs_f32();
         for arm in 0..self.arms.len() {
-            self.settle(arm, now);
-        }
-        let since = Instant::from_start(now.since_start().saturating_sub(elapsed));
-        for arm in 0..self.arms.len() {
-            self.place_arm(arm, now);
-            let state = &mut self.arms[arm];
-            let current = state.motion.map(|motion| (motion.start, now));
-            state.moving = state
-                .ended
-                .drain(..)
-                .chain(current)
-                .map(|(start, end)| (start.max(since), end.min(now)))
-                .filter(|(start, end)| start < end)
-                .collect();
+            let moved = self.arms[arm].step(dt);
+            self.arms[arm].moved = moved;
+            self.place_arm(arm);
         }
         self.physics.detect();
         self.measured.steps += 1;
@@ -245,13 +218,9 @@ impl TableWorld {
             }
             let conflict = match zone.usage {
                 ZoneUse::Exclusive => inside.len() > 1,
-                // Two moving at the same time: their moves in the step overlap. (One that
-                // stops as the other starts, within a step, is not a conflict.)
-                ZoneUse::Shared => inside.iter().enumerate().any(|(i, a)| {
-                    inside[i + 1..]
-                        .iter()
-                        .any(|b| overlap(&a.moving, &b.moving))
-                }),
+                // Two that moved in the same step. (One that stops as the other starts is
+                // seen moving in different steps: no conflict.)
+                ZoneUse::Shared => inside.iter().filter(|arm| arm.moved).count() > 1,
             };
             if conflict && !zone.in_conflict {
                 self.measured.zone_conflicts.push((
@@ -263,10 +232,4 @@ impl TableWorld {
             zone.in_conflict = conflict;
         }
     }
-}
-
-/// Whether two sets of intervals overlap for a positive time.
-fn overlap(a: &[(Instant, Instant)], b: &[(Instant, Instant)]) -> bool {
-    a.iter()
-        .any(|&(s1, e1)| b.iter().any(|&(s2, e2)| s1.max(s2) < e1.min(e2)))
 }
