@@ -4,8 +4,9 @@
 //!
 //! The controller is told the leg (the trajectory) when it starts, but may go only as far as
 //! the last point allowed (the seed's TRAJECTORY_POINT). It does not plan to stop there:
-//! once it reaches that point with no other allowed, or when it is halted (STOP_C), it
-//! brakes, and goes on along the leg by its stopping distance, `v² / 2a`. That is why an arm
+//! from the step in which it reaches that point with no other allowed, or is halted
+//! (STOP_C), it brakes, and goes on along the leg by its stopping distance, `v² / 2a`, and
+//! by up to a step's travel more, since it looks at the start of each step. That is why an arm
 //! is allowed points only `offset` ahead of a point checked: the offset covers what it needs
 //! to stop.
 
