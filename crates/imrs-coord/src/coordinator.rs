@@ -10,7 +10,9 @@
 //! | alarm: an emergency stop reaches every robot | `EMERGENCY`, a `sendall` | coordinator → every robot |
 //!
 //! After every sleep it looks for deadlocks among the robots asleep, over exclusive zones,
-//! tools and rights to move in shared zones; each victim is told to back off. A robot's way is checked against the other robots where *they said* they
+//! tools and rights to move in shared zones; each victim is told to back off. A way it
+//! finds blocked by a robot asleep at a border that waits for what the blocked robot holds
+//! is a deadlock too, of space and zones: the sleeper is told to back off. A robot's way is checked against the other robots where *they said* they
 //! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -231,15 +233,17 @@ impl RobotLink {
 
     /// Asks for `zone` (or a tool) while the robot moves, as its pipeline asks for a point
     /// ahead; granted, it goes on. Told to sleep, it stops (`stopped` halts it and resolves
-    /// once it stands still): an arm cannot stop at once, and keeps its right to move in the
-    /// shared zones `moving_in` while it brakes in them. Stopped, it gives each up with a
-    /// position message, as the seed's robot does, waits to be woken, and asks again.
+    /// once it stands still, to where its links are then, if it can say): an arm cannot
+    /// stop at once, and keeps its right to move in the shared zones `moving_in` while it
+    /// brakes in them. Stopped, it tells where it is (position information), gives each
+    /// right up with a position message, as the seed's robot does, waits to be woken, and
+    /// asks again.
     /// Returns the zones it gave up, for it to ask again before it moves.
     ///
     /// From the sleep until the wake-up, every message it sends is sent while it listens for
     /// the wake-up: the coordinator waits for a robot it wakes, and one that waited for the
     /// coordinator in turn would leave both waiting.
-    pub async fn acquire_stopping<F: Future<Output = ()>>(
+    pub async fn acquire_stopping<F: Future<Output = Option<Pose>>>(
         &mut self,
         zone: &str,
         moving_in: &[Name],
@@ -269,9 +273,9 @@ impl RobotLink {
                 tokio::select! {
                     biased;
                     woken = self.wake.receive() => woken,
-                    () = stop => {
+                    pose = stop => {
                         at_rest = true;
-                        self.give_up_stopped(moving_in, &mut given_up).await?
+                        self.give_up_stopped(pose, moving_in, &mut given_up).await?
                     }
                 }
             };
@@ -283,13 +287,28 @@ impl RobotLink {
         }
     }
 
-    /// Stopped while asleep: gives up the right to move in each of `moving_in`, a position
-    /// message each, listening for the wake-up meanwhile; then waits for it.
+    /// Stopped while asleep at `pose`: tells where it is, and gives up the right to move in
+    /// each of `moving_in`, a position message each, listening for the wake-up meanwhile;
+    /// then waits for it. A message answered counts even if the wake-up came as well: the
+    /// coordinator has acted on it.
     async fn give_up_stopped(
         &mut self,
+        pose: Option<Pose>,
         moving_in: &[Name],
         given_up: &mut Vec<Name>,
     ) -> Result<Woken, Refused> {
+        if let Some(pose) = pose {
+            let at = (self.robot.clone(), Geometry::At(pose));
+            tokio::select! {
+                biased;
+                told = self.space.send(at) => {
+                    told
+                        .map_err(|error| Refused::Failed(error.to_string()))?
+                        .map_err(Refused::Failed)?;
+                }
+                woken = self.wake.receive() => return Ok(woken),
+            }
+        }
         for shared in moving_in {
             let position = (self.robot.clone(), Message::Position(shared.clone()));
             tokio::select! {
@@ -375,6 +394,9 @@ pub struct CoordinatorLog {
     pub slept: u32,
     /// Deadlocks found and resolved, with their victims.
     pub deadlocks: Vec<Name>,
+    /// Deadlocks of space and zones found and resolved, with their victims: a robot asleep
+    /// at a border in the way of one that holds what it waits for, told to back off.
+    pub in_the_way: Vec<Name>,
     /// Alarms, each passed on to every robot.
     pub alarms: Vec<(Name, String)>,
     /// Messages it could not take (unknown zone or robot), named.
@@ -448,7 +470,36 @@ pub fn coordinator(
                         if let Err(error) = &seen {
                             lock(&log).refused.push(error.to_string());
                         }
+                        // A robot asleep at a border, in the way of one that holds what it
+                        // waits for: neither can go on. The sleeper is the victim: stopped
+                        // and waiting for nothing else, it can get out of the way.
+                        let victims: Vec<Name> = match &seen {
+                            Ok(Seen::Blocked(blocking)) => {
+                                let table = lock(&table);
+                                blocking
+                                    .iter()
+                                    .filter(|other| asleep.contains(*other))
+                                    .filter(|other| {
+                                        table.waits_on(other.as_str(), robot.as_str(), |r| {
+                                            asleep.contains(r)
+                                        })
+                                    })
+                                    .cloned()
+                                    .collect()
+                            }
+                            _ => Vec::new(),
+                        };
                         reply.reply(seen.map_err(|error| error.to_string()));
+                        for victim in victims {
+                            let woken = lock(&table)
+                                .stop_waiting(victim.as_str())
+                                .unwrap_or_default();
+                            lock(&log).in_the_way.push(victim.clone());
+                            wake_up(&mut wake, &mut asleep, &victim, Wake::BackOff).await;
+                            for robot in woken {
+                                wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
+                            }
+                        }
                     }
                     Event::Alarm(robot, text) => {
                         lock(&log).alarms.push((robot.clone(), text.clone()));

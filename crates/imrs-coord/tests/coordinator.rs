@@ -445,7 +445,10 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                 ctx.delay(Duration::from_millis(100)).await;
                 let braking = &ctx;
                 let gave = link
-                    .acquire_stopping("FIXTURE", &["PASSAGE".into()], || braking.delay(BRAKING))
+                    .acquire_stopping("FIXTURE", &["PASSAGE".into()], || async {
+                        braking.delay(BRAKING).await;
+                        None
+                    })
                     .await
                     .map_err(|e| format!("{e:?}"))?;
                 granted.lock().unwrap().1 = Some(seconds(&ctx));
@@ -626,4 +629,99 @@ async fn a_robot_woken_twice_before_it_asks_again_is_not_waited_for() {
         assert_eq!(finished.ok(), Some(ModuleOutcome::Finished));
     }
     assert_eq!(*moved.lock().unwrap(), Some(1.0));
+}
+
+/// ROBOT_A is in FIXTURE. ROBOT_B says it stands across A's way out, and asks for `wants`
+/// (FIXTURE, or TRAY, which ROBOT_C holds for 3 s): it sleeps. A then checks its way out.
+/// Returns what A's check found, what B heard, and the coordinator's log.
+async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, String, CoordinatorLog) {
+    let (cell, clock, ports, log) = start();
+    let found = Arc::new(Mutex::new(Vec::new()));
+    let heard = Arc::new(Mutex::new(String::new()));
+    let c = {
+        let ports = ports.clone();
+        ModuleSpec::new("ROBOT_C", ()).task("ROBOT_C", move |ctx| {
+            let ports = ports.clone();
+            async move {
+                let mut link = ports.link("ROBOT_C")?;
+                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(3)).await;
+                link.tell(Message::Release("TRAY".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let a = {
+        let (ports, found) = (ports.clone(), Arc::clone(&found));
+        ModuleSpec::new("ROBOT_A", ()).task("ROBOT_A", move |ctx| {
+            let (ports, found) = (ports.clone(), Arc::clone(&found));
+            async move {
+                let mut link = ports.link("ROBOT_A")?;
+                link.acquire("FIXTURE")
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_secs(1)).await;
+                let blocked = link
+                    .check(vec![along(0.05)])
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                found
+                    .lock()
+                    .unwrap()
+                    .extend(blocked.iter().map(ToString::to_string));
+                ctx.delay(Duration::from_secs(1)).await;
+                link.tell(Message::Release("FIXTURE".into()))
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                Ok(())
+            }
+        })
+    };
+    let b = {
+        let heard = Arc::clone(&heard);
+        ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
+            let (ports, heard) = (ports.clone(), Arc::clone(&heard));
+            async move {
+                let mut link = ports.link("ROBOT_B")?;
+                ctx.delay(Duration::from_millis(500)).await;
+                // Its arm reaches across the line y = 0.05.
+                link.at([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]])
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                let asked = link.acquire(wants).await;
+                *heard.lock().unwrap() = format!("{asked:?}");
+                Ok(())
+            }
+        })
+    };
+    let mut robots = [
+        cell.start(c).unwrap(),
+        cell.start(a).unwrap(),
+        cell.start(b).unwrap(),
+    ];
+    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
+    for robot in &mut robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+    let found = found.lock().unwrap().clone();
+    let heard = heard.lock().unwrap().clone();
+    let log = log.lock().unwrap().clone();
+    (found, heard, log)
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_robot_asleep_in_the_way_of_the_one_it_waits_for_is_told_to_back_off() {
+    // B sleeps on FIXTURE, which A holds, across A's way out: neither could go on.
+    let (found, heard, log) = asleep_in_the_way("FIXTURE").await;
+    assert_eq!(found, ["ROBOT_B"]);
+    assert_eq!(heard, "Err(BackOff)");
+    assert_eq!(log.in_the_way, ["ROBOT_B"]);
+    // B sleeps on TRAY, which C holds: A waits for B's space, B for C, C for nothing. Not a
+    // deadlock: B is granted once C leaves.
+    let (found, heard, log) = asleep_in_the_way("TRAY").await;
+    assert_eq!(found, ["ROBOT_B"]);
+    assert_eq!(heard, "Ok(())");
+    assert!(log.in_the_way.is_empty(), "{:?}", log.in_the_way);
 }

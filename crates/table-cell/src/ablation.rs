@@ -45,11 +45,13 @@ impl AblationRow {
             .min_by(f32::total_cmp)
     }
 
-    /// Deadlocks the coordinator found and resolved, over every seed.
+    /// Deadlocks the coordinator found and resolved, over every seed: of zones and the
+    /// tool, and of space and zones (an arm asleep at a border in the way of one it waits
+    /// for).
     pub fn deadlocks(&self) -> usize {
         self.reports
             .iter()
-            .map(|r| r.coordinator.deadlocks.len())
+            .map(|r| r.coordinator.deadlocks.len() + r.coordinator.in_the_way.len())
             .sum()
     }
 

@@ -17,7 +17,7 @@
 //! | STOP_D (the trajectory cannot be completed) | a leg given up for another arm in the way: round it, or back |
 //! | TRAJECTORY_END | [`Next::End`], told to the coordinator |
 
-use std::collections::VecDeque;
+use std::collections::{BTreeSet, VecDeque};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -48,6 +48,14 @@ const DETOUR_AFTER: Duration = Duration::from_secs(1);
 /// How long before the later of two arms that block each other backs off, home; and how
 /// long it then lets the other pass.
 const BACK_OFF_AFTER: Duration = Duration::from_secs(3);
+
+/// What a request for a zone or the tool came to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Got {
+    Granted,
+    /// Told to back off: the victim of a deadlock, it waits for nothing any more.
+    BackOff,
+}
 
 /// How one straight leg of a trajectory ended.
 enum Leg {
@@ -87,10 +95,12 @@ pub(crate) struct Mechanisms {
     pub(crate) geometric: bool,
 }
 
-/// STOP_C: brakes the arm; resolves once it stands still.
-async fn stop(arm: TableArm) {
+/// STOP_C: brakes the arm; resolves once it stands still, to where its links are then.
+async fn stop(arm: TableArm) -> Option<Pose> {
     arm.halt();
     while !arm.step().await.at_rest() {}
+    let here = arm.at();
+    Some(arm.scara().joints(&here)?.map(|joint| [joint.x, joint.y]))
 }
 
 /// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`), in a
@@ -150,7 +160,12 @@ impl Driver {
             };
             let started = self.ctx.now();
             if job.tool {
-                self.acquire(&SCREWDRIVER.into()).await?;
+                // Told to back off while it waits at home, it waits for nothing: it asks
+                // again once the others had time to move.
+                while self.acquire(&SCREWDRIVER.into()).await? == Got::BackOff {
+                    lock(&self.stats).victims += 1;
+                    self.ctx.delay(BACK_OFF_AFTER).await;
+                }
                 self.go(RACK.into()).await?;
                 self.arm.grasp_tool().map_err(|error| error.to_string())?;
             }
@@ -226,7 +241,7 @@ impl Driver {
     }
 
     /// Asks for a zone or the tool until granted, stopped meanwhile (STOP_C).
-    async fn acquire(&mut self, resource: &Name) -> Result<(), String> {
+    async fn acquire(&mut self, resource: &Name) -> Result<Got, String> {
         self.acquire_moving_in(resource, &[]).await
     }
 
@@ -238,32 +253,36 @@ impl Driver {
         &mut self,
         resource: &Name,
         moving_in: &[Name],
-    ) -> Result<(), String> {
-        let given_up = self
+    ) -> Result<Got, String> {
+        let given_up = match self
             .link
             .acquire_giving_up(resource.as_str(), moving_in)
             .await
-            .map_err(|refused| unexpected(resource, refused))?;
+        {
+            Ok(given_up) => given_up,
+            Err(Refused::BackOff) => return Ok(Got::BackOff),
+            Err(Refused::Failed(why)) => return Err(why),
+        };
         lock(&self.stats).rights_given_up += given_up.len() as u32;
         self.reacquire_shared(given_up).await
     }
 
     /// Asks again for the rights to move in the shared zones `shared`, one after the
     /// other; stopped at a border meanwhile, it gives up again those it has had back.
-    async fn reacquire_shared(&mut self, shared: Vec<Name>) -> Result<(), String> {
+    async fn reacquire_shared(&mut self, shared: Vec<Name>) -> Result<Got, String> {
         let mut held: Vec<Name> = Vec::new();
         let mut pending: std::collections::VecDeque<Name> = shared.into();
         while let Some(zone) = pending.pop_front() {
-            let given_up = self
-                .link
-                .acquire_giving_up(zone.as_str(), &held)
-                .await
-                .map_err(|refused| unexpected(&zone, refused))?;
+            let given_up = match self.link.acquire_giving_up(zone.as_str(), &held).await {
+                Ok(given_up) => given_up,
+                Err(Refused::BackOff) => return Ok(Got::BackOff),
+                Err(Refused::Failed(why)) => return Err(why),
+            };
             held.retain(|h| !given_up.contains(h));
             pending.extend(given_up);
             held.push(zone);
         }
-        Ok(())
+        Ok(Got::Granted)
     }
 
     /// Moves the tool to `to`, going round or backing off from arms in the way.
@@ -340,17 +359,33 @@ impl Driver {
                     // up while it waits.
                     let moving_in: Vec<Name> = pipeline
                         .holding()
+                        .chain(allowed.iter().flat_map(|(_, release)| release))
                         .filter(|held| self.is_shared(held))
                         .cloned()
+                        .collect::<BTreeSet<Name>>()
+                        .into_iter()
                         .collect();
                     let arm = self.arm.clone();
-                    let given_up = self
+                    let asked = self
                         .link
                         .acquire_stopping(zone.as_str(), &moving_in, || stop(arm.clone()))
-                        .await
-                        .map_err(|refused| unexpected(&zone, refused))?;
-                    lock(&self.stats).rights_given_up += given_up.len() as u32;
-                    self.reacquire_shared(given_up).await?;
+                        .await;
+                    let got = match asked {
+                        Ok(given_up) => {
+                            lock(&self.stats).rights_given_up += given_up.len() as u32;
+                            self.reacquire_shared(given_up).await?
+                        }
+                        Err(Refused::BackOff) => Got::BackOff,
+                        Err(Refused::Failed(why)) => return Err(why),
+                    };
+                    if got == Got::BackOff {
+                        // The victim of a deadlock: it gets out of the way, home, and
+                        // comes back; the zones it is in stay its own until it has left.
+                        self.halt().await?;
+                        lock(&self.stats).victims += 1;
+                        self.abandon(&pipeline, &mut allowed).await?;
+                        return Ok(Leg::BackOff(self.home));
+                    }
                     pipeline.granted(zone);
                     // CONTINUE, if it was stopped: where it stands allows nothing new.
                     self.arm.allow(self.arm.at());
@@ -359,8 +394,11 @@ impl Driver {
                     if self.mechanisms.geometric {
                         let reach = (next + pipeline.offset() + LOOKAHEAD).min(points.len());
                         let ahead = &points[next..reach];
-                        if let Some(leg) = self.clear(ahead, &to, &pipeline, may_back_off).await? {
-                            self.abandon(&pipeline).await?;
+                        let taken = (&pipeline, &mut allowed);
+                        if let Some(leg) = self.clear(ahead, &to, taken, may_back_off).await? {
+                            // The zones it would have left at this point are its own too.
+                            allowed.push_back((f32::INFINITY, release));
+                            self.abandon(&pipeline, &mut allowed).await?;
                             return Ok(leg);
                         }
                     }
@@ -431,7 +469,7 @@ impl Driver {
         &mut self,
         ahead: &[Point2<f32>],
         leg_end: &Point2<f32>,
-        pipeline: &Pipeline,
+        (pipeline, allowed): (&Pipeline, &mut VecDeque<(f32, Vec<Name>)>),
         may_back_off: bool,
     ) -> Result<Option<Leg>, String> {
         let mut freed: Vec<Name> = Vec::new();
@@ -448,18 +486,30 @@ impl Driver {
                 let (shared, exclusive): (Vec<Name>, Vec<Name>) = std::mem::take(&mut freed)
                     .into_iter()
                     .partition(|zone| self.is_shared(zone));
+                let mut got = Got::Granted;
                 for zone in exclusive {
-                    self.acquire(&zone).await?;
+                    if got == Got::Granted {
+                        got = self.acquire(&zone).await?;
+                    }
                 }
-                self.reacquire_shared(shared).await?;
+                if got == Got::Granted {
+                    got = self.reacquire_shared(shared).await?;
+                }
+                if got == Got::BackOff {
+                    // The victim of a deadlock: out of the way, home.
+                    lock(&self.stats).victims += 1;
+                    return Ok(Some(Leg::BackOff(self.home)));
+                }
                 // The others may have moved while this arm waited for its zones.
                 continue;
             }
             if waited.is_zero() {
                 lock(&self.stats).geometric_blocks += 1;
                 // It cannot stop at once: it brakes along the points it was allowed, which
-                // were checked with its stopping distance to spare.
+                // were checked with its stopping distance to spare; the zones it left at
+                // the points it reached meanwhile, it releases.
                 self.halt().await?;
+                self.track(allowed).await?;
             }
             // Whatever it holds and is not inside, and its right to move where it is in a
             // shared zone, it frees while it waits — every time it finds itself blocked,
@@ -547,8 +597,37 @@ impl Driver {
         Ok(clear.then_some(self.home))
     }
 
+    /// On a leg given up: releases the zones it was to leave at an allowed point ahead but
+    /// is not in (it braked out of them): no point it will go to on this leg needs them.
+    async fn release_left(
+        &mut self,
+        allowed: &mut VecDeque<(f32, Vec<Name>)>,
+    ) -> Result<(), String> {
+        let inside = self.zones_at(self.arm.at());
+        let mut left = Vec::new();
+        for (_, release) in allowed.iter_mut() {
+            release.retain(|zone| {
+                let gone = !inside.contains(zone);
+                if gone && !left.contains(zone) {
+                    left.push(zone.clone());
+                }
+                !gone
+            });
+        }
+        for zone in left {
+            self.tell(Message::Release(zone)).await?;
+        }
+        Ok(())
+    }
+
     /// Gives up a leg part-way: frees what it holds but is not inside.
-    async fn abandon(&mut self, pipeline: &Pipeline) -> Result<(), String> {
+    async fn abandon(
+        &mut self,
+        pipeline: &Pipeline,
+        allowed: &mut VecDeque<(f32, Vec<Name>)>,
+    ) -> Result<(), String> {
+        self.track(allowed).await?;
+        self.release_left(allowed).await?;
         let inside = self.zones_at(self.arm.at());
         for zone in pipeline.holding().cloned().collect::<Vec<_>>() {
             if !inside.contains(&zone) {
@@ -557,19 +636,5 @@ impl Driver {
         }
         self.tell(Message::TrajectoryEnd).await?;
         Ok(())
-    }
-}
-
-/// What an arm reports of a request the coordinator refused.
-fn unexpected(resource: &Name, refused: Refused) -> String {
-    match refused {
-        // Every arm takes the tool before any zone and frees the zones it holds before it
-        // waits on another arm, so no cycle of waits can form here; a back-off would mean
-        // the coordinator found one, and is reported as such.
-        Refused::BackOff => format!(
-            "told to back off while asking for {resource}: a deadlock the cell's \
-             order of requests should have made impossible"
-        ),
-        Refused::Failed(why) => why,
     }
 }

@@ -198,6 +198,9 @@ pub struct CellStats {
     /// Rights to move in a shared zone given up by an arm stopped at the border of
     /// another zone, and asked for again once that zone was granted.
     pub rights_given_up: u32,
+    /// Times an arm told by the coordinator to back off, the victim of a deadlock, got out
+    /// of the way.
+    pub victims: u32,
     /// Arms that stopped working, and why.
     pub failures: Vec<String>,
 }

@@ -108,6 +108,13 @@ impl fmt::Display for Report {
         )?;
         writeln!(
             f,
+            "  deadlocks of space and zones (an arm asleep at a border in the way of one it \
+             waits for), found and resolved  {}; victims that backed off  {}",
+            log.in_the_way.len(),
+            stats.victims
+        )?;
+        writeln!(
+            f,
             "  an arm in another's way: stopped {}, went round {}, \
              two in each other's way parted by a back-off {}",
             stats.geometric_blocks, stats.detours, stats.back_offs

@@ -31,6 +31,46 @@ impl Resources {
     /// and is on its way to ask again waits for nothing yet, and is looked at again when it
     /// sleeps.
     pub fn deadlock_among(&self, asleep: impl Fn(&Name) -> bool) -> Option<Deadlock> {
+        let waits_for = self.waits_for(asleep);
+        let robots: Vec<Name> = waits_for.keys().cloned().collect();
+        for start in robots {
+            let mut path = vec![start.clone()];
+            if let Some(cycle) = find_cycle(&waits_for, &mut path) {
+                let victim = cycle.iter().max_by_key(|r| r.as_str()).cloned()?;
+                return Some(Deadlock { cycle, victim });
+            }
+        }
+        None
+    }
+
+    /// Whether `sleeper`, asleep, waits (through the robots asleep for which `asleep`
+    /// holds, one holding what the next sleeps on) for something `holder` holds. A robot
+    /// in `sleeper`'s way that `sleeper` waits for in turn closes a cycle the books alone
+    /// do not show: one waiting on the other's zone, the other on its space.
+    pub fn waits_on(&self, sleeper: &str, holder: &str, asleep: impl Fn(&Name) -> bool) -> bool {
+        let waits_for = self.waits_for(asleep);
+        let mut seen: Vec<&Name> = Vec::new();
+        let mut next: Vec<&Name> = waits_for
+            .get_key_value(&Name::from(sleeper))
+            .map(|(name, _)| vec![name])
+            .unwrap_or_default();
+        while let Some(robot) = next.pop() {
+            if seen.contains(&robot) {
+                continue;
+            }
+            seen.push(robot);
+            for held_by in waits_for.get(robot).into_iter().flatten() {
+                if *held_by == holder {
+                    return true;
+                }
+                next.push(held_by);
+            }
+        }
+        false
+    }
+
+    /// Each sleeper for which `asleep` holds, and who holds what it sleeps on.
+    fn waits_for(&self, asleep: impl Fn(&Name) -> bool) -> BTreeMap<Name, Vec<Name>> {
         let mut waits_for: BTreeMap<Name, Vec<Name>> = BTreeMap::new();
         for (_, holders, sleepers) in self
             .exclusive_waits()
@@ -44,15 +84,7 @@ impl Resources {
                     .extend(holders.iter().filter(|h| *h != sleeper).cloned());
             }
         }
-        let robots: Vec<Name> = waits_for.keys().cloned().collect();
-        for start in robots {
-            let mut path = vec![start.clone()];
-            if let Some(cycle) = find_cycle(&waits_for, &mut path) {
-                let victim = cycle.iter().max_by_key(|r| r.as_str()).cloned()?;
-                return Some(Deadlock { cycle, victim });
-            }
-        }
-        None
+        waits_for
     }
 
     /// Resolves `deadlock`: its victim stops waiting (leaves every queue, and, stopped,

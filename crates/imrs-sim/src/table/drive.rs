@@ -113,10 +113,6 @@ impl Drive {
         self.speed > 0.0 || (!self.halted && self.along < self.allowed.min(self.length) - ARRIVED)
     }
 
-    pub(crate) fn arrived(&self) -> bool {
-        self.progress().arrived()
-    }
-
     /// One step of `dt` seconds at `top` speed and `acceleration` (both ways); whether it
     /// moved.
     pub(crate) fn step(&mut self, dt: f32, top: f32, acceleration: f32) -> bool {
@@ -159,7 +155,7 @@ mod tests {
         let mut drive = Drive::new(Point2::new(0.0, 0.0), Point2::new(0.3, 0.0));
         drive.allow(Point2::new(0.3, 0.0));
         run(&mut drive, 200);
-        assert!(drive.arrived(), "{:?}", drive.progress());
+        assert!(drive.progress().arrived(), "{:?}", drive.progress());
         assert_eq!(drive.tool(), Point2::new(0.3, 0.0));
     }
 
@@ -194,6 +190,6 @@ mod tests {
         drive.allow(Point2::new(1.0, 0.0));
         assert!(drive.can_move());
         run(&mut drive, 200);
-        assert!(drive.arrived());
+        assert!(drive.progress().arrived());
     }
 }

@@ -36,17 +36,12 @@ impl TableArmState {
         self.drive.is_some_and(|drive| drive.can_move())
     }
 
-    /// One step of its controller; whether it moved. A leg driven to its end is done.
+    /// One step of its controller; whether it moved. A leg driven to its end stays its
+    /// leg, at rest, until the next starts: its progress says where it ended.
     fn step(&mut self, dt: f32) -> bool {
-        let Some(drive) = &mut self.drive else {
-            return false;
-        };
-        let moved = drive.step(dt, self.spec.speed, self.spec.acceleration);
-        if drive.arrived() {
-            self.tool = drive.tool();
-            self.drive = None;
-        }
-        moved
+        self.drive
+            .as_mut()
+            .is_some_and(|drive| drive.step(dt, self.spec.speed, self.spec.acceleration))
     }
 }
 
