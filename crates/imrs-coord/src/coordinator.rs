@@ -12,7 +12,8 @@
 //! After every sleep it looks for deadlocks among the robots asleep, over exclusive zones,
 //! tools and rights to move in shared zones; each victim is told to back off. A way it
 //! finds blocked by a robot asleep at a border that waits for what the blocked robot holds
-//! is a deadlock too, of space and zones: the sleeper is told to back off. A robot's way is checked against the other robots where *they said* they
+//! is a deadlock too, of space and zones, once the blocked robot says it waits
+//! ([`RobotLink::wait_on`]): the sleeper is told to back off. A robot's way is checked against the other robots where *they said* they
 //! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -48,6 +49,11 @@ pub enum Geometry {
     /// Its links at the next points of its trajectory: do they keep clear of every other
     /// robot?
     Check(Sweep),
+    /// Its links at the next points of its trajectory, where it waits, stopped, holding
+    /// only what it is in: do they keep clear of every other robot? As [`Geometry::Check`];
+    /// and a robot asleep in the way that waits for what this one holds is told to back
+    /// off (a deadlock of space and zones).
+    Wait(Sweep),
     /// Its straight way from `from` to `to` is blocked by the robots `around`: an
     /// alternative trajectory round them.
     Alternative {
@@ -349,6 +355,17 @@ impl RobotLink {
         }
     }
 
+    /// As [`check`](Self::check), for a robot stopped and waiting for its way to clear,
+    /// holding only what it is in: a robot asleep in its way that waits for what it holds
+    /// is told to back off.
+    pub async fn wait_on(&mut self, sweep: Sweep) -> Result<Vec<Name>, Refused> {
+        match self.ask(Geometry::Wait(sweep)).await? {
+            Seen::Blocked(robots) => Ok(robots),
+            Seen::Clear => Ok(Vec::new()),
+            other => Err(Refused::Failed(format!("a wait answered {other:?}"))),
+        }
+    }
+
     /// The coordinator's alternative trajectory from `from` to `to` round the robots
     /// `around`: the whole way, `from` first, or `None` if there is none.
     pub async fn alternative(
@@ -466,6 +483,7 @@ pub fn coordinator(
                     .await?;
                 match event {
                     Event::Space(robot, geometry, reply) => {
+                        let waits = matches!(geometry, Geometry::Wait(_));
                         let seen = see(&mut lock(&positions), &mut lock(&log), &robot, geometry);
                         if let Err(error) = &seen {
                             lock(&log).refused.push(error.to_string());
@@ -474,7 +492,7 @@ pub fn coordinator(
                         // waits for: neither can go on. The sleeper is the victim: stopped
                         // and waiting for nothing else, it can get out of the way.
                         let victims: Vec<Name> = match &seen {
-                            Ok(Seen::Blocked(blocking)) => {
+                            Ok(Seen::Blocked(blocking)) if waits => {
                                 let table = lock(&table);
                                 blocking
                                     .iter()
@@ -491,8 +509,16 @@ pub fn coordinator(
                         };
                         reply.reply(seen.map_err(|error| error.to_string()));
                         for victim in victims {
+                            // One woken by a victim before it waits for nothing any more.
+                            let still = asleep.contains(&victim)
+                                && lock(&table).waits_on(victim.as_str(), robot.as_str(), |r| {
+                                    asleep.contains(r)
+                                });
+                            if !still {
+                                continue;
+                            }
                             let woken = lock(&table)
-                                .stop_waiting(victim.as_str())
+                                .stop_sleeping(victim.as_str())
                                 .unwrap_or_default();
                             lock(&log).in_the_way.push(victim.clone());
                             wake_up(&mut wake, &mut asleep, &victim, Wake::BackOff).await;
@@ -583,7 +609,7 @@ fn see(
             positions.tell(robot, pose)?;
             Seen::Noted
         }
-        Geometry::Check(sweep) => {
+        Geometry::Check(sweep) | Geometry::Wait(sweep) => {
             log.checked += 1;
             let blocking = positions.blockers(robot, &sweep)?;
             if blocking.is_empty() {

@@ -10,6 +10,7 @@ use std::time::Duration;
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, Message, Refused, coordinator};
 use imrs_coord::zones::{Pose, Positions, Resources, ZoneDef, ZoneKind};
 use imrs_core::prelude::*;
+use imrs_ports::Name;
 
 const ROBOTS: [&str; 3] = ["ROBOT_A", "ROBOT_B", "ROBOT_C"];
 
@@ -409,9 +410,10 @@ async fn a_robot_asleep_at_a_border_gives_up_moving_in_its_shared_zone() {
 /// 0.1 s, asks for FIXTURE as it moves: told to sleep, it needs 0.3 s to stop. ROBOT_B
 /// asks to move in PASSAGE at `b_asks` s. Returns when B and A were granted PASSAGE and
 /// FIXTURE, and what A gave up.
-async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>) {
+async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>, Vec<Name>) {
     const BRAKING: Duration = Duration::from_millis(300);
     let (cell, clock, ports, log) = start();
+    let seen: Arc<Mutex<Vec<Name>>> = Arc::default();
     let granted = Arc::new(Mutex::new((None, None)));
     let given_up = Arc::new(Mutex::new(Vec::new()));
     let c = {
@@ -447,7 +449,8 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                 let gave = link
                     .acquire_stopping("FIXTURE", &["PASSAGE".into()], || async {
                         braking.delay(BRAKING).await;
-                        None
+                        // Stopped across the line y = 0.05.
+                        Some([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]])
                     })
                     .await
                     .map_err(|e| format!("{e:?}"))?;
@@ -472,9 +475,10 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
         })
     };
     let b = {
-        let granted = Arc::clone(&granted);
+        let (granted, seen) = (Arc::clone(&granted), Arc::clone(&seen));
         ModuleSpec::new("ROBOT_B", ()).task("ROBOT_B", move |ctx| {
             let (ports, granted) = (ports.clone(), Arc::clone(&granted));
+            let seen_stopped = Arc::clone(&seen);
             async move {
                 let mut link = ports.link("ROBOT_B")?;
                 ctx.delay(Duration::from_secs_f64(b_asks)).await;
@@ -482,6 +486,12 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                     .await
                     .map_err(|e| format!("{e:?}"))?;
                 granted.lock().unwrap().0 = Some(seconds(&ctx));
+                // Where A stopped, if it said: in the way along y = 0.05.
+                let blocked = link
+                    .check(vec![along(0.05)])
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                seen_stopped.lock().unwrap().extend(blocked);
                 ctx.delay(Duration::from_millis(100)).await;
                 link.tell(Message::Release("PASSAGE".into()))
                     .await
@@ -502,10 +512,12 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
     assert!(log.lock().unwrap().refused.is_empty());
     let (b, a) = *granted.lock().unwrap();
     let given_up = given_up.lock().unwrap().clone();
+    let seen = seen.lock().unwrap().clone();
     (
         b.expect("B was granted PASSAGE"),
         a.expect("A was granted FIXTURE"),
         given_up,
+        seen,
     )
 }
 
@@ -513,13 +525,17 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
 async fn a_robot_told_to_sleep_keeps_its_right_to_move_until_it_has_stopped() {
     // A brakes from 0.1 s to 0.4 s in PASSAGE: B, asking at 0.2 s, moves there only once A
     // has stopped and given it up.
-    let (b, a, given_up) = stopping_at_border(2.0, 0.2).await;
+    let (b, a, given_up, seen) = stopping_at_border(2.0, 0.2).await;
+    // Stopped, A told where: B's check finds it in the way.
+    assert_eq!(seen, ["ROBOT_A"]);
     assert_eq!(given_up, ["PASSAGE"]);
     assert!((0.4..0.45).contains(&b), "B moved in PASSAGE at {b} s");
     assert!(a >= 2.0, "A had FIXTURE at {a} s, before C left it");
     // Woken while it still brakes, A is granted at once, and gives nothing up: B waits
     // until A leaves PASSAGE.
-    let (b, a, given_up) = stopping_at_border(0.2, 0.25).await;
+    let (b, a, given_up, seen) = stopping_at_border(0.2, 0.25).await;
+    // Woken before it stopped, A told nothing yet.
+    assert!(seen.is_empty(), "{seen:?}");
     assert!(given_up.is_empty(), "{given_up:?}");
     assert!((0.2..0.25).contains(&a), "A had FIXTURE at {a} s");
     assert!(b >= a + 0.2, "B moved in PASSAGE at {b} s, beside A");
@@ -632,12 +648,13 @@ async fn a_robot_woken_twice_before_it_asks_again_is_not_waited_for() {
 }
 
 /// ROBOT_A is in FIXTURE. ROBOT_B says it stands across A's way out, and asks for `wants`
-/// (FIXTURE, or TRAY, which ROBOT_C holds for 3 s): it sleeps. A then checks its way out.
-/// Returns what A's check found, what B heard, and the coordinator's log.
-async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, String, CoordinatorLog) {
+/// (FIXTURE, or TRAY, which ROBOT_C holds for 3 s): it sleeps. A checks its way out at 1 s,
+/// and at 1.5 s says it waits on it. Returns what A's check found, what B heard and when,
+/// and the coordinator's log.
+async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, (String, f64), CoordinatorLog) {
     let (cell, clock, ports, log) = start();
     let found = Arc::new(Mutex::new(Vec::new()));
-    let heard = Arc::new(Mutex::new(String::new()));
+    let heard = Arc::new(Mutex::new((String::new(), 0.0)));
     let c = {
         let ports = ports.clone();
         ModuleSpec::new("ROBOT_C", ()).task("ROBOT_C", move |ctx| {
@@ -671,7 +688,11 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, String, Coordin
                     .lock()
                     .unwrap()
                     .extend(blocked.iter().map(ToString::to_string));
-                ctx.delay(Duration::from_secs(1)).await;
+                ctx.delay(Duration::from_millis(500)).await;
+                link.wait_on(vec![along(0.05)])
+                    .await
+                    .map_err(|e| format!("{e:?}"))?;
+                ctx.delay(Duration::from_millis(500)).await;
                 link.tell(Message::Release("FIXTURE".into()))
                     .await
                     .map_err(|e| format!("{e:?}"))?;
@@ -691,7 +712,7 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, String, Coordin
                     .await
                     .map_err(|e| format!("{e:?}"))?;
                 let asked = link.acquire(wants).await;
-                *heard.lock().unwrap() = format!("{asked:?}");
+                *heard.lock().unwrap() = (format!("{asked:?}"), seconds(&ctx));
                 Ok(())
             }
         })
@@ -713,15 +734,18 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, String, Coordin
 
 #[tokio::test(start_paused = true)]
 async fn a_robot_asleep_in_the_way_of_the_one_it_waits_for_is_told_to_back_off() {
-    // B sleeps on FIXTURE, which A holds, across A's way out: neither could go on.
-    let (found, heard, log) = asleep_in_the_way("FIXTURE").await;
+    // B sleeps on FIXTURE, which A holds, across A's way out: neither could go on. A
+    // check alone tells nobody to back off; once A says it waits, B is told to.
+    let (found, (heard, at), log) = asleep_in_the_way("FIXTURE").await;
     assert_eq!(found, ["ROBOT_B"]);
     assert_eq!(heard, "Err(BackOff)");
+    assert!((1.5..1.6).contains(&at), "B was told at {at} s");
     assert_eq!(log.in_the_way, ["ROBOT_B"]);
     // B sleeps on TRAY, which C holds: A waits for B's space, B for C, C for nothing. Not a
     // deadlock: B is granted once C leaves.
-    let (found, heard, log) = asleep_in_the_way("TRAY").await;
+    let (found, (heard, at), log) = asleep_in_the_way("TRAY").await;
     assert_eq!(found, ["ROBOT_B"]);
     assert_eq!(heard, "Ok(())");
+    assert!(at >= 3.0, "B was granted TRAY at {at} s");
     assert!(log.in_the_way.is_empty(), "{:?}", log.in_the_way);
 }

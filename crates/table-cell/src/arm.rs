@@ -218,6 +218,16 @@ impl Driver {
             .map_err(|refused| format!("{refused:?}"))
     }
 
+    /// The same, said while it waits for them, stopped, holding only what it is in: an
+    /// arm asleep in its way that waits for what it holds is told to back off.
+    async fn waiting_on(&mut self, points: &[Point2<f32>]) -> Result<Vec<Name>, String> {
+        let sweep = self.sweep(points);
+        self.link
+            .wait_on(sweep)
+            .await
+            .map_err(|refused| format!("{refused:?}"))
+    }
+
     fn zones_at(&self, point: Point2<f32>) -> Vec<Name> {
         let point = [point.x, point.y, WORK_Z];
         self.zones
@@ -372,6 +382,8 @@ impl Driver {
                         .await;
                     let got = match asked {
                         Ok(given_up) => {
+                            // Granted: its own, even if it backs off before it moves on.
+                            pipeline.granted(zone.clone());
                             lock(&self.stats).rights_given_up += given_up.len() as u32;
                             self.reacquire_shared(given_up).await?
                         }
@@ -386,7 +398,6 @@ impl Driver {
                         self.abandon(&pipeline, &mut allowed).await?;
                         return Ok(Leg::BackOff(self.home));
                     }
-                    pipeline.granted(zone);
                     // CONTINUE, if it was stopped: where it stands allows nothing new.
                     self.arm.allow(self.arm.at());
                 }
@@ -475,7 +486,12 @@ impl Driver {
         let mut freed: Vec<Name> = Vec::new();
         let mut waited = Duration::ZERO;
         loop {
-            let blocking = self.blockers(ahead).await?;
+            // Once stopped and freed of what it is not in, it says it waits.
+            let blocking = if waited.is_zero() {
+                self.blockers(ahead).await?
+            } else {
+                self.waiting_on(ahead).await?
+            };
             if blocking.is_empty() {
                 if freed.is_empty() {
                     return Ok(None);
@@ -536,12 +552,15 @@ impl Driver {
             }
             // Two arms in each other's way: the later-named backs off; if it cannot, the
             // other does, after twice as long.
+            // On a way round or back, it may back off again only after long: two arms
+            // that cannot part otherwise.
             let my_turn =
                 blocking.iter().all(|other| *other < self.name) || waited >= 2 * BACK_OFF_AFTER;
+            let may = may_back_off || waited >= 4 * BACK_OFF_AFTER;
             if waited >= BACK_OFF_AFTER
-                && may_back_off
+                && may
                 && my_turn
-                && let Some(point) = self.back_point().await?
+                && let Some(point) = self.back_point(leg_end).await?
             {
                 lock(&self.stats).back_offs += 1;
                 return Ok(Some(Leg::BackOff(point)));
@@ -584,17 +603,34 @@ impl Driver {
         Ok(clear.then(|| points[1..].to_vec()))
     }
 
-    /// Where to back off to: home, if the coordinator finds the first steps there clear.
-    async fn back_point(&mut self) -> Result<Option<Point2<f32>>, String> {
+    /// Where to back off to, away from `leg_end`: home, if the coordinator finds the first
+    /// steps there clear; else a short way back, or to either side, whichever it finds
+    /// clear all the way (home may lie past the arm in the way).
+    async fn back_point(&mut self, leg_end: &Point2<f32>) -> Result<Option<Point2<f32>>, String> {
         let here = self.arm.at();
         let towards = self.home - here;
-        if towards.norm() < SPACING {
+        if towards.norm() >= SPACING {
+            let step = towards.normalize() * SPACING;
+            let first: Vec<Point2<f32>> = (1..=LOOKAHEAD).map(|i| here + step * i as f32).collect();
+            if self.blockers(&first).await?.is_empty() {
+                return Ok(Some(self.home));
+            }
+        }
+        let ahead = *leg_end - here;
+        if ahead.norm() < SPACING {
             return Ok(None);
         }
-        let step = towards.normalize() * SPACING;
-        let first: Vec<Point2<f32>> = (1..=LOOKAHEAD).map(|i| here + step * i as f32).collect();
-        let clear = self.blockers(&first).await?.is_empty();
-        Ok(clear.then_some(self.home))
+        let back = -ahead.normalize();
+        let side = nalgebra::Vector2::new(-back.y, back.x);
+        for direction in [back, side, -side] {
+            let way: Vec<Point2<f32>> = (1..=LOOKAHEAD)
+                .map(|i| here + direction * (SPACING * i as f32))
+                .collect();
+            if way.iter().all(|p| self.scara.reaches(p)) && self.blockers(&way).await?.is_empty() {
+                return Ok(way.last().copied());
+            }
+        }
+        Ok(None)
     }
 
     /// On a leg given up: releases the zones it was to leave at an allowed point ahead but

@@ -69,17 +69,29 @@ impl Positions {
     }
 
     /// The other robots whose links, where they last said they were, come within the margin
-    /// of `robot`'s links at any pose of `sweep`: none when its way is clear.
+    /// of `robot`'s links at any pose of `sweep`: none when its way is clear. Of two robots
+    /// already within the margin where they said they were, the way is blocked only if it
+    /// comes nearer than they are (by halves of the margin), so that they can part.
     pub fn blockers(&self, robot: &str, sweep: &Sweep) -> Result<Vec<Name>, ZoneError> {
         self.known(robot)?;
         if sweep.iter().flatten().flatten().any(|c| !c.is_finite()) {
             return Err(ZoneError::NoPlace(robot.into()));
         }
         let mine = space(sweep, self.radius);
+        let here = self.told.get(&Name::from(robot));
         Ok(self
             .told
             .iter()
-            .filter(|(other, theirs)| **other != robot && !mine.clear_of(theirs, self.margin))
+            .filter(|(other, _)| **other != robot)
+            .filter(|(_, theirs)| {
+                // Two robots already within the margin of each other may still part: a way
+                // is blocked only if it comes nearer than they are, by halves of the margin.
+                let margin = [self.margin, self.margin / 2.0, self.margin / 4.0, 0.0]
+                    .into_iter()
+                    .find(|&m| here.is_none_or(|here| here.clear_of(theirs, m)))
+                    .unwrap_or(0.0);
+                !mine.clear_of(theirs, margin)
+            })
             .map(|(other, _)| other.clone())
             .collect())
     }
@@ -146,6 +158,25 @@ mod tests {
         );
         // A robot is never in its own way.
         assert!(positions.blockers("A", &vec![arm(0.5)]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn robots_already_within_the_margin_may_part_but_not_come_nearer() {
+        let mut positions = Positions::new(["A", "B"], 0.035, 0.03);
+        positions.tell("A", arm(0.0)).unwrap();
+        // B's links 2 cm from A's (7 cm between the axes, 3.5 cm radius each).
+        positions.tell("B", arm(0.09)).unwrap();
+        // Away from A: clear, though B is within the margin now.
+        assert!(positions.blockers("B", &vec![arm(0.1)]).unwrap().is_empty());
+        // Staying as near: clear too, within the half margin.
+        assert!(
+            positions
+                .blockers("B", &vec![arm(0.09)])
+                .unwrap()
+                .is_empty()
+        );
+        // Nearer: blocked.
+        assert_eq!(positions.blockers("B", &vec![arm(0.078)]).unwrap(), ["A"]);
     }
 
     #[test]

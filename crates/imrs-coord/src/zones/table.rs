@@ -395,6 +395,24 @@ impl Resources {
         Ok(woken)
     }
 
+    /// `robot` sleeps no more: it leaves every queue it is in, and keeps what it holds,
+    /// its rights to move in shared zones too (to get out of the way, it must move).
+    /// Returns who is woken: the next in a queue it headed.
+    pub fn stop_sleeping(&mut self, robot: &str) -> Result<Vec<Name>, ZoneError> {
+        let robot = self.robot(robot)?;
+        let names: Vec<Name> = self.held.keys().cloned().collect();
+        let mut woken = Vec::new();
+        for name in names {
+            let held = self.held(name.as_str())?;
+            let was_first = held.sleeping.front() == Some(&robot);
+            held.sleeping.retain(|r| *r != robot);
+            if was_first {
+                woken.extend(self.wake(name.as_str()));
+            }
+        }
+        Ok(woken)
+    }
+
     /// Takes `robot` out of every queue and resource it holds at once, as when it is taken
     /// out of the cell; returns who is woken. A robot that backs off from a deadlock still
     /// holds what it is inside: see [`stop_waiting`](Self::stop_waiting).
