@@ -381,3 +381,24 @@ fn a_cycle_among_robots_asleep_is_found_beside_one_whose_victim_is_awake() -> Re
     assert!(!found.cycle.contains(&"ARM_C".into()));
     Ok(())
 }
+
+#[test]
+fn a_robot_that_stops_sleeping_leaves_its_queues_and_keeps_its_right_to_move()
+-> Result<(), ZoneError> {
+    let mut table = table();
+    // B is in FIXTURE; A moves in FEEDERS and sleeps on FIXTURE, C behind it.
+    assert_eq!(table.request_move("ARM_B", "FIXTURE")?, Answer::Grant);
+    assert_eq!(table.request_move("ARM_A", "FEEDERS")?, Answer::Grant);
+    assert_eq!(table.request_move("ARM_A", "FIXTURE")?, Answer::Sleep);
+    assert_eq!(table.request_move("ARM_C", "FIXTURE")?, Answer::Sleep);
+    // A waits on B: told to back off, it leaves the queue, and C heads it.
+    assert!(table.waits_on("ARM_A", "ARM_B", |_| true));
+    assert!(!table.waits_on("ARM_B", "ARM_A", |_| true));
+    table.stop_sleeping("ARM_A")?;
+    assert!(!table.waits_on("ARM_A", "ARM_B", |_| true));
+    assert_eq!(table.release("ARM_B", "FIXTURE")?, ["ARM_C"]);
+    // It still moves in FEEDERS: nobody else may, until it stops there.
+    assert_eq!(table.request_move("ARM_B", "FEEDERS")?, Answer::Sleep);
+    assert_eq!(table.stopped_inside("ARM_A", "FEEDERS")?, ["ARM_B"]);
+    Ok(())
+}

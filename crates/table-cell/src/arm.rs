@@ -77,8 +77,6 @@ struct Driver {
     zones: Arc<Vec<ZoneDef>>,
     ctx: Ctx<()>,
     stats: Arc<Mutex<CellStats>>,
-    /// Whether it has just backed off, and lets the other pass before going on.
-    yield_after_back_off: bool,
     /// Which of the seed's mechanisms it uses.
     mechanisms: Mechanisms,
     /// Where it last told the coordinator it was.
@@ -131,7 +129,6 @@ pub(crate) fn arm_module(
                 zones,
                 ctx,
                 stats: Arc::clone(&stats),
-                yield_after_back_off: false,
                 mechanisms,
                 last_told: None,
             };
@@ -295,24 +292,25 @@ impl Driver {
         Ok(Got::Granted)
     }
 
-    /// Moves the tool to `to`, going round or backing off from arms in the way.
+    /// Moves the tool to `to`, going round or backing off from arms in the way. Backed
+    /// off, it gives the other arm the time to pass before it goes on.
     async fn go(&mut self, to: Point2<f32>) -> Result<(), String> {
-        let mut legs: Vec<(Point2<f32>, bool)> = vec![(to, true)];
-        while let Some((target, may_back_off)) = legs.pop() {
-            if may_back_off && std::mem::take(&mut self.yield_after_back_off) {
-                self.ctx.delay(BACK_OFF_AFTER).await;
-            }
+        // Each leg: where to, whether it may back off, whether it is a back-off.
+        let mut legs: Vec<(Point2<f32>, bool, bool)> = vec![(to, true, false)];
+        while let Some((target, may_back_off, backing)) = legs.pop() {
             match self.leg(target, may_back_off).await? {
-                Leg::Arrived => {}
+                Leg::Arrived => {
+                    if backing {
+                        self.ctx.delay(BACK_OFF_AFTER).await;
+                    }
+                }
                 Leg::Via(points) => {
-                    legs.push((target, may_back_off));
-                    legs.extend(points.into_iter().rev().map(|p| (p, false)));
+                    legs.push((target, may_back_off, backing));
+                    legs.extend(points.into_iter().rev().map(|p| (p, false, false)));
                 }
                 Leg::BackOff(point) => {
-                    legs.push((target, may_back_off));
-                    legs.push((point, false));
-                    // Backed off: give the other arm the time to pass before going on.
-                    self.yield_after_back_off = true;
+                    legs.push((target, may_back_off, backing));
+                    legs.push((point, false, true));
                 }
             }
         }
@@ -485,12 +483,14 @@ impl Driver {
     ) -> Result<Option<Leg>, String> {
         let mut freed: Vec<Name> = Vec::new();
         let mut waited = Duration::ZERO;
+        // Whether it is stopped and holds only what it is in: then it says it waits.
+        let mut waiting = false;
         loop {
             // Once stopped and freed of what it is not in, it says it waits.
-            let blocking = if waited.is_zero() {
-                self.blockers(ahead).await?
-            } else {
+            let blocking = if waiting {
                 self.waiting_on(ahead).await?
+            } else {
+                self.blockers(ahead).await?
             };
             if blocking.is_empty() {
                 if freed.is_empty() {
@@ -516,6 +516,7 @@ impl Driver {
                     lock(&self.stats).victims += 1;
                     return Ok(Some(Leg::BackOff(self.home)));
                 }
+                waiting = false;
                 // The others may have moved while this arm waited for its zones.
                 continue;
             }
@@ -544,6 +545,7 @@ impl Driver {
                     freed.push(zone);
                 }
             }
+            waiting = true;
             if waited >= DETOUR_AFTER
                 && let Some(points) = self.round(&blocking, leg_end).await?
             {
@@ -551,9 +553,8 @@ impl Driver {
                 return Ok(Some(Leg::Via(points)));
             }
             // Two arms in each other's way: the later-named backs off; if it cannot, the
-            // other does, after twice as long.
-            // On a way round or back, it may back off again only after long: two arms
-            // that cannot part otherwise.
+            // other does, after twice as long. On a way round or back, it may back off
+            // again only after long: two arms that cannot part otherwise.
             let my_turn =
                 blocking.iter().all(|other| *other < self.name) || waited >= 2 * BACK_OFF_AFTER;
             let may = may_back_off || waited >= 4 * BACK_OFF_AFTER;

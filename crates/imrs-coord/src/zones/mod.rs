@@ -42,6 +42,6 @@ mod table;
 pub use deadlock::Deadlock;
 pub use detour::{Obstacle, detour, first_blocked};
 pub use pipeline::{Command, Next, Pipeline};
-pub use positions::{Pose, Positions};
+pub use positions::{PARTING, Pose, Positions};
 pub use sweep::{Reservations, Sweep};
 pub use table::{Answer, Resources, ZoneDef, ZoneError, ZoneKind};

@@ -13,6 +13,10 @@ use super::space::Space;
 use super::sweep::{Sweep, space};
 use super::table::ZoneError;
 
+/// How much nearer than they are a way may take two robots already within the margin:
+/// a way along the other keeps its distance only to within a millimetre.
+pub const PARTING: f32 = 0.001;
+
 /// An arm's pose in the working plane: its base, elbow and tool.
 pub type Pose = [[f32; 2]; 3];
 
@@ -70,8 +74,8 @@ impl Positions {
 
     /// The other robots whose links, where they last said they were, come within the margin
     /// of `robot`'s links at any pose of `sweep`: none when its way is clear. Of two robots
-    /// already within the margin where they said they were, the way is blocked only if it
-    /// comes nearer than they are (by halves of the margin), so that they can part.
+    /// already nearer than the margin where they said they were, the way is blocked if it
+    /// comes nearer than they are (less [`PARTING`]), so that they can part.
     pub fn blockers(&self, robot: &str, sweep: &Sweep) -> Result<Vec<Name>, ZoneError> {
         self.known(robot)?;
         if sweep.iter().flatten().flatten().any(|c| !c.is_finite()) {
@@ -84,12 +88,17 @@ impl Positions {
             .iter()
             .filter(|(other, _)| **other != robot)
             .filter(|(_, theirs)| {
-                // Two robots already within the margin of each other may still part: a way
-                // is blocked only if it comes nearer than they are, by halves of the margin.
-                let margin = [self.margin, self.margin / 2.0, self.margin / 4.0, 0.0]
-                    .into_iter()
-                    .find(|&m| here.is_none_or(|here| here.clear_of(theirs, m)))
-                    .unwrap_or(0.0);
+                // Two robots already nearer than the margin may still part: the way is
+                // blocked if it comes nearer than they are now (less a tolerance for a way
+                // along the other, never down to touching).
+                let margin = here.map_or(self.margin, |here| {
+                    let now = here.distance(theirs);
+                    if now >= self.margin {
+                        self.margin
+                    } else {
+                        (now - PARTING).max(now / 2.0).max(PARTING / 10.0)
+                    }
+                });
                 !mine.clear_of(theirs, margin)
             })
             .map(|(other, _)| other.clone())
@@ -164,19 +173,31 @@ mod tests {
     fn robots_already_within_the_margin_may_part_but_not_come_nearer() {
         let mut positions = Positions::new(["A", "B"], 0.035, 0.03);
         positions.tell("A", arm(0.0)).unwrap();
-        // B's links 2 cm from A's (7 cm between the axes, 3.5 cm radius each).
+        // B's links 2 cm from A's (9 cm between the axes, 3.5 cm radius each).
         positions.tell("B", arm(0.09)).unwrap();
         // Away from A: clear, though B is within the margin now.
         assert!(positions.blockers("B", &vec![arm(0.1)]).unwrap().is_empty());
-        // Staying as near: clear too, within the half margin.
+        // As near as now: clear.
         assert!(
             positions
                 .blockers("B", &vec![arm(0.09)])
                 .unwrap()
                 .is_empty()
         );
-        // Nearer: blocked.
-        assert_eq!(positions.blockers("B", &vec![arm(0.078)]).unwrap(), ["A"]);
+        // 5 mm nearer, or down to 2 mm: blocked, at any nearness.
+        assert_eq!(positions.blockers("B", &vec![arm(0.085)]).unwrap(), ["A"]);
+        assert_eq!(positions.blockers("B", &vec![arm(0.072)]).unwrap(), ["A"]);
+        // Through A: blocked.
+        assert_eq!(positions.blockers("B", &vec![arm(0.0)]).unwrap(), ["A"]);
+        // B told it is 1 mm from A: it may part, and not come nearer.
+        positions.tell("B", arm(0.071)).unwrap();
+        assert!(
+            positions
+                .blockers("B", &vec![arm(0.08)])
+                .unwrap()
+                .is_empty()
+        );
+        assert_eq!(positions.blockers("B", &vec![arm(0.0703)]).unwrap(), ["A"]);
     }
 
     #[test]

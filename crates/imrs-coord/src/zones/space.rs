@@ -102,6 +102,20 @@ impl Space {
                 })
         })
     }
+
+    /// The least distance between a link of `self` and one of `other`, as parry3d measures
+    /// it: 0 where they touch.
+    pub(super) fn distance(&self, other: &Self) -> f32 {
+        self.links
+            .iter()
+            .flat_map(|(a, _)| {
+                other.links.iter().map(move |(b, _)| {
+                    query::distance(&Pose::IDENTITY, a, &Pose::IDENTITY, b)
+                        .map_or(0.0, |d| d.distance)
+                })
+            })
+            .fold(f32::INFINITY, f32::min)
+    }
 }
 
 #[cfg(test)]
