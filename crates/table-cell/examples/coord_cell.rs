@@ -1,15 +1,16 @@
 //! The coordinated table cell: four arms sharing an exclusive fixture, a shared tray and
 //! one screwdriver, under the zone coordinator and the run-time task scheduler.
 //!
-//! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--compare]`
+//! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--straight] [--compare]`
 //!
 //! With `--compare`, the same arrivals also run under the static assignment (each arm's
 //! fixed program, and the same assignment dispatched), and the units made are set side by
-//! side.
+//! side. With `--straight`, each arm goes straight on to its next job instead of home,
+//! which makes zone and tool deadlocks happen.
 
 use std::process::ExitCode;
 
-use table_cell::{Assignment, CellConfig, run};
+use table_cell::{Assignment, CellConfig, Travel, run};
 
 fn main() -> ExitCode {
     match cell() {
@@ -39,9 +40,10 @@ fn cell() -> Result<(), Box<dyn std::error::Error>> {
                     .map_err(|e| format!("--hours: {e}"))?
             }
             "--compare" => compare = true,
+            "--straight" => config.travel = Travel::Straight,
             other => {
                 return Err(format!(
-                    "unknown argument {other}; use --seed N, --hours H, --compare"
+                    "unknown argument {other}; use --seed N, --hours H, --straight, --compare"
                 )
                 .into());
             }

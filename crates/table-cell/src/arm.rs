@@ -35,6 +35,10 @@ use imrs_coord::zones::{Answer, Next, Pipeline, Pose, Sweep, ZoneDef, ZoneKind};
 
 /// Points of a trajectory, this far apart.
 const SPACING: f32 = 0.02;
+/// How near a point of a leg the gripper passes a zone to need it: its own radius, and
+/// half a spacing, since between two points checked it is anywhere on the line joining
+/// them (a leg that clips a zone's corner between two points needs the zone).
+const SWEPT: f32 = GRIPPER_RADIUS + SPACING / 2.0;
 /// How near an allowed point the tool must come to have reached it.
 const REACHED: f32 = 1e-4;
 /// How many points ahead an arm checks its links against the others'.
@@ -64,6 +68,8 @@ enum Leg {
     Via(Vec<Point2<f32>>),
     /// Blocked by an arm that is itself blocked: back off to this point first.
     BackOff(Point2<f32>),
+    /// The victim of a deadlock the coordinator found: it waits for nothing any more.
+    Victim,
 }
 
 struct Driver {
@@ -91,6 +97,8 @@ pub(crate) struct Mechanisms {
     /// Whether it has the coordinator check its way ahead against the other arms, and
     /// waits, goes round or backs off.
     pub(crate) geometric: bool,
+    /// Whether it goes home after every job, or straight on to the next.
+    pub(crate) via_home: bool,
 }
 
 /// STOP_C: brakes the arm; resolves once it stands still, to where its links are then.
@@ -152,33 +160,65 @@ impl Driver {
                 .await
                 .map_err(|error| error.to_string())?;
             let Some(job) = job else {
+                // Idle, it waits out of the way.
+                self.go_surely(self.home).await?;
                 self.ctx.delay(RETRY).await;
                 continue;
             };
             let started = self.ctx.now();
-            if job.tool {
-                // Told to back off while it waits at home, it waits for nothing: it asks
-                // again once the others had time to move.
-                while self.acquire(&SCREWDRIVER.into()).await? == Got::BackOff {
-                    lock(&self.stats).victims += 1;
-                    self.ctx.delay(BACK_OFF_AFTER).await;
-                }
-                self.go(RACK.into()).await?;
-                self.arm.grasp_tool().map_err(|error| error.to_string())?;
-            }
-            self.go(job.at.into()).await?;
+            // Told to back off on its way, it starts the job again, the tool put back.
+            while !self.reach_job(job.tool, job.at.into()).await? {}
             self.ctx.delay(job.work).await;
             if job.tool {
-                self.go(RACK.into()).await?;
-                self.arm.put_tool().map_err(|error| error.to_string())?;
-                self.tell(Message::Release(SCREWDRIVER.into())).await?;
+                self.return_tool().await?;
             }
-            self.go(self.home).await?;
+            if self.mechanisms.via_home {
+                self.go_surely(self.home).await?;
+            }
             let mut stats = lock(&self.stats);
             stats.jobs[self.index] += 1;
             stats.busy[self.index] += self.ctx.now().saturating_duration_since(started);
             finished = Some((job.unit, job.task));
         }
+    }
+
+    /// To a job at `at`, with the tool if it needs it; false if it was told to back off
+    /// on the way (it is home then, holding nothing it is not in).
+    async fn reach_job(&mut self, tool: bool, at: Point2<f32>) -> Result<bool, String> {
+        if tool {
+            // Told to back off while it waits for the tool, it gets out of the zone it is
+            // in and waits for nothing: it asks again once the others had time to move.
+            while self.acquire(&SCREWDRIVER.into()).await? == Got::BackOff {
+                lock(&self.stats).victims += 1;
+                self.go_surely(self.home).await?;
+            }
+            if !self.go(RACK.into()).await? {
+                self.tell(Message::Release(SCREWDRIVER.into())).await?;
+                return Ok(false);
+            }
+            self.arm.grasp_tool().map_err(|error| error.to_string())?;
+        }
+        if !self.go(at).await? {
+            if tool {
+                self.return_tool().await?;
+            }
+            return Ok(false);
+        }
+        Ok(true)
+    }
+
+    /// Puts the tool back on its rack, and says so.
+    async fn return_tool(&mut self) -> Result<(), String> {
+        self.go_surely(RACK.into()).await?;
+        self.arm.put_tool().map_err(|error| error.to_string())?;
+        self.tell(Message::Release(SCREWDRIVER.into())).await?;
+        Ok(())
+    }
+
+    /// Goes to `to`, however often it is told to back off on the way.
+    async fn go_surely(&mut self, to: Point2<f32>) -> Result<(), String> {
+        while !self.go(to).await? {}
+        Ok(())
     }
 
     /// Its links with the tool at `tool`, if it reaches there.
@@ -293,10 +333,12 @@ impl Driver {
     }
 
     /// Moves the tool to `to`, going round or backing off from arms in the way. Backed
-    /// off, it gives the other arm the time to pass before it goes on.
-    async fn go(&mut self, to: Point2<f32>) -> Result<(), String> {
+    /// off, it gives the other arm the time to pass before it goes on. Returns false if it
+    /// was the victim of a deadlock: then it has gone home instead, and waited there.
+    async fn go(&mut self, to: Point2<f32>) -> Result<bool, String> {
         // Each leg: where to, whether it may back off, whether it is a back-off.
         let mut legs: Vec<(Point2<f32>, bool, bool)> = vec![(to, true, false)];
+        let mut arrived = true;
         while let Some((target, may_back_off, backing)) = legs.pop() {
             match self.leg(target, may_back_off).await? {
                 Leg::Arrived => {
@@ -312,9 +354,13 @@ impl Driver {
                     legs.push((target, may_back_off, backing));
                     legs.push((point, false, true));
                 }
+                Leg::Victim => {
+                    legs = vec![(self.home, false, true)];
+                    arrived = false;
+                }
             }
         }
-        Ok(())
+        Ok(arrived)
     }
 
     /// One straight leg through the pipeline, its three stages at once: the arm's
@@ -356,7 +402,7 @@ impl Driver {
             let zones_at = |point: [f32; 3]| -> Vec<Name> {
                 zones
                     .iter()
-                    .filter(|zone| zone.touches(point, GRIPPER_RADIUS))
+                    .filter(|zone| zone.touches(point, SWEPT))
                     .map(|zone| zone.name.clone())
                     .collect()
             };
@@ -394,7 +440,7 @@ impl Driver {
                         self.halt().await?;
                         lock(&self.stats).victims += 1;
                         self.abandon(&pipeline, &mut allowed).await?;
-                        return Ok(Leg::BackOff(self.home));
+                        return Ok(Leg::Victim);
                     }
                     // CONTINUE, if it was stopped: where it stands allows nothing new.
                     self.arm.allow(self.arm.at());
@@ -514,7 +560,7 @@ impl Driver {
                 if got == Got::BackOff {
                     // The victim of a deadlock: out of the way, home.
                     lock(&self.stats).victims += 1;
-                    return Ok(Some(Leg::BackOff(self.home)));
+                    return Ok(Some(Leg::Victim));
                 }
                 waiting = false;
                 // The others may have moved while this arm waited for its zones.

@@ -119,15 +119,32 @@ impl fmt::Display for Coordination {
 }
 
 impl Coordination {
-    fn mechanisms(self) -> Mechanisms {
+    fn mechanisms(self, travel: Travel) -> Mechanisms {
         let (offset, geometric) = match self {
             Self::ZonesOnly => (Some(0), false),
             Self::Pipeline => (None, false),
             Self::PipelineOffset(offset) => (Some(offset), false),
             Self::Full => (None, true),
         };
-        Mechanisms { offset, geometric }
+        Mechanisms {
+            offset,
+            geometric,
+            via_home: travel == Travel::ViaHome,
+        }
     }
+}
+
+/// How an arm goes from one job to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Travel {
+    /// Home between jobs, out of the others' way: an arm holds nothing while it waits for
+    /// the tool, and no zone or tool deadlock arises.
+    ViaHome,
+    /// Straight on to the next job: an arm that finished in the fixture asks for the tool
+    /// from inside it, and one coming from the tray asks for the fixture from inside the
+    /// tray. Zone and tool deadlocks arise, and rights to move in the tray are given up at
+    /// the fixture's border.
+    Straight,
 }
 
 /// A run of the table cell.
@@ -141,17 +158,20 @@ pub struct CellConfig {
     pub assignment: Assignment,
     /// Which mechanisms keep the arms apart.
     pub coordination: Coordination,
+    /// How an arm goes from one job to the next.
+    pub travel: Travel,
 }
 
 impl CellConfig {
     /// A run of `hours` on the arrivals of `seed`, with every mechanism: the run-time
-    /// scheduler and [`Coordination::Full`].
+    /// scheduler and [`Coordination::Full`], the arms going home between jobs.
     pub fn new(seed: u64, hours: f64) -> Self {
         Self {
             seed,
             hours,
             assignment: Assignment::RunTime,
             coordination: Coordination::Full,
+            travel: Travel::ViaHome,
         }
     }
 }
@@ -290,7 +310,7 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
             &jobs,
             Arc::clone(&zones),
             Arc::clone(&stats),
-            config.coordination.mechanisms(),
+            config.coordination.mechanisms(config.travel),
         ))?;
     }
 

@@ -5,7 +5,7 @@
 
 use std::thread;
 
-use table_cell::{Assignment, CellConfig, CellError, Report, run};
+use table_cell::{Assignment, CellConfig, CellError, Report, Travel, run};
 
 fn config(seed: u64, hours: f64, assignment: Assignment) -> CellConfig {
     CellConfig {
@@ -98,6 +98,36 @@ fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
     println!("units per hour over ten seeds: {per_hour:?}");
 }
 
+/// Arms that go straight on to their next job ask for the fixture from inside the tray, in
+/// which they move: refused at the border, each stops and gives up its right to move
+/// there, and another moves in the tray meanwhile. Rapier sees no collision and no
+/// conflict, and every victim of a deadlock the coordinator found got out of the way.
+#[test]
+fn arms_going_straight_on_give_up_their_right_to_move_in_the_tray_at_the_fixture() {
+    let reports = run_all(
+        (1..=4)
+            .map(|seed| CellConfig {
+                travel: Travel::Straight,
+                ..CellConfig::new(seed, 0.5)
+            })
+            .collect(),
+    );
+    for report in &reports {
+        assert!(report.is_clean(), "{report}");
+        assert!(report.measured.closest.is_some_and(|c| c > 0.0), "{report}");
+        assert!(report.units >= 60, "{report}");
+        let log = &report.coordinator;
+        assert_eq!(
+            report.stats.victims as usize,
+            log.deadlocks.len() + log.in_the_way.len(),
+            "{report}"
+        );
+    }
+    let given_up: u32 = reports.iter().map(|r| r.stats.rights_given_up).sum();
+    assert!(given_up > 0, "no right to move given up at a border");
+    println!("rights to move given up at a border over four half hours: {given_up}");
+}
+
 #[test]
 fn the_same_seed_gives_the_same_run() {
     let reports = run_all(vec![
@@ -116,7 +146,7 @@ fn the_same_seed_gives_the_same_run() {
 /// arm's fixed program or the same assignment dispatched, on every seed of the same
 /// arrivals. The goal of 15 % more is not met by arms that speed up and brake at their
 /// limit: they spend more of each job on the way and stopped in each other's way, which no
-/// assignment changes, and the gain measured is 1.2 to 7.1 % over the programs. The
+/// assignment changes, and the gain measured is 2.4 to 5.9 % over the programs. The
 /// figures are printed.
 #[test]
 fn the_run_time_scheduler_makes_more_than_a_static_assignment_on_the_same_arrivals() {
