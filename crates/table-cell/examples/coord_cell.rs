@@ -4,9 +4,9 @@
 //! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--straight] [--compare]`
 //!
 //! With `--compare`, the same arrivals also run under the static assignment (each arm's
-//! fixed program, and the same assignment dispatched), and the units made are set side by
-//! side. With `--straight`, each arm goes straight on to its next job instead of home,
-//! which makes zone and tool deadlocks happen.
+//! fixed program, and the same assignment dispatched) and the part-driven variant, and the
+//! units made are set side by side. With `--straight`, each arm goes straight on to its
+//! next job instead of home, and asks for the fixture from inside the tray.
 
 use std::process::ExitCode;
 
@@ -60,7 +60,11 @@ fn cell() -> Result<(), Box<dyn std::error::Error>> {
             Assignment::RunTime.to_string(),
             report.per_hour()
         );
-        for assignment in [Assignment::Programs, Assignment::Dispatching] {
+        for assignment in [
+            Assignment::Programs,
+            Assignment::Dispatching,
+            Assignment::PartDriven,
+        ] {
             let other = run(&CellConfig {
                 assignment,
                 ..config.clone()

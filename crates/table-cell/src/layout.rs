@@ -142,5 +142,7 @@ pub fn workcell() -> Workcell {
         }],
         travel: NOMINAL_SPEED,
         acceleration: f64::from(ACCELERATION),
+        // An arm's tool at work, its links round it, and the margin.
+        clearance: 0.1,
     }
 }

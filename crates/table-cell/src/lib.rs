@@ -61,7 +61,7 @@ use self::arm::{MARGIN, Mechanisms, arm_module};
 use self::schedule::{job_port, scheduler};
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, coordinator};
 use imrs_coord::network::{Bus, Placement, report};
-use imrs_coord::scheduler::{Arrivals, Dispatch, Policy, RunTime, Static};
+use imrs_coord::scheduler::{Arrivals, Dispatch, PartDriven, Policy, RunTime, Static};
 use imrs_coord::zones::{Positions, Resources, ZoneDef};
 
 /// The coordinator module's name.
@@ -78,6 +78,9 @@ pub enum Assignment {
     Programs,
     /// The same static assignment, each arm taking its oldest ready task.
     Dispatching,
+    /// The part-driven variant: tasks in the order their parts came, by whichever capable
+    /// arm asks first.
+    PartDriven,
 }
 
 impl fmt::Display for Assignment {
@@ -86,6 +89,7 @@ impl fmt::Display for Assignment {
             Self::RunTime => "run-time scheduler",
             Self::Programs => "static programs",
             Self::Dispatching => "static, dispatched",
+            Self::PartDriven => "part-driven",
         })
     }
 }
@@ -265,6 +269,7 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
         Assignment::RunTime => Box::new(RunTime::default()),
         Assignment::Programs => Box::new(Static::programs(&plan)),
         Assignment::Dispatching => Box::new(Static::dispatching(&plan)),
+        Assignment::PartDriven => Box::new(PartDriven),
     };
     let completions: schedule::Completions = Arc::default();
     let jobs = job_port(&shared);

@@ -86,22 +86,15 @@ fn ten_seeds_of_an_hour_each_with_no_collision_and_no_conflict() {
             "{report}"
         );
     }
-    // An arm asleep at a border in the way of the one it waits for: the deadlock of space
-    // and zones happens in this cell, and is resolved.
-    let in_the_way: usize = reports.iter().map(|r| r.coordinator.in_the_way.len()).sum();
-    assert!(
-        in_the_way > 0,
-        "no deadlock of space and zones in ten hours"
-    );
-    println!("deadlocks of space and zones over ten seeds: {in_the_way}");
     let per_hour: Vec<f64> = reports.iter().map(Report::per_hour).collect();
     println!("units per hour over ten seeds: {per_hour:?}");
 }
 
 /// Arms that go straight on to their next job ask for the fixture from inside the tray, in
 /// which they move: refused at the border, each stops and gives up its right to move
-/// there, and another moves in the tray meanwhile. Rapier sees no collision and no
-/// conflict, and every victim of a deadlock the coordinator found got out of the way.
+/// there, and another moves in the tray meanwhile. An arm stopped at a border is at times
+/// in the way of the arm it waits for; the coordinator finds that deadlock. Rapier sees no
+/// collision and no conflict, and every victim of a deadlock got out of the way.
 #[test]
 fn arms_going_straight_on_give_up_their_right_to_move_in_the_tray_at_the_fixture() {
     let reports = run_all(
@@ -126,6 +119,14 @@ fn arms_going_straight_on_give_up_their_right_to_move_in_the_tray_at_the_fixture
     let given_up: u32 = reports.iter().map(|r| r.stats.rights_given_up).sum();
     assert!(given_up > 0, "no right to move given up at a border");
     println!("rights to move given up at a border over four half hours: {given_up}");
+    // An arm stopped at a border in the way of the one it waits for: the deadlock of space
+    // and zones happens, and is resolved.
+    let in_the_way: usize = reports.iter().map(|r| r.coordinator.in_the_way.len()).sum();
+    assert!(
+        in_the_way > 0,
+        "no deadlock of space and zones in two hours"
+    );
+    println!("deadlocks of space and zones over four half hours: {in_the_way}");
 }
 
 #[test]
@@ -146,7 +147,7 @@ fn the_same_seed_gives_the_same_run() {
 /// arm's fixed program or the same assignment dispatched, on every seed of the same
 /// arrivals. The goal of 15 % more is not met by arms that speed up and brake at their
 /// limit: they spend more of each job on the way and stopped in each other's way, which no
-/// assignment changes, and the gain measured is 2.4 to 5.9 % over the programs. The
+/// assignment changes, and the gain measured is 2.4 to 13.1 % over the programs. The
 /// figures are printed.
 #[test]
 fn the_run_time_scheduler_makes_more_than_a_static_assignment_on_the_same_arrivals() {

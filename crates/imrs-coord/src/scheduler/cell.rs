@@ -124,6 +124,9 @@ pub struct Workcell {
     pub travel: f64,
     /// How fast a robot speeds up and brakes, in m/s² (infinite: at once).
     pub acceleration: f64,
+    /// How far a robot's way must keep from the tool of a robot at work, in metres: one
+    /// that passes nearer goes round it (0: robots never meet).
+    pub clearance: f64,
 }
 
 impl Workcell {
@@ -161,6 +164,7 @@ impl Workcell {
             }],
             travel: 0.5,
             acceleration: f64::INFINITY,
+            clearance: 0.0,
         }
     }
 }

@@ -28,7 +28,8 @@
 mod cell;
 mod policy;
 mod sim;
+mod way;
 
 pub use cell::{Arrivals, Robot, Skill, TaskSpec, Workcell, Zone};
-pub use policy::{Policy, RunTime, Static};
+pub use policy::{PartDriven, Policy, RunTime, Static};
 pub use sim::{Dispatch, Estimate, Outcome, Refusal, State, simulate};

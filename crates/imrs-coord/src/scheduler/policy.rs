@@ -102,15 +102,20 @@ impl Policy for Static {
 }
 
 /// The run-time scheduler: of the ready tasks within the robot's skills, the one it would
-/// finish soonest — its travel, its speed and its wait at the zone's border worked out
-/// ahead — unless another robot, free soon, would finish it clearly sooner; older units
-/// first among equals. Candidates are taken in order of a lower bound on their finish
+/// finish soonest — its travel, its speed, its waits at the borders of the zones on its way
+/// (their entry points computed) and its way round robots at work worked out ahead — unless
+/// another robot, free soon, would finish it clearly sooner; older units first among
+/// equals. An assignment with no resource or collision conflict scores better (the seed's
+/// "favourable score"). Candidates are taken in order of a lower bound on their finish
 /// (work alone), and the search stops once that bound passes the best found.
 #[derive(Debug, Clone)]
 pub struct RunTime {
     /// How much a second of waiting at the zone counts against a candidate, beyond the
     /// delay itself (it also holds the robot idle where another could use the zone).
     pub zone_weight: f64,
+    /// How many seconds each robot at work in its way counts against a candidate, beyond
+    /// the longer way round it (the coordinator may stop it first, and the other may move).
+    pub collision_weight: f64,
     /// How much sooner, in seconds, another robot must finish a task for this one to leave
     /// it.
     pub margin: f64,
@@ -123,6 +128,7 @@ impl Default for RunTime {
     fn default() -> Self {
         Self {
             zone_weight: 3.0,
+            collision_weight: 2.0,
             margin: 2.0,
             prune: true,
         }
@@ -148,7 +154,9 @@ impl RunTime {
         } else {
             0.0
         };
-        own.finish + self.zone_weight * (own.zone_wait + in_zone)
+        own.finish
+            + self.zone_weight * (own.zone_wait + in_zone)
+            + self.collision_weight * own.in_the_way as f64
     }
 }
 
@@ -184,5 +192,43 @@ impl Policy for RunTime {
             }
         }
         best.map(|(_, unit, task)| (unit, task))
+    }
+}
+
+/// The part-driven variant the seed weighs: each part comes with its tasks, and the tasks
+/// are done in the order their parts came, by whichever capable robot is free first. A task
+/// of no single part (one that needs a set of parts assembled) comes with the last part of
+/// its prerequisites. No look-ahead: where a robot would wait, or whom it would meet, does
+/// not count.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PartDriven;
+
+impl PartDriven {
+    /// When task `task` of unit `unit` came: with the last of its parts, or of its
+    /// prerequisites' parts.
+    fn came(state: &State<'_>, unit: usize, task: usize) -> f64 {
+        let spec = &state.cell().tasks[task];
+        let own = spec
+            .parts
+            .iter()
+            .map(|&part| state.arrived(unit, part))
+            .fold(f64::NEG_INFINITY, f64::max);
+        spec.after
+            .iter()
+            .map(|&before| Self::came(state, unit, before))
+            .fold(own, f64::max)
+    }
+}
+
+impl Policy for PartDriven {
+    fn choose(&mut self, robot: usize, state: &State<'_>) -> Option<(usize, usize)> {
+        state
+            .ready_tasks()
+            .filter(|&(_, task)| state.can(robot, task))
+            .min_by(|&(a_unit, a_task), &(b_unit, b_task)| {
+                Self::came(state, a_unit, a_task)
+                    .total_cmp(&Self::came(state, b_unit, b_task))
+                    .then((a_unit, a_task).cmp(&(b_unit, b_task)))
+            })
     }
 }

@@ -2,6 +2,7 @@
 
 use super::cell::{Arrivals, Workcell, distance};
 use super::policy::Policy;
+use super::way::{detour, entry};
 
 /// Where a robot is in a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,14 +34,22 @@ pub struct State<'a> {
     progress: &'a Progress,
 }
 
-/// How a robot would do a task, worked out ahead: when it would enter, how long it would
-/// wait at the zone's border, when it would be done.
+/// How a robot would do a task, worked out ahead: when it would start, how long it would
+/// wait at the borders of the zones on its way (their entry points computed), which
+/// robots at work it would have to go round, and when it would be done.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     /// When it would start the task's work.
     pub start: f64,
-    /// How long it would wait for the zone.
+    /// How long it would wait for zones: those it crosses on its way, and the task's.
     pub zone_wait: f64,
+    /// The zones on its way, not the task's, that it would wait to enter.
+    pub zones_crossed: usize,
+    /// The robots at work that its straight way passes too near: the coordinator would
+    /// send it round each, on an alternative trajectory.
+    pub in_the_way: usize,
+    /// How much longer its way is round them, in metres.
+    pub detour: f64,
     /// When it would be done.
     pub finish: f64,
 }
@@ -81,6 +90,11 @@ impl<'a> State<'a> {
                 .all(|&part| self.arrivals.at[unit][part] <= self.progress.now)
     }
 
+    /// When part `part` of unit `unit` comes, in seconds.
+    pub fn arrived(&self, unit: usize, part: usize) -> f64 {
+        self.arrivals.at[unit][part]
+    }
+
     /// Every ready task, unit by unit.
     pub fn ready_tasks(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         (0..self.units())
@@ -100,17 +114,51 @@ impl<'a> State<'a> {
             &self.cell.robots[robot],
             &self.progress.robots[robot],
         );
+        let (from, to) = (state.at, spec.at);
+        let depart = self.progress.now.max(state.free_at);
+        let task_zone = self.cell.zone_of(to);
+        // Each zone on the way, but the task's and one it starts in: entered at its entry
+        // point, waited for there if it is taken then.
+        let mut crossing = (0, 0.0);
+        for (zone, disc) in self.cell.zones.iter().enumerate() {
+            if Some(zone) == task_zone || disc.contains(from) {
+                continue;
+            }
+            if let Some(along) = entry(from, to, disc.centre, disc.radius) {
+                let at = depart + crossing.1 + self.cell.travel_time(along, who.speed);
+                let wait = (self.progress.zone_free_at[zone] - at).max(0.0);
+                if wait > 0.0 {
+                    crossing = (crossing.0 + 1, crossing.1 + wait);
+                }
+            }
+        }
+        // Each robot at work, where its tool is, that the way passes too near.
+        let mut in_the_way = (0, 0.0);
+        if self.cell.clearance > 0.0 {
+            for (other, at_work) in self.progress.robots.iter().enumerate() {
+                if other == robot || at_work.free_at <= self.progress.now {
+                    continue;
+                }
+                let longer = detour(from, to, at_work.at, self.cell.clearance);
+                if longer > 0.0 {
+                    in_the_way = (in_the_way.0 + 1, in_the_way.1 + longer);
+                }
+            }
+        }
         let travel = self
             .cell
-            .travel_time(distance(state.at, spec.at), who.speed);
-        let arrive = self.progress.now.max(state.free_at) + travel;
-        let start = match self.cell.zone_of(spec.at) {
+            .travel_time(distance(from, to) + in_the_way.1, who.speed);
+        let arrive = depart + crossing.1 + travel;
+        let start = match task_zone {
             Some(zone) => arrive.max(self.progress.zone_free_at[zone]),
             None => arrive,
         };
         Estimate {
             start,
-            zone_wait: start - arrive,
+            zone_wait: start - arrive + crossing.1,
+            zones_crossed: crossing.0,
+            in_the_way: in_the_way.0,
+            detour: in_the_way.1,
             finish: start + spec.work / who.speed,
         }
     }
