@@ -140,7 +140,7 @@ fn an_estimate_counts_the_zones_on_the_way_and_the_robots_at_work_it_must_go_rou
         at: vec![vec![0.0]],
     };
     let mut dispatch = Dispatch::new(across(0.1), arrivals.clone());
-    // RIGHT takes the task in the zone: 10 s of work there, from about 0.6 s.
+    // RIGHT takes the task in the zone: 10 s of work there once it has come.
     let (_, _, busy) = dispatch
         .next(1, 0.0, &mut InTheZone(false))
         .unwrap()
@@ -152,19 +152,39 @@ fn an_estimate_counts_the_zones_on_the_way_and_the_robots_at_work_it_must_go_rou
         (left.zone_wait - (busy.finish - 0.8)).abs() < 1e-9,
         "{left:?}"
     );
-    // And its straight way runs through RIGHT's tool: round it, half a circle of 0.1 m
-    // instead of its diameter.
-    assert_eq!(left.in_the_way, 1);
-    let round = std::f64::consts::PI * 0.1 - 0.2;
-    assert!((left.detour - round).abs() < 1e-9, "{left:?}");
-    assert!(left.finish > busy.finish + 2.0 + round / 0.5, "{left:?}");
+    // By the time it passes RIGHT's tool, RIGHT is done: nobody to go round.
+    assert_eq!((left.in_the_way, left.detour), (0, 0.0));
 
-    // With no clearance kept, robots never meet; the zone is still waited for.
-    let mut dispatch = Dispatch::new(across(0.0), arrivals);
+    // With no zone to wait at, it passes while RIGHT works: round it, half a circle of
+    // 0.1 m instead of its diameter.
+    let open = Workcell {
+        zones: Vec::new(),
+        ..across(0.1)
+    };
+    let mut dispatch = Dispatch::new(open.clone(), arrivals.clone());
     dispatch.next(1, 0.0, &mut InTheZone(false)).unwrap();
     let left = dispatch.state().estimate(0, 1);
-    assert_eq!((left.zones_crossed, left.in_the_way), (1, 0));
-    assert_eq!(left.detour, 0.0);
+    let round = std::f64::consts::PI * 0.1 - 0.2;
+    assert_eq!((left.zones_crossed, left.in_the_way), (0, 1));
+    assert!((left.detour - round).abs() < 1e-9, "{left:?}");
+    assert!(
+        (left.finish - (1.0 + round) / 0.5 - 1.0).abs() < 1e-9,
+        "{left:?}"
+    );
+    // Told LEFT stands beyond RIGHT already, its way no longer passes it.
+    dispatch.moved(0, [0.6, 0.0]);
+    assert_eq!(dispatch.state().estimate(0, 1).in_the_way, 0);
+
+    // With no clearance kept, robots never meet.
+    let mut dispatch = Dispatch::new(
+        Workcell {
+            clearance: 0.0,
+            ..open
+        },
+        arrivals,
+    );
+    dispatch.next(1, 0.0, &mut InTheZone(false)).unwrap();
+    assert_eq!(dispatch.state().estimate(0, 1).in_the_way, 0);
 }
 
 /// The part-driven variant takes tasks in the order their parts came; the run-time
@@ -187,27 +207,36 @@ fn the_part_driven_variant_follows_the_parts_and_the_run_time_scheduler_makes_mo
             part_driven.per_hour()
         );
     }
-    // Its first choice is a task of the part that came first.
-    struct First(Option<(usize, usize)>);
-    impl Policy for First {
+    // Every choice is, of the ready tasks the robot can do, one whose parts (its own, or
+    // its prerequisites') came first: checked against the arrivals themselves.
+    fn came(cell: &Workcell, arrivals: &Arrivals, unit: usize, task: usize) -> f64 {
+        let spec = &cell.tasks[task];
+        let own = spec
+            .parts
+            .iter()
+            .map(|&part| arrivals.at[unit][part])
+            .fold(f64::NEG_INFINITY, f64::max);
+        spec.after
+            .iter()
+            .map(|&before| came(cell, arrivals, unit, before))
+            .fold(own, f64::max)
+    }
+    struct Ordered<'a>(&'a Workcell, &'a Arrivals, usize);
+    impl Policy for Ordered<'_> {
         fn choose(&mut self, robot: usize, state: &State<'_>) -> Option<(usize, usize)> {
-            let choice = PartDriven.choose(robot, state);
-            self.0.get_or_insert(choice?);
-            choice
+            let (unit, task) = PartDriven.choose(robot, state)?;
+            let chosen = came(self.0, self.1, unit, task);
+            for (other_unit, other) in state.ready_tasks() {
+                if state.can(robot, other) {
+                    assert!(chosen <= came(self.0, self.1, other_unit, other));
+                }
+            }
+            self.2 += 1;
+            Some((unit, task))
         }
     }
-    let arrivals = Arrivals::random(&cell, 3, 9);
-    let mut first = First(None);
-    simulate(&cell, &arrivals, &mut first);
-    let (unit, task) = first.0.expect("a choice");
-    let earliest = (0..3)
-        .flat_map(|unit| arrivals.at[unit].iter().copied())
-        .fold(f64::INFINITY, f64::min);
-    let parts = &cell.tasks[task].parts;
-    assert!(
-        parts
-            .iter()
-            .any(|&part| arrivals.at[unit][part] == earliest),
-        "unit {unit} task {task}"
-    );
+    let arrivals = Arrivals::random(&cell, 30, 9);
+    let mut ordered = Ordered(&cell, &arrivals, 0);
+    assert_eq!(simulate(&cell, &arrivals, &mut ordered).units, 30);
+    assert_eq!(ordered.2, 180);
 }

@@ -155,8 +155,9 @@ impl Driver {
         let mut finished = None;
         self.tell_position().await?;
         loop {
+            let here = self.arm.at();
             let job = ask
-                .send((self.index, finished.take()))
+                .send((self.index, finished.take(), [here.x, here.y]))
                 .await
                 .map_err(|error| error.to_string())?;
             let Some(job) = job else {
@@ -191,6 +192,7 @@ impl Driver {
             while self.acquire(&SCREWDRIVER.into()).await? == Got::BackOff {
                 lock(&self.stats).victims += 1;
                 self.go_surely(self.home).await?;
+                self.ctx.delay(BACK_OFF_AFTER).await;
             }
             if !self.go(RACK.into()).await? {
                 self.tell(Message::Release(SCREWDRIVER.into())).await?;
@@ -470,7 +472,14 @@ impl Driver {
                     }
                     self.track(&mut allowed).await?;
                     // Stopped in a shared zone: another may move there now.
-                    for zone in self.zones_at(to) {
+                    // (Every shared zone the pipeline asked for here, within its reach.)
+                    let near: Vec<Name> = self
+                        .zones
+                        .iter()
+                        .filter(|zone| zone.touches([to.x, to.y, WORK_Z], SWEPT))
+                        .map(|zone| zone.name.clone())
+                        .collect();
+                    for zone in near {
                         if self.is_shared(&zone) {
                             self.tell(Message::Position(zone)).await?;
                         }

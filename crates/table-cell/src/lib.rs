@@ -55,7 +55,7 @@ pub use self::layout::{
     ACCELERATION, FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell,
 };
 pub use self::report::Report;
-pub use self::schedule::{Job, JobAsker, JobPort, SCHEDULER};
+pub use self::schedule::{Asking, Job, JobAsker, JobPort, SCHEDULER};
 
 use self::arm::{MARGIN, Mechanisms, arm_module};
 use self::schedule::{job_port, scheduler};

@@ -29,12 +29,16 @@ pub struct Job {
     pub tool: bool,
 }
 
-/// `NEXT_JOB`: an arm (by index) tells what it finished, if anything, and is given its
-/// next job, or none for now.
-pub type JobPort = Port<(usize, Option<(usize, usize)>), Option<Job>, usage::Receive, AnyUser, 8>;
+/// What an arm tells the scheduler when it asks for work: its index, what it finished, if
+/// anything, and where its tool is.
+pub type Asking = (usize, Option<(usize, usize)>, [f32; 2]);
+
+/// `NEXT_JOB`: an arm tells what it finished and where it is, and is given its next job,
+/// or none for now.
+pub type JobPort = Port<Asking, Option<Job>, usage::Receive, AnyUser, 8>;
 
 /// An arm's end of [`JobPort`].
-pub type JobAsker = End<(usize, Option<(usize, usize)>), Option<Job>, usage::Send>;
+pub type JobAsker = End<Asking, Option<Job>, usage::Send>;
 
 /// The port, owned by the scheduler.
 pub(super) fn job_port(clock: &SharedClock) -> JobPort {
@@ -62,7 +66,7 @@ pub(super) fn scheduler(
         async move {
             let mut jobs = port.owner()?;
             loop {
-                let ((robot, finished), reply) = jobs.receive().await?;
+                let ((robot, finished, at), reply) = jobs.receive().await?;
                 let now = ctx.now();
                 let seconds = now.since_start().as_secs_f64();
                 let mut run = lock(&run);
@@ -72,6 +76,8 @@ pub(super) fn scheduler(
                 {
                     lock(&done).push(now);
                 }
+                // Its next way starts where it is, not where its last task was.
+                dispatch.moved(robot, at.map(f64::from));
                 // A refused choice leaves the arm without work this time; it asks again.
                 let job = dispatch
                     .next(robot, seconds, policy.as_mut())

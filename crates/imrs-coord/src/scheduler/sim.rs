@@ -117,30 +117,38 @@ impl<'a> State<'a> {
         let (from, to) = (state.at, spec.at);
         let depart = self.progress.now.max(state.free_at);
         let task_zone = self.cell.zone_of(to);
-        // Each zone on the way, but the task's and one it starts in: entered at its entry
-        // point, waited for there if it is taken then.
+        // Each zone on the way, but the task's and one it starts in, in the order it
+        // meets them: entered at its entry point, waited for there if it is taken then.
+        let mut entries: Vec<(f64, usize)> = self
+            .cell
+            .zones
+            .iter()
+            .enumerate()
+            .filter(|&(zone, disc)| Some(zone) != task_zone && !disc.contains(from))
+            .filter_map(|(zone, disc)| Some((entry(from, to, disc.centre, disc.radius)?, zone)))
+            .collect();
+        entries.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut crossing = (0, 0.0);
-        for (zone, disc) in self.cell.zones.iter().enumerate() {
-            if Some(zone) == task_zone || disc.contains(from) {
-                continue;
-            }
-            if let Some(along) = entry(from, to, disc.centre, disc.radius) {
-                let at = depart + crossing.1 + self.cell.travel_time(along, who.speed);
-                let wait = (self.progress.zone_free_at[zone] - at).max(0.0);
-                if wait > 0.0 {
-                    crossing = (crossing.0 + 1, crossing.1 + wait);
-                }
+        for (along, zone) in entries {
+            let at = depart + crossing.1 + self.cell.travel_time(along, who.speed);
+            let wait = (self.progress.zone_free_at[zone] - at).max(0.0);
+            if wait > 0.0 {
+                crossing = (crossing.0 + 1, crossing.1 + wait);
             }
         }
-        // Each robot at work, where its tool is, that the way passes too near.
+        // Each robot still at work, where its tool is, when the way passes too near it.
         let mut in_the_way = (0, 0.0);
         if self.cell.clearance > 0.0 {
             for (other, at_work) in self.progress.robots.iter().enumerate() {
-                if other == robot || at_work.free_at <= self.progress.now {
+                if other == robot {
                     continue;
                 }
-                let longer = detour(from, to, at_work.at, self.cell.clearance);
-                if longer > 0.0 {
+                let Some((along, longer)) = detour(from, to, at_work.at, self.cell.clearance)
+                else {
+                    continue;
+                };
+                let passing = depart + crossing.1 + self.cell.travel_time(along, who.speed);
+                if at_work.free_at > passing {
                     in_the_way = (in_the_way.0 + 1, in_the_way.1 + longer);
                 }
             }
@@ -299,6 +307,14 @@ impl Dispatch {
             self.progress.zone_task[zone] = None;
         }
         done.iter().all(|&d| d)
+    }
+
+    /// Robot `robot` is at `at` now, wherever its last task was (it went home, or out of
+    /// the way): its next way starts there.
+    pub fn moved(&mut self, robot: usize, at: [f64; 2]) {
+        if let Some(state) = self.progress.robots.get_mut(robot) {
+            state.at = at;
+        }
     }
 
     /// Units whose every task is done.

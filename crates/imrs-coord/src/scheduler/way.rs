@@ -29,13 +29,19 @@ pub(crate) fn entry(from: [f64; 2], to: [f64; 2], centre: [f64; 2], radius: f64)
     (0.0..=length).contains(&along).then_some(along)
 }
 
-/// How much longer, in metres, the way from `from` to `to` is round a disc of `radius`
-/// about `centre` than straight through it: the arc on the near side instead of the chord.
-/// 0 if the way keeps clear of the disc.
-pub(crate) fn detour(from: [f64; 2], to: [f64; 2], centre: [f64; 2], radius: f64) -> f64 {
+/// Where the way from `from` to `to` passes nearest `centre`, in metres along it, and how
+/// much longer it is round a disc of `radius` about `centre` than straight through it: the
+/// arc on the near side instead of the chord. `None` if the way keeps clear of the disc,
+/// or if it starts or ends inside it (there is no way round then: a matter for the zone).
+pub(crate) fn detour(
+    from: [f64; 2],
+    to: [f64; 2],
+    centre: [f64; 2],
+    radius: f64,
+) -> Option<(f64, f64)> {
     let length = distance(from, to);
-    if length == 0.0 {
-        return 0.0;
+    if length == 0.0 || distance(from, centre) < radius || distance(to, centre) < radius {
+        return None;
     }
     let u = [(to[0] - from[0]) / length, (to[1] - from[1]) / length];
     let offset = [centre[0] - from[0], centre[1] - from[1]];
@@ -43,11 +49,11 @@ pub(crate) fn detour(from: [f64; 2], to: [f64; 2], centre: [f64; 2], radius: f64
     let nearest = [from[0] + u[0] * along, from[1] + u[1] * along];
     let gap = distance(nearest, centre);
     if gap >= radius {
-        return 0.0;
+        return None;
     }
     let chord = 2.0 * (radius * radius - gap * gap).sqrt();
     let arc = 2.0 * radius * (gap / radius).acos();
-    arc - chord
+    Some((along, arc - chord))
 }
 
 #[cfg(test)]
@@ -68,15 +74,20 @@ mod tests {
 
     #[test]
     fn a_way_through_a_disc_is_longer_round_it_and_one_beside_it_is_not() {
-        // Through the centre: half the circumference instead of the diameter.
-        let through = detour([0.0, 0.0], [1.0, 0.0], [0.5, 0.0], 0.1);
+        // Through the centre: half the circumference instead of the diameter, passing
+        // nearest half-way.
+        let (along, through) = detour([0.0, 0.0], [1.0, 0.0], [0.5, 0.0], 0.1).unwrap();
+        assert!((along - 0.5).abs() < 1e-9, "{along}");
         assert!(
             (through - (std::f64::consts::PI * 0.1 - 0.2)).abs() < 1e-9,
             "{through}"
         );
         // Grazing it: less.
-        let grazing = detour([0.0, 0.09], [1.0, 0.09], [0.5, 0.0], 0.1);
+        let (_, grazing) = detour([0.0, 0.09], [1.0, 0.09], [0.5, 0.0], 0.1).unwrap();
         assert!(grazing > 0.0 && grazing < through, "{grazing}");
-        assert_eq!(detour([0.0, 0.2], [1.0, 0.2], [0.5, 0.0], 0.1), 0.0);
+        assert_eq!(detour([0.0, 0.2], [1.0, 0.2], [0.5, 0.0], 0.1), None);
+        // Ending, or starting, inside it: no way round.
+        assert_eq!(detour([0.0, 0.0], [0.45, 0.0], [0.5, 0.0], 0.1), None);
+        assert_eq!(detour([0.55, 0.0], [1.0, 0.0], [0.5, 0.0], 0.1), None);
     }
 }
