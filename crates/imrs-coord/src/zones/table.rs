@@ -376,29 +376,21 @@ impl Resources {
     /// ([`release`](Self::release), [`release_tool`](Self::release_tool)), as it really
     /// has. Returns who is woken.
     pub fn stop_waiting(&mut self, robot: &str) -> Result<Vec<Name>, ZoneError> {
-        let robot = self.robot(robot)?;
-        self.robots.insert(robot.clone(), false);
-        let names: Vec<Name> = self.held.keys().cloned().collect();
-        let mut woken = Vec::new();
-        for name in names {
-            let held = self.held(name.as_str())?;
-            let was_first = held.sleeping.front() == Some(&robot);
-            held.sleeping.retain(|r| *r != robot);
-            let was_moving = held.moving.as_ref() == Some(&robot);
-            if was_moving {
-                held.moving = None;
-            }
-            if was_first || was_moving {
-                woken.extend(self.wake(name.as_str()));
-            }
-        }
-        Ok(woken)
+        let name = self.robot(robot)?;
+        self.robots.insert(name, false);
+        self.leave_queues(robot, false)
     }
 
     /// `robot` sleeps no more: it leaves every queue it is in, and keeps what it holds,
     /// its rights to move in shared zones too (to get out of the way, it must move).
     /// Returns who is woken: the next in a queue it headed.
     pub fn stop_sleeping(&mut self, robot: &str) -> Result<Vec<Name>, ZoneError> {
+        self.leave_queues(robot, true)
+    }
+
+    /// `robot` leaves every queue, and its rights to move unless `keep_moving`; who is
+    /// woken: the next in a queue it headed, or at a zone it no longer moves in.
+    fn leave_queues(&mut self, robot: &str, keep_moving: bool) -> Result<Vec<Name>, ZoneError> {
         let robot = self.robot(robot)?;
         let names: Vec<Name> = self.held.keys().cloned().collect();
         let mut woken = Vec::new();
@@ -406,7 +398,11 @@ impl Resources {
             let held = self.held(name.as_str())?;
             let was_first = held.sleeping.front() == Some(&robot);
             held.sleeping.retain(|r| *r != robot);
-            if was_first {
+            let stops_moving = !keep_moving && held.moving.as_ref() == Some(&robot);
+            if stops_moving {
+                held.moving = None;
+            }
+            if was_first || stops_moving {
                 woken.extend(self.wake(name.as_str()));
             }
         }
