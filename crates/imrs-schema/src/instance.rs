@@ -126,7 +126,8 @@ pub(crate) fn instantiate<S: Schema>(
     mut schema: S,
 ) -> Result<Si<S>, SchemaError> {
     let number = scope.reserve(S::NAME, number)?;
-    let name: Name = format!("{}{}_{}", scope.path, S::NAME, number).into();
+    let label = schema.label().unwrap_or(S::NAME);
+    let name: Name = format!("{}{}_{}", scope.path, label, number).into();
     let inside = scope.inside(&name);
     let control = Arc::new(Control::new(name.clone(), Arc::clone(&inside)));
     // An assemblage or a task-unit sets up its components inside itself; a task-unit's

@@ -78,6 +78,14 @@ pub trait Schema: Send + Sized + 'static {
     /// `(ip)` and `(op)`.
     type Ports: Ports;
 
+    /// The name its instances go by, if not [`NAME`](Self::NAME): instances of a schema
+    /// whose values are different things (a port automaton run as a schema) are named
+    /// after what each is, `label_i`. They are still `NAME`'s for `FORALL`, and numbered
+    /// among them.
+    fn label(&self) -> Option<&str> {
+        None
+    }
+
     /// Makes the instance's ports, and for an assemblage or a task-unit instantiates and
     /// connects its components in `cx` (its own inside). A plain schema declares fresh
     /// ports: `Ok(Declare::declare(cx.me()))`.

@@ -105,6 +105,14 @@ fn bad_declarations_are_refused_by_name() {
         refused.to_string(),
         "no port Nope on an automaton Closejoint_1 of this composition"
     );
+    // A name that could not name an instance.
+    for name in ["", "Grip/Closejoint"] {
+        let bad = PortAutomaton::new(name, "s").stop("s");
+        assert_eq!(
+            Composition::new([bad]).unwrap_err(),
+            AutomatonError::BadName(name.into())
+        );
+    }
     assert!(grip_automata(0, 4).is_err());
     assert!(grip_automata(MAX_JOINTS + 1, 4).is_err());
     // A transition to a state that does not exist is found when it is taken.
@@ -153,6 +161,12 @@ async fn behave(
         let schema = AutomatonSchema::new(part);
         visited.insert(name.clone(), schema.visited());
         let instance = net.instantiate_as(number as u32 + 1, schema).unwrap();
+        // Each instance is named after its automaton.
+        assert_eq!(
+            instance.name().as_str(),
+            format!("{name}_{}", number + 1),
+            "an automaton's instance"
+        );
         instances.insert(name, instance);
     }
     let cx = net.cx();

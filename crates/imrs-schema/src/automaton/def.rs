@@ -93,6 +93,9 @@ pub enum AutomatonError {
     },
     /// Two automata of one name in a composition.
     Duplicate(String),
+    /// A name that cannot name an instance: empty, or with a `/` (which parts an
+    /// assemblage's path from its components').
+    BadName(String),
     /// An input connected to more than one output, or an output to more than one input:
     /// the composition models one-to-one connections only.
     NotOneToOne {
@@ -115,6 +118,10 @@ impl fmt::Display for AutomatonError {
             Self::BothWays { automaton, port } => {
                 write!(f, "automaton {automaton} both reads and writes port {port}")
             }
+            Self::BadName(name) => write!(
+                f,
+                "an automaton cannot be named {name:?}: a name is not empty and has no '/'"
+            ),
             Self::NoPort { automaton, port } => {
                 write!(
                     f,
@@ -218,6 +225,9 @@ impl PortAutomaton {
     /// port is both read and written. A reading state's transitions are checked as they are
     /// taken.
     pub fn check(&self) -> Result<(), AutomatonError> {
+        if self.name.is_empty() || self.name.contains('/') {
+            return Err(AutomatonError::BadName(self.name.clone()));
+        }
         let no_state = |state: &str| AutomatonError::NoState {
             automaton: self.name.clone(),
             state: state.to_string(),

@@ -86,6 +86,11 @@ impl Schema for AutomatonSchema {
     const NAME: &'static str = "PortAutomaton";
     type Ports = AutomatonPorts;
 
+    /// Each instance is named after its automaton: `Grip_1`, `Closejoint_2_3`.
+    fn label(&self) -> Option<&str> {
+        Some(self.automaton.name())
+    }
+
     fn set_up(&mut self, cx: &Cx) -> Result<AutomatonPorts, SchemaError> {
         self.automaton
             .check()
