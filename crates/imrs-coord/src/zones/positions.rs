@@ -13,8 +13,9 @@ use super::space::Space;
 use super::sweep::{Sweep, space};
 use super::table::ZoneError;
 
-/// How much nearer than they are a way may take two robots already within the margin:
-/// a way along the other keeps its distance only to within a millimetre.
+/// How much nearer than they are a way may take two robots already within the margin, down
+/// to half the margin: a way along the other keeps its distance only to within a
+/// millimetre.
 pub const PARTING: f32 = 0.001;
 
 /// An arm's pose in the working plane: its base, elbow and tool.
@@ -75,7 +76,8 @@ impl Positions {
     /// The other robots whose links, where they last said they were, come within the margin
     /// of `robot`'s links at any pose of `sweep`: none when its way is clear. Of two robots
     /// already nearer than the margin where they said they were, the way is blocked if it
-    /// comes nearer than they are (less [`PARTING`]), so that they can part.
+    /// comes nearer than they are (less [`PARTING`], down to half the margin; below that,
+    /// at all), so that they can part.
     pub fn blockers(&self, robot: &str, sweep: &Sweep) -> Result<Vec<Name>, ZoneError> {
         self.known(robot)?;
         if sweep.iter().flatten().flatten().any(|c| !c.is_finite()) {
@@ -95,8 +97,13 @@ impl Positions {
                     let now = here.distance(theirs);
                     if now >= self.margin {
                         self.margin
+                    } else if now >= self.margin / 2.0 {
+                        // A way along the other may come a little nearer, but never below
+                        // half the margin: step after step, the tolerance cannot ratchet.
+                        (now - PARTING).max(self.margin / 2.0)
                     } else {
-                        (now - PARTING).max(now / 2.0).max(PARTING / 10.0)
+                        // Nearer than that, only a way that comes no nearer at all.
+                        now
                     }
                 });
                 !mine.clear_of(theirs, margin)
@@ -189,7 +196,11 @@ mod tests {
         assert_eq!(positions.blockers("B", &vec![arm(0.072)]).unwrap(), ["A"]);
         // Through A: blocked.
         assert_eq!(positions.blockers("B", &vec![arm(0.0)]).unwrap(), ["A"]);
-        // B told it is 1 mm from A: it may part, and not come nearer.
+        // At 1.5 cm (half the margin), a way 0.5 mm nearer is blocked: the tolerance stops
+        // there.
+        positions.tell("B", arm(0.085)).unwrap();
+        assert_eq!(positions.blockers("B", &vec![arm(0.0845)]).unwrap(), ["A"]);
+        // B told it is 1 mm from A: it may part, and not come nearer at all.
         positions.tell("B", arm(0.071)).unwrap();
         assert!(
             positions
@@ -197,7 +208,13 @@ mod tests {
                 .unwrap()
                 .is_empty()
         );
-        assert_eq!(positions.blockers("B", &vec![arm(0.0703)]).unwrap(), ["A"]);
+        assert!(
+            positions
+                .blockers("B", &vec![arm(0.071)])
+                .unwrap()
+                .is_empty()
+        );
+        assert_eq!(positions.blockers("B", &vec![arm(0.0709)]).unwrap(), ["A"]);
     }
 
     #[test]
