@@ -13,8 +13,9 @@
 //! tools and rights to move in shared zones; each victim is told to back off. A way it
 //! finds blocked by a robot asleep at a border that waits for what the blocked robot holds
 //! is a deadlock too, of space and zones, once the blocked robot says it waits
-//! ([`RobotLink::wait_on`]): the sleeper is told to back off. A robot's way is checked against the other robots where *they said* they
-//! were ([`Positions`]): the coordinator knows no more of the cell than its messages told it.
+//! ([`RobotLink::wait_on`]): the sleeper is told to back off. A robot's way is checked
+//! against the other robots where *they said* they were ([`Positions`]): the coordinator
+//! knows no more of the cell than its messages told it.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -238,22 +239,22 @@ impl RobotLink {
     }
 
     /// Asks for `zone` (or a tool) while the robot moves, as its pipeline asks for a point
-    /// ahead; granted, it goes on. Told to sleep, it stops (`stopped` halts it and resolves
-    /// once it stands still, to where its links are then, if it can say): an arm cannot
-    /// stop at once, and keeps its right to move in the shared zones `moving_in` while it
-    /// brakes in them. Stopped, it tells where it is (position information), gives each
-    /// right up with a position message, as the seed's robot does, waits to be woken, and
-    /// asks again.
+    /// ahead; granted, it goes on. Told to sleep, it stops (each call of `braking` halts it
+    /// and resolves after a step, to where its links are then, if it can say, and whether
+    /// it stands still; each pose is told as it brakes): an arm cannot stop at once, and
+    /// keeps its right to move in the shared zones `moving_in` while it brakes in them.
+    /// Stopped, it tells where it is (position information), gives each right up with a
+    /// position message, as the seed's robot does, waits to be woken, and asks again.
     /// Returns the zones it gave up, for it to ask again before it moves.
     ///
     /// From the sleep until the wake-up, every message it sends is sent while it listens for
     /// the wake-up: the coordinator waits for a robot it wakes, and one that waited for the
     /// coordinator in turn would leave both waiting.
-    pub async fn acquire_stopping<F: Future<Output = Option<Pose>>>(
+    pub async fn acquire_stopping<F: Future<Output = (Option<Pose>, bool)>>(
         &mut self,
         zone: &str,
         moving_in: &[Name],
-        mut stopped: impl FnMut() -> F,
+        mut braking: impl FnMut() -> F,
     ) -> Result<Vec<Name>, Refused> {
         let mut given_up: Vec<Name> = Vec::new();
         let mut at_rest = false;
@@ -275,20 +276,49 @@ impl RobotLink {
             let woken = if at_rest {
                 self.wake.receive().await
             } else {
-                let stop = stopped();
-                tokio::select! {
-                    biased;
-                    woken = self.wake.receive() => woken,
-                    pose = stop => {
-                        at_rest = true;
-                        self.give_up_stopped(pose, moving_in, &mut given_up).await?
-                    }
-                }
+                self.brake_asleep(&mut braking, moving_in, &mut given_up, &mut at_rest)
+                    .await?
             };
             let (wake, reply) = woken.map_err(|error| Refused::Failed(error.to_string()))?;
             reply.reply(());
             if wake == Wake::BackOff {
                 return Err(Refused::BackOff);
+            }
+        }
+    }
+
+    /// Asleep and braking: each step of `braking` (where its links are after it, and
+    /// whether it stands still) told as position information, listening for the wake-up
+    /// meanwhile; once it stands still, its rights given up. The wake-up.
+    async fn brake_asleep<F: Future<Output = (Option<Pose>, bool)>>(
+        &mut self,
+        braking: &mut impl FnMut() -> F,
+        moving_in: &[Name],
+        given_up: &mut Vec<Name>,
+        at_rest: &mut bool,
+    ) -> Result<Woken, Refused> {
+        loop {
+            let step = braking();
+            let (pose, still) = tokio::select! {
+                biased;
+                woken = self.wake.receive() => return Ok(woken),
+                braked = step => braked,
+            };
+            if still {
+                *at_rest = true;
+                return self.give_up_stopped(pose, moving_in, given_up).await;
+            }
+            if let Some(pose) = pose {
+                let at = (self.robot.clone(), Geometry::At(pose));
+                tokio::select! {
+                    biased;
+                    told = self.space.send(at) => {
+                        told
+                            .map_err(|error| Refused::Failed(error.to_string()))?
+                            .map_err(Refused::Failed)?;
+                    }
+                    woken = self.wake.receive() => return Ok(woken),
+                }
             }
         }
     }

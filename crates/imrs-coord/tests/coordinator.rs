@@ -450,7 +450,7 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                     .acquire_stopping("FIXTURE", &["PASSAGE".into()], || async {
                         braking.delay(BRAKING).await;
                         // Stopped across the line y = 0.05.
-                        Some([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]])
+                        (Some([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]]), true)
                     })
                     .await
                     .map_err(|e| format!("{e:?}"))?;

@@ -49,8 +49,9 @@ pub(crate) const MARGIN: f32 = 0.03;
 const RETRY: Duration = Duration::from_millis(200);
 /// How long an arm waits for a stopped arm in its way before it goes round it.
 const DETOUR_AFTER: Duration = Duration::from_secs(1);
-/// How long before the later of two arms that block each other backs off, home; and how
-/// long it then lets the other pass.
+/// How long before the later of two arms that block each other backs off (the earlier
+/// after twice as long), home or a short way back or aside; and how long it then lets the
+/// other pass.
 const BACK_OFF_AFTER: Duration = Duration::from_secs(3);
 
 /// What a request for a zone or the tool came to.
@@ -66,7 +67,7 @@ enum Leg {
     Arrived,
     /// Blocked by a stopped arm: go round it through these points.
     Via(Vec<Point2<f32>>),
-    /// Blocked by an arm that is itself blocked: back off to this point first.
+    /// Blocked for long, with no way round: back off to this point first.
     BackOff(Point2<f32>),
     /// The victim of a deadlock the coordinator found: it waits for nothing any more.
     Victim,
@@ -101,12 +102,14 @@ pub(crate) struct Mechanisms {
     pub(crate) via_home: bool,
 }
 
-/// STOP_C: brakes the arm; resolves once it stands still, to where its links are then.
-async fn stop(arm: TableArm) -> Option<Pose> {
+/// STOP_C, a step of it: brakes the arm; resolves after the world's next step, to where its
+/// links are then and whether it stands still.
+async fn braking(arm: TableArm) -> (Option<Pose>, bool) {
     arm.halt();
-    while !arm.step().await.at_rest() {}
+    let still = arm.step().await.at_rest();
     let here = arm.at();
-    Some(arm.scara().joints(&here)?.map(|joint| [joint.x, joint.y]))
+    let pose = arm.scara().joints(&here).map(|j| j.map(|p| [p.x, p.y]));
+    (pose, still)
 }
 
 /// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`), in a
@@ -424,7 +427,7 @@ impl Driver {
                     let arm = self.arm.clone();
                     let asked = self
                         .link
-                        .acquire_stopping(zone.as_str(), &moving_in, || stop(arm.clone()))
+                        .acquire_stopping(zone.as_str(), &moving_in, || braking(arm.clone()))
                         .await;
                     let got = match asked {
                         Ok(given_up) => {

@@ -18,7 +18,7 @@
 //! every step asks it to check its links a few points ahead against where the other arms
 //! told it they are: a stopped arm in the way is waited for, then gone round on the
 //! alternative trajectory the coordinator computes, and two arms in each other's way are
-//! parted by the later-named one backing off. No arm reads another's state from the
+//! parted by one backing off (home, or a short way back or aside). No arm reads another's state from the
 //! simulation: an arm module holds its own arm of the table, and nothing else of it.
 //!
 //! Rapier measures the outcome: collisions between arms, the closest they came, zone
@@ -146,8 +146,7 @@ pub enum Travel {
     ViaHome,
     /// Straight on to the next job: an arm that finished in the fixture asks for the tool
     /// from inside it, and one coming from the tray asks for the fixture from inside the
-    /// tray. Zone and tool deadlocks arise, and rights to move in the tray are given up at
-    /// the fixture's border.
+    /// tray, where rights to move are given up at the fixture's border.
     Straight,
 }
 

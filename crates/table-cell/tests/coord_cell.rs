@@ -147,7 +147,7 @@ fn the_same_seed_gives_the_same_run() {
 /// arm's fixed program or the same assignment dispatched, on every seed of the same
 /// arrivals. The goal of 15 % more is not met by arms that speed up and brake at their
 /// limit: they spend more of each job on the way and stopped in each other's way, which no
-/// assignment changes, and the gain measured is 1.2 to 3.6 % over the programs. The
+/// assignment changes, and the gain measured here is 1.2 to 3.6 % over the programs. The
 /// figures are printed.
 #[test]
 fn the_run_time_scheduler_makes_more_than_a_static_assignment_on_the_same_arrivals() {

@@ -1,14 +1,15 @@
-//! The run-time task scheduler of Jiménez et al. 1992 ("Programming/user interface"): robot-independent
-//! elementary tasks with task and part prerequisites, parts that come in random order at
-//! random times, and tasks assigned to robots as the cell runs — by capability, speed, and a
-//! score for the zone conflicts each assignment would meet, its entry points computed
-//! ahead, with the search pruned.
+//! The run-time task scheduler of Jiménez et al. 1992 ("Programming/user interface"):
+//! robot-independent elementary tasks with task and part prerequisites, parts that come in
+//! random order at random times, and tasks assigned to robots as the cell runs — by
+//! capability, speed, and a score for the resource and collision conflicts each assignment
+//! would meet (the entry points of the zones on its way, the robots at work it would go
+//! round), worked out ahead, with the search pruned.
 //!
 //! [`simulate`] runs a [`Workcell`] on a stream of [`Arrivals`] under a [`Policy`]: the
 //! [`RunTime`] scheduler, or the [`Static`] assignment it is compared with — each task kind
 //! bound to one robot beforehand, each robot running its program in a fixed order (or, as
-//! a stronger baseline, taking its oldest ready task). All meet the same arrivals, so their
-//! throughputs compare.
+//! a stronger baseline, taking its oldest ready task); or the [`PartDriven`] variant, tasks
+//! in the order their parts came. All meet the same arrivals, so their throughputs compare.
 //!
 //! The cell here is a discrete-event model (travel at a robot's speed, work scaled by it,
 //! one robot at a time in a shared zone), not the rapier world: what is compared is the

@@ -5,8 +5,8 @@
 //! braking at its own limit: its dynamic controller stops at a leg's end as planned, but
 //! goes only as far as it is allowed, and beyond the last point allowed it needs its
 //! stopping distance to stop ([`TableArm::allow`], [`TableArm::halt`]). Its links are
-//! placed by its kinematics ([`Scara`], on nalgebra) at every step. Rapier measures what the coordination
-//! must guarantee: whether the links of two arms touched, how close they came, and which
+//! placed by its kinematics ([`Scara`], on nalgebra) at every step. Rapier measures what
+//! the coordination must guarantee: whether the links of two arms touched, how close they came, and which
 //! grippers were inside which zone, moving or still — an exclusive zone with two grippers
 //! in it, or a shared zone with two moving in it, is a conflict. The tool is a body of its
 //! own: an arm can grasp it only where rapier finds it within reach of the gripper.
