@@ -175,6 +175,27 @@ pub enum Refused {
 /// A wake-up received, or why none could be.
 type Woken = Result<(Wake, imrs_ports::ReplyHandle<()>), imrs_ports::ReceiveError>;
 
+/// Sends `request` on `to` while listening for a wake-up on `wake`, for a robot asleep in
+/// the coordinator's books: `None` once the coordinator answered (an answer counts even if
+/// the wake-up came as well: the coordinator has acted on it), or the wake-up if it came
+/// first, the request withdrawn.
+async fn listening<Q: Send + 'static, A: Send + 'static>(
+    to: &mut End<(Name, Q), Result<A, String>, usage::Send>,
+    wake: &mut End<Wake, (), usage::Receive>,
+    request: (Name, Q),
+) -> Result<Option<Woken>, Refused> {
+    tokio::select! {
+        biased;
+        told = to.send(request) => {
+            told
+                .map_err(|error| Refused::Failed(error.to_string()))?
+                .map_err(Refused::Failed)?;
+            Ok(None)
+        }
+        woken = wake.receive() => Ok(Some(woken)),
+    }
+}
+
 /// A robot's ends of the coordinator's ports.
 pub struct RobotLink {
     robot: Name,
@@ -310,23 +331,16 @@ impl RobotLink {
             }
             if let Some(pose) = pose {
                 let at = (self.robot.clone(), Geometry::At(pose));
-                tokio::select! {
-                    biased;
-                    told = self.space.send(at) => {
-                        told
-                            .map_err(|error| Refused::Failed(error.to_string()))?
-                            .map_err(Refused::Failed)?;
-                    }
-                    woken = self.wake.receive() => return Ok(woken),
+                if let Some(woken) = listening(&mut self.space, &mut self.wake, at).await? {
+                    return Ok(woken);
                 }
             }
         }
     }
 
     /// Stopped while asleep at `pose`: tells where it is, and gives up the right to move in
-    /// each of `moving_in`, a position message each, listening for the wake-up meanwhile;
-    /// then waits for it. A message answered counts even if the wake-up came as well: the
-    /// coordinator has acted on it.
+    /// each of `moving_in`, a position message each, listening for the wake-up meanwhile
+    /// ([`listening`]); then waits for it.
     async fn give_up_stopped(
         &mut self,
         pose: Option<Pose>,
@@ -335,28 +349,16 @@ impl RobotLink {
     ) -> Result<Woken, Refused> {
         if let Some(pose) = pose {
             let at = (self.robot.clone(), Geometry::At(pose));
-            tokio::select! {
-                biased;
-                told = self.space.send(at) => {
-                    told
-                        .map_err(|error| Refused::Failed(error.to_string()))?
-                        .map_err(Refused::Failed)?;
-                }
-                woken = self.wake.receive() => return Ok(woken),
+            if let Some(woken) = listening(&mut self.space, &mut self.wake, at).await? {
+                return Ok(woken);
             }
         }
         for shared in moving_in {
             let position = (self.robot.clone(), Message::Position(shared.clone()));
-            tokio::select! {
-                biased;
-                told = self.to.send(position) => {
-                    told
-                        .map_err(|error| Refused::Failed(error.to_string()))?
-                        .map_err(Refused::Failed)?;
-                    given_up.push(shared.clone());
-                }
-                woken = self.wake.receive() => return Ok(woken),
+            if let Some(woken) = listening(&mut self.to, &mut self.wake, position).await? {
+                return Ok(woken);
             }
+            given_up.push(shared.clone());
         }
         Ok(self.wake.receive().await)
     }

@@ -194,6 +194,12 @@ fn what_cannot_be_is_refused_by_name() {
     assert!(matches!(table.arm("NOBODY"), Err(TableError::UnknownArm(name)) if name == "NOBODY"));
     runtime().block_on(async {
         let left = table.arm("LEFT").unwrap();
+        // A point allowed before any leg was started would never move the arm.
+        let error = left.allow(Point2::new(-0.3, 0.1)).unwrap_err();
+        assert!(
+            matches!(&error, TableError::NoLeg { arm } if arm == "LEFT"),
+            "{error}"
+        );
         let error = left.move_to(Point2::new(0.5, 0.0)).await.unwrap_err();
         assert!(error.to_string().contains("LEFT cannot reach"), "{error}");
         assert!(matches!(
@@ -212,7 +218,7 @@ fn drive_towards_the_zone(allowed: f32) -> (Duration, Point2<f32>) {
         let arm = left.clone();
         let driving = tokio::spawn(async move {
             arm.start_leg(Point2::new(0.0, 0.0))?;
-            arm.allow(Point2::new(allowed, 0.0));
+            arm.allow(Point2::new(allowed, 0.0))?;
             while !arm.step().await.at_rest() {}
             Ok::<_, TableError>(())
         });
@@ -243,7 +249,7 @@ fn a_halted_arm_brakes_and_a_leg_starts_only_from_rest() {
         let arm = left.clone();
         let driving = tokio::spawn(async move {
             arm.start_leg(Point2::new(-0.1, 0.0))?;
-            arm.allow(Point2::new(-0.1, 0.0));
+            arm.allow(Point2::new(-0.1, 0.0))?;
             let mut progress = arm.step().await;
             while progress.speed < 0.4 {
                 progress = arm.step().await;
@@ -256,7 +262,7 @@ fn a_halted_arm_brakes_and_a_leg_starts_only_from_rest() {
             }
             let braked = progress.along - at;
             // Allowed again, it goes on to the end.
-            arm.allow(Point2::new(-0.1, 0.0));
+            arm.allow(Point2::new(-0.1, 0.0))?;
             while !arm.step().await.arrived() {}
             Ok::<_, TableError>((moving, braked, arm.at()))
         });

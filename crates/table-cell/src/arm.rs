@@ -448,7 +448,9 @@ impl Driver {
                         return Ok(Leg::Victim);
                     }
                     // CONTINUE, if it was stopped: where it stands allows nothing new.
-                    self.arm.allow(self.arm.at());
+                    self.arm
+                        .allow(self.arm.at())
+                        .map_err(|error| error.to_string())?;
                 }
                 Next::Move { point, release } => {
                     if self.mechanisms.geometric {
@@ -463,7 +465,7 @@ impl Driver {
                         }
                     }
                     let point = Point2::new(point[0], point[1]);
-                    self.arm.allow(point);
+                    self.arm.allow(point).map_err(|error| error.to_string())?;
                     allowed.push_back(((point - from).norm(), release));
                     next += 1;
                 }

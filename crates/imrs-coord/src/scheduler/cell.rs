@@ -125,7 +125,7 @@ pub struct Workcell {
     /// How fast a robot speeds up and brakes, in m/s² (infinite: at once).
     pub acceleration: f64,
     /// How far a robot's way must keep from the tool of a robot at work, in metres: one
-    /// that passes nearer goes round it (0: robots never meet).
+    /// that passes nearer goes round it (0 or less: robots never meet).
     pub clearance: f64,
 }
 

@@ -115,6 +115,7 @@ pub struct RunTime {
     pub zone_weight: f64,
     /// How many seconds each robot at work in its way counts against a candidate, beyond
     /// the longer way round it (the coordinator may stop it first, and the other may move).
+    /// Not negative: the search prunes by a bound that counts it as nothing or more.
     pub collision_weight: f64,
     /// How much sooner, in seconds, another robot must finish a task for this one to leave
     /// it.

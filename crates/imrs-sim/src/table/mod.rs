@@ -175,6 +175,11 @@ pub enum TableError {
         /// Its speed, in m/s.
         speed: f32,
     },
+    /// A point was allowed to an arm that drives no leg.
+    NoLeg {
+        /// The arm.
+        arm: Name,
+    },
     /// The arm put down a tool it did not hold.
     NotHolding {
         /// The arm.
@@ -201,6 +206,9 @@ impl fmt::Display for TableError {
                 f,
                 "{arm} still moves at {speed:.3} m/s: a leg starts from rest"
             ),
+            Self::NoLeg { arm } => {
+                write!(f, "{arm} was allowed a point of no leg: start one first")
+            }
             Self::NotHolding { arm } => write!(f, "{arm} holds no tool to put down"),
             Self::Layout(why) => write!(f, "the table's layout cannot be built: {why}"),
         }
@@ -378,7 +386,7 @@ impl TableArm {
     /// reach or the arm still moves.
     pub async fn move_to(&self, to: Point2<f32>) -> Result<(), TableError> {
         self.start_leg(to)?;
-        self.allow(to);
+        self.allow(to)?;
         while !self.step().await.arrived() {}
         Ok(())
     }
@@ -407,11 +415,17 @@ impl TableArm {
     /// Allows the arm as far as `point` of its leg (taken where it lies along the leg), and
     /// lifts a halt: the seed's TRAJECTORY_POINT, and CONTINUE. It does not plan to stop at
     /// the last point allowed: there it brakes, and goes on by its stopping distance.
-    pub fn allow(&self, point: Point2<f32>) {
-        if let Some(drive) = &mut self.table.world().arms[self.index].drive {
-            drive.allow(point);
-        }
+    /// Refused, by the arm's name, if no leg was started ([`TableArm::start_leg`]): it
+    /// would allow nothing, and the arm would never move.
+    pub fn allow(&self, point: Point2<f32>) -> Result<(), TableError> {
+        let Some(drive) = &mut self.table.world().arms[self.index].drive else {
+            return Err(TableError::NoLeg {
+                arm: self.name().clone(),
+            });
+        };
+        drive.allow(point);
         self.table.shared.activity.notify_one();
+        Ok(())
     }
 
     /// STOP_C: the arm brakes at once, whatever it was allowed.
