@@ -23,7 +23,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use imrs_core::prelude::*;
 use imrs_ports::{AnyUser, End, Name, Port, PortSpec, SharedClock, select, usage};
 
-use crate::zones::{Answer, Pose, Positions, Resources, Sweep, ZoneError};
+use crate::zones::{Answer, Deadlock, DeadlockKind, Pose, Positions, Resources, Sweep, ZoneError};
 
 /// What a robot tells the coordinator.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -441,11 +441,13 @@ pub struct CoordinatorLog {
     pub granted: u32,
     /// Requests answered with sleep.
     pub slept: u32,
-    /// Deadlocks found and resolved, with their victims.
-    pub deadlocks: Vec<Name>,
-    /// Deadlocks of space and zones found and resolved, with their victims: a robot asleep
-    /// at a border in the way of one that holds what it waits for, told to back off.
-    pub in_the_way: Vec<Name>,
+    /// Deadlocks among zones, tools and rights to move found and resolved: each cycle,
+    /// what it ran through and its victim.
+    pub deadlocks: Vec<Deadlock>,
+    /// Deadlocks of space and zones found and resolved, each with its victim and what the
+    /// victim waited on (through the sleepers): a robot asleep at a border in the way of one
+    /// that holds what it waits for, told to back off.
+    pub in_the_way: Vec<(Name, DeadlockKind)>,
     /// Alarms, each passed on to every robot.
     pub alarms: Vec<(Name, String)>,
     /// Messages it could not take (unknown zone or robot), named.
@@ -530,9 +532,11 @@ pub fn coordinator(
                                     .iter()
                                     .filter(|other| asleep.contains(*other))
                                     .filter(|other| {
-                                        table.waits_on(other.as_str(), robot.as_str(), |r| {
-                                            asleep.contains(r)
-                                        })
+                                        let waits =
+                                            table.waits_on(other.as_str(), robot.as_str(), |r| {
+                                                asleep.contains(r)
+                                            });
+                                        waits.is_some()
                                     })
                                     .cloned()
                                     .collect()
@@ -542,17 +546,18 @@ pub fn coordinator(
                         reply.reply(seen.map_err(|error| error.to_string()));
                         for victim in victims {
                             // One woken by a victim before it waits for nothing any more.
-                            let still = asleep.contains(&victim)
-                                && lock(&table).waits_on(victim.as_str(), robot.as_str(), |r| {
+                            let still = asleep.contains(&victim).then(|| {
+                                lock(&table).waits_on(victim.as_str(), robot.as_str(), |r| {
                                     asleep.contains(r)
-                                });
-                            if !still {
+                                })
+                            });
+                            let Some(Some(kind)) = still else {
                                 continue;
-                            }
+                            };
                             let woken = lock(&table)
                                 .stop_sleeping(victim.as_str())
                                 .unwrap_or_default();
-                            lock(&log).in_the_way.push(victim.clone());
+                            lock(&log).in_the_way.push((victim.clone(), kind));
                             wake_up(&mut wake, &mut asleep, &victim, Wake::BackOff).await;
                             for robot in woken {
                                 wake_up(&mut wake, &mut asleep, &robot, Wake::WakeUp).await;
@@ -598,7 +603,7 @@ pub fn coordinator(
                                 break;
                             };
                             let woken = lock(&table).resolve(&deadlock).unwrap_or_default();
-                            lock(&log).deadlocks.push(deadlock.victim.clone());
+                            lock(&log).deadlocks.push(deadlock.clone());
                             let victim = &deadlock.victim;
                             // The victim leaves `asleep` here, so the loop ends.
                             wake_up(&mut wake, &mut asleep, victim, Wake::BackOff).await;

@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use imrs_coord::coordinator::{CoordinatorLog, CoordinatorPorts, Message, Refused, coordinator};
-use imrs_coord::zones::{Pose, Positions, Resources, ZoneDef, ZoneKind};
+use imrs_coord::zones::{DeadlockKind, Pose, Positions, Resources, ZoneDef, ZoneKind};
 use imrs_core::prelude::*;
 use imrs_ports::Name;
 
@@ -169,7 +169,10 @@ async fn a_deadlock_between_two_robots_is_resolved_by_the_coordinator() {
     for robot in &mut robots {
         assert_eq!(robot.finished().await, ModuleOutcome::Finished);
     }
-    assert_eq!(log.lock().unwrap().deadlocks, ["ROBOT_B"]);
+    let victims: Vec<Name> = (log.lock().unwrap().deadlocks.iter())
+        .map(|deadlock| deadlock.victim.clone())
+        .collect();
+    assert_eq!(victims, ["ROBOT_B"]);
 }
 
 #[tokio::test(start_paused = true)]
@@ -591,7 +594,10 @@ async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off()
         assert_eq!(robot.finished().await, ModuleOutcome::Finished);
     }
     assert_eq!(*outcome.lock().unwrap(), Some(Err(Refused::BackOff)));
-    assert_eq!(log.lock().unwrap().deadlocks, ["ROBOT_B"]);
+    let victims: Vec<Name> = (log.lock().unwrap().deadlocks.iter())
+        .map(|deadlock| deadlock.victim.clone())
+        .collect();
+    assert_eq!(victims, ["ROBOT_B"]);
 }
 
 /// A robot woken once is on its way to ask again: a second event that would wake it (here
@@ -740,7 +746,7 @@ async fn a_robot_asleep_in_the_way_of_the_one_it_waits_for_is_told_to_back_off()
     assert_eq!(found, ["ROBOT_B"]);
     assert_eq!(heard, "Err(BackOff)");
     assert!((1.5..1.6).contains(&at), "B was told at {at} s");
-    assert_eq!(log.in_the_way, ["ROBOT_B"]);
+    assert_eq!(log.in_the_way, [("ROBOT_B".into(), DeadlockKind::Zone)]);
     // B sleeps on TRAY, which C holds: A waits for B's space, B for C, C for nothing. Not a
     // deadlock: B is granted once C leaves.
     let (found, (heard, at), log) = asleep_in_the_way("TRAY").await;

@@ -2,7 +2,9 @@
 //! shared zones, tools, the active-zone grant, deadlocks found and resolved, and the arm's
 //! pipeline stopping before a zone it may not enter.
 
-use imrs_coord::zones::{Answer, Command, Pipeline, Resources, ZoneDef, ZoneError, ZoneKind};
+use imrs_coord::zones::{
+    Answer, Command, DeadlockKind, Pipeline, Resources, ZoneDef, ZoneError, ZoneKind,
+};
 
 fn table() -> Resources {
     Resources::new(
@@ -128,7 +130,9 @@ fn a_zone_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
     assert_eq!(t.request_move("ARM_A", "TRAY")?, Answer::Sleep);
     assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Sleep);
     let deadlock = t.deadlock().expect("the cycle A → B → A");
-    assert_eq!(deadlock.cycle.len(), 2);
+    assert_eq!(deadlock.cycle, ["ARM_A", "ARM_B"]);
+    assert_eq!(deadlock.waiting_on, ["TRAY", "FIXTURE"]);
+    assert_eq!(deadlock.kind, DeadlockKind::Zone);
     assert_eq!(deadlock.victim, "ARM_B");
     // B stops waiting: the cycle is broken, but TRAY is B's until it has left it.
     assert!(t.resolve(&deadlock)?.is_empty());
@@ -147,12 +151,31 @@ fn a_tool_deadlock_is_found_and_resolved() -> Result<(), ZoneError> {
     assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Sleep);
     assert_eq!(t.request_tool("ARM_C", "SCREWDRIVER")?, Answer::Sleep);
     let deadlock = t.deadlock().expect("a tool cycle");
+    assert_eq!(deadlock.kind, DeadlockKind::Tool);
+    assert_eq!(deadlock.waiting_on, ["GRIPPER", "SCREWDRIVER"]);
     assert_eq!(deadlock.victim, "ARM_C");
     // C stops waiting; the gripper is C's until it has put it down.
     assert!(t.resolve(&deadlock)?.is_empty());
     assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Sleep);
     assert_eq!(t.release_tool("ARM_C", "GRIPPER")?, ["ARM_A"]);
     assert_eq!(t.request_tool("ARM_A", "GRIPPER")?, Answer::Grant);
+    Ok(())
+}
+
+/// A robot inside an exclusive zone asks for the tool that another holds, which asks for
+/// that zone: a tool deadlock, though one of its waits is for a zone.
+#[test]
+fn a_cycle_through_a_zone_and_a_tool_is_a_tool_deadlock() -> Result<(), ZoneError> {
+    let mut t = table();
+    assert_eq!(t.request_move("ARM_A", "FIXTURE")?, Answer::Grant);
+    assert_eq!(t.request_tool("ARM_B", "SCREWDRIVER")?, Answer::Grant);
+    assert_eq!(t.request_tool("ARM_A", "SCREWDRIVER")?, Answer::Sleep);
+    assert_eq!(t.deadlock(), None);
+    assert_eq!(t.request_move("ARM_B", "FIXTURE")?, Answer::Sleep);
+    let deadlock = t.deadlock().expect("A waits for B's tool, B for A's zone");
+    assert_eq!(deadlock.kind, DeadlockKind::Tool);
+    assert_eq!(deadlock.cycle, ["ARM_A", "ARM_B"]);
+    assert_eq!(deadlock.waiting_on, ["SCREWDRIVER", "FIXTURE"]);
     Ok(())
 }
 
@@ -172,6 +195,8 @@ fn a_mixed_shared_and_exclusive_deadlock_is_found_and_resolved() -> Result<(), Z
     let deadlock = t
         .deadlock()
         .expect("A waits for B's zone, B for A's movement");
+    assert_eq!(deadlock.kind, DeadlockKind::Mixed);
+    assert_eq!(deadlock.waiting_on, ["FIXTURE", "FEEDERS"]);
     assert_eq!(deadlock.victim, "ARM_B");
     assert!(t.resolve(&deadlock)?.is_empty());
     assert_eq!(t.deadlock(), None);
@@ -382,6 +407,30 @@ fn a_cycle_among_robots_asleep_is_found_beside_one_whose_victim_is_awake() -> Re
     Ok(())
 }
 
+/// What a sleeper waits on through a chain of sleepers: the most telling kind of wait on
+/// the way — a tool, then a right to move.
+#[test]
+fn a_wait_through_the_tool_and_a_zone_is_of_the_tool() -> Result<(), ZoneError> {
+    let mut table = table();
+    // A waits for the screwdriver C holds; C waits for FIXTURE, where B is.
+    assert_eq!(table.request_move("ARM_B", "FIXTURE")?, Answer::Grant);
+    assert_eq!(table.request_tool("ARM_C", "SCREWDRIVER")?, Answer::Grant);
+    assert_eq!(table.request_tool("ARM_A", "SCREWDRIVER")?, Answer::Sleep);
+    assert_eq!(table.request_move("ARM_C", "FIXTURE")?, Answer::Sleep);
+    let asleep = |r: &imrs_ports::Name| *r != "ARM_B";
+    assert_eq!(
+        table.waits_on("ARM_A", "ARM_B", asleep),
+        Some(DeadlockKind::Tool)
+    );
+    assert_eq!(
+        table.waits_on("ARM_C", "ARM_B", asleep),
+        Some(DeadlockKind::Zone)
+    );
+    // Not through a robot that is awake.
+    assert_eq!(table.waits_on("ARM_A", "ARM_B", |r| *r == "ARM_A"), None);
+    Ok(())
+}
+
 #[test]
 fn a_robot_that_stops_sleeping_leaves_its_queues_and_keeps_its_right_to_move()
 -> Result<(), ZoneError> {
@@ -392,10 +441,13 @@ fn a_robot_that_stops_sleeping_leaves_its_queues_and_keeps_its_right_to_move()
     assert_eq!(table.request_move("ARM_A", "FIXTURE")?, Answer::Sleep);
     assert_eq!(table.request_move("ARM_C", "FIXTURE")?, Answer::Sleep);
     // A waits on B: told to back off, it leaves the queue, and C heads it.
-    assert!(table.waits_on("ARM_A", "ARM_B", |_| true));
-    assert!(!table.waits_on("ARM_B", "ARM_A", |_| true));
+    assert_eq!(
+        table.waits_on("ARM_A", "ARM_B", |_| true),
+        Some(DeadlockKind::Zone)
+    );
+    assert_eq!(table.waits_on("ARM_B", "ARM_A", |_| true), None);
     table.stop_sleeping("ARM_A")?;
-    assert!(!table.waits_on("ARM_A", "ARM_B", |_| true));
+    assert_eq!(table.waits_on("ARM_A", "ARM_B", |_| true), None);
     assert_eq!(table.release("ARM_B", "FIXTURE")?, ["ARM_C"]);
     // It still moves in FEEDERS: nobody else may, until it stops there.
     assert_eq!(table.request_move("ARM_B", "FEEDERS")?, Answer::Sleep);

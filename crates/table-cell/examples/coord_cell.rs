@@ -1,16 +1,20 @@
 //! The coordinated table cell: four arms sharing an exclusive fixture, a shared tray and
 //! one screwdriver, under the zone coordinator and the run-time task scheduler.
 //!
-//! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--straight] [--compare]`
+//! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--straight]
+//! [--variant seed|exclusive-tray|screwed-base|rights-kept] [--compare]`
 //!
 //! With `--compare`, the same arrivals also run under the static assignment (each arm's
 //! fixed program, and the same assignment dispatched) and the part-driven variant, and the
 //! units made are set side by side. With `--straight`, each arm goes straight on to its
-//! next job instead of home, and asks for the fixture from inside the tray.
+//! next job instead of home, and asks for the fixture from inside the tray. With
+//! `--variant`, the cell is changed in one thing so that deadlocks of one kind happen (with
+//! `--straight`): the tray exclusive (zone), the base screwed down (tool), or rights to move
+//! kept at a border against the seed's rule (mixed).
 
 use std::process::ExitCode;
 
-use table_cell::{Assignment, CellConfig, Travel, run};
+use table_cell::{Assignment, CellConfig, Travel, Variant, run};
 
 fn main() -> ExitCode {
     match cell() {
@@ -41,9 +45,25 @@ fn cell() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--compare" => compare = true,
             "--straight" => config.travel = Travel::Straight,
+            "--variant" => {
+                config.variant = match value("--variant")?.as_str() {
+                    "seed" => Variant::Seed,
+                    "exclusive-tray" => Variant::ExclusiveTray,
+                    "screwed-base" => Variant::ScrewedBase,
+                    "rights-kept" => Variant::RightsKept,
+                    other => {
+                        return Err(format!(
+                            "--variant: no variant {other}; use seed, exclusive-tray, \
+                             screwed-base or rights-kept"
+                        )
+                        .into());
+                    }
+                }
+            }
             other => {
                 return Err(format!(
-                    "unknown argument {other}; use --seed N, --hours H, --straight, --compare"
+                    "unknown argument {other}; use --seed N, --hours H, --straight, \
+                     --variant V, --compare"
                 )
                 .into());
             }

@@ -100,6 +100,9 @@ pub(crate) struct Mechanisms {
     pub(crate) geometric: bool,
     /// Whether it goes home after every job, or straight on to the next.
     pub(crate) via_home: bool,
+    /// Whether, refused at a border, it gives up its rights to move in the shared zones it
+    /// is in, as the seed's robots do.
+    pub(crate) gives_up_rights: bool,
 }
 
 /// STOP_C, a step of it: brakes the arm; resolves after the world's next step, to where its
@@ -419,7 +422,7 @@ impl Driver {
                     let moving_in: Vec<Name> = pipeline
                         .holding()
                         .chain(allowed.iter().flat_map(|(_, release)| release))
-                        .filter(|held| self.is_shared(held))
+                        .filter(|held| self.mechanisms.gives_up_rights && self.is_shared(held))
                         .cloned()
                         .collect::<BTreeSet<Name>>()
                         .into_iter()
@@ -455,6 +458,18 @@ impl Driver {
                 Next::Move { point, release } => {
                     if self.mechanisms.geometric {
                         let reach = (next + pipeline.offset() + LOOKAHEAD).min(points.len());
+                        // Past the points the pipeline checked, the way ahead ends at the
+                        // border of a zone not granted: whoever is inside is the zone's to
+                        // keep, and is waited for there, asleep, as the seed's robots do.
+                        let granted = |p: &Point2<f32>| {
+                            let zones = zones_at([p.x, p.y, WORK_Z]);
+                            zones
+                                .iter()
+                                .all(|zone| pipeline.holding().any(|h| h == zone))
+                        };
+                        let reach = (next..reach)
+                            .find(|&i| !granted(&points[i]))
+                            .unwrap_or(reach);
                         let ahead = &points[next..reach];
                         let taken = (&pipeline, &mut allowed);
                         if let Some(leg) = self.clear(ahead, &to, taken, may_back_off).await? {

@@ -5,6 +5,8 @@
 
 use imrs_sim::scara::{Elbow, Scara};
 use imrs_sim::table::{ArmSpec, TableLayout, ZoneSpec, ZoneUse};
+use std::fmt;
+
 use nalgebra::{Point2, Point3};
 
 use imrs_coord::scheduler::{Robot, Skill, TaskSpec, Workcell, Zone};
@@ -70,7 +72,75 @@ fn home(base: [f32; 2]) -> Point2<f32> {
     base + (Point2::origin() - base).normalize() * 0.28
 }
 
-/// The simulated table.
+/// The cell as laid out and programmed, or changed in one thing so that deadlocks of one
+/// kind happen when arms go straight on to their next job ([`Travel::Straight`]).
+///
+/// [`Travel::Straight`]: crate::Travel::Straight
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    /// As the seed would have it: the tray shared with restrictions, a right to move given
+    /// up at a border, one screw a unit. No deadlock can pass through the tray.
+    Seed,
+    /// The tray for exclusive use: an arm in it asks for the fixture, next to it, from
+    /// inside, and one in the fixture asks for the tray — zone deadlocks.
+    ExclusiveTray,
+    /// The base screwed down before the shaft goes in: an arm that placed it asks for the
+    /// screwdriver from inside the fixture, which the screwdriver's holder may be waiting
+    /// for — tool deadlocks.
+    ScrewedBase,
+    /// Against the seed's rule, an arm refused at a border keeps its right to move in the
+    /// tray: one in the fixture that asks to move in the tray closes a cycle — mixed
+    /// deadlocks.
+    RightsKept,
+}
+
+impl fmt::Display for Variant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Seed => "as laid out",
+            Self::ExclusiveTray => "tray exclusive",
+            Self::ScrewedBase => "base screwed down",
+            Self::RightsKept => "rights to move kept at a border",
+        })
+    }
+}
+
+impl Variant {
+    /// The simulated table.
+    pub fn layout(self) -> TableLayout {
+        let tray = if self == Self::ExclusiveTray {
+            ZoneUse::Exclusive
+        } else {
+            ZoneUse::Shared
+        };
+        let mut layout = layout();
+        if let Some(zone) = layout.zones.iter_mut().find(|zone| zone.name == TRAY) {
+            zone.usage = tray;
+        }
+        layout
+    }
+
+    /// The cell as the run-time scheduler sees it.
+    pub fn workcell(self) -> Workcell {
+        let mut cell = workcell();
+        if self == Self::ScrewedBase {
+            // Screwed down after it is placed, and before the shaft goes in.
+            let screw = TaskSpec::new("screw base", Skill::Screw, 3.0, [0.02, 0.02], &[0], &[]);
+            cell.tasks.push(screw);
+            let screwed = cell.tasks.len() - 1;
+            let insert = cell
+                .tasks
+                .iter_mut()
+                .find(|task| task.name == "insert shaft");
+            if let Some(insert) = insert {
+                insert.after.push(screwed);
+            }
+        }
+        cell
+    }
+}
+
+/// The simulated table, as laid out.
 pub fn layout() -> TableLayout {
     let zone = |name: &str, usage, centre: [f32; 2], half: f32| ZoneSpec {
         name: name.into(),
@@ -107,7 +177,7 @@ pub fn needs_tool(task: &TaskSpec) -> bool {
     task.skill == Skill::Screw
 }
 
-/// The cell as the run-time scheduler sees it: the four arms (skills, speeds, where they
+/// The cell as the run-time scheduler sees it, as laid out: the four arms (skills, speeds, where they
 /// stand and how far they reach), the six tasks of a unit, and the fixture as its zone.
 pub fn workcell() -> Workcell {
     let robots = SIDES

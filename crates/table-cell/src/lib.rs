@@ -52,7 +52,7 @@ use imrs_sim::table::{LINK_RADIUS, Table, TableError, ZoneSpec, ZoneUse};
 
 pub use self::ablation::{Ablation, AblationRow, ablation};
 pub use self::layout::{
-    ACCELERATION, FIXTURE, RACK, SCREWDRIVER, TRAY, layout, needs_tool, workcell,
+    ACCELERATION, FIXTURE, RACK, SCREWDRIVER, TRAY, Variant, layout, needs_tool, workcell,
 };
 pub use self::report::Report;
 pub use self::schedule::{Asking, Job, JobAsker, JobPort, SCHEDULER};
@@ -123,7 +123,7 @@ impl fmt::Display for Coordination {
 }
 
 impl Coordination {
-    fn mechanisms(self, travel: Travel) -> Mechanisms {
+    fn mechanisms(self, travel: Travel, variant: Variant) -> Mechanisms {
         let (offset, geometric) = match self {
             Self::ZonesOnly => (Some(0), false),
             Self::Pipeline => (None, false),
@@ -134,6 +134,7 @@ impl Coordination {
             offset,
             geometric,
             via_home: travel == Travel::ViaHome,
+            gives_up_rights: variant != Variant::RightsKept,
         }
     }
 }
@@ -150,6 +151,15 @@ pub enum Travel {
     Straight,
 }
 
+impl fmt::Display for Travel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::ViaHome => "home between jobs",
+            Self::Straight => "straight on between jobs",
+        })
+    }
+}
+
 /// A run of the table cell.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellConfig {
@@ -163,6 +173,8 @@ pub struct CellConfig {
     pub coordination: Coordination,
     /// How an arm goes from one job to the next.
     pub travel: Travel,
+    /// The cell as laid out, or changed so that deadlocks of one kind happen.
+    pub variant: Variant,
 }
 
 impl CellConfig {
@@ -175,6 +187,7 @@ impl CellConfig {
             assignment: Assignment::RunTime,
             coordination: Coordination::Full,
             travel: Travel::ViaHome,
+            variant: Variant::Seed,
         }
     }
 }
@@ -254,12 +267,12 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
     let clock = VirtualClock::new();
     let shared: SharedClock = Arc::new(clock.clone());
     let cell = Cell::new(Arc::clone(&shared));
-    let layout = layout();
+    let layout = config.variant.layout();
     let table = Table::new(layout.clone(), Arc::clone(&shared)).map_err(CellError::Table)?;
     let names: Vec<&str> = layout.arms.iter().map(|arm| arm.name.as_str()).collect();
     let zones: Arc<Vec<ZoneDef>> = Arc::new(layout.zones.iter().map(zone_def).collect());
 
-    let plan = workcell();
+    let plan = config.variant.workcell();
     // Enough units that parts keep coming for the whole run (a window opens every 12 s on
     // average).
     let units = (config.hours * 3600.0 / 12.0 * 1.5).ceil() as usize;
@@ -314,7 +327,9 @@ async fn simulate(config: &CellConfig) -> Result<Report, CellError> {
             &jobs,
             Arc::clone(&zones),
             Arc::clone(&stats),
-            config.coordination.mechanisms(config.travel),
+            config
+                .coordination
+                .mechanisms(config.travel, config.variant),
         ))?;
     }
 

@@ -9,6 +9,7 @@ use imrs_sim::table::Measured;
 use super::{CellConfig, CellStats};
 use imrs_coord::coordinator::CoordinatorLog;
 use imrs_coord::network::PortBound;
+use imrs_coord::zones::DeadlockKind;
 
 /// A run's report.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,6 +40,20 @@ impl Report {
         self.units as f64 / self.config.hours
     }
 
+    /// The deadlocks of `kind` the coordinator found and resolved.
+    pub fn deadlocks(&self, kind: DeadlockKind) -> usize {
+        let found = self.coordinator.deadlocks.iter();
+        found.filter(|deadlock| deadlock.kind == kind).count()
+    }
+
+    /// The deadlocks of space and `kind` the coordinator found and resolved: an arm asleep
+    /// at a border, waiting on a resource of `kind` (through other sleepers), in the way of
+    /// the arm that holds it.
+    pub fn in_the_way(&self, kind: DeadlockKind) -> usize {
+        let found = self.coordinator.in_the_way.iter();
+        found.filter(|(_, of)| *of == kind).count()
+    }
+
     /// Whether rapier saw neither a collision nor a zone or tool conflict, and every arm
     /// kept working.
     pub fn is_clean(&self) -> bool {
@@ -55,8 +70,8 @@ impl fmt::Display for Report {
             (&self.config, &self.measured, &self.coordinator, &self.stats);
         writeln!(
             f,
-            "coord_cell: seed {}, {} h simulated, {}",
-            config.seed, config.hours, config.assignment
+            "coord_cell: seed {}, {} h simulated, {}, {}, {}",
+            config.seed, config.hours, config.assignment, config.travel, config.variant
         )?;
         writeln!(
             f,
@@ -103,14 +118,22 @@ impl fmt::Display for Report {
         )?;
         writeln!(
             f,
-            "  deadlocks over zones and the tool, found and resolved  {}",
-            log.deadlocks.len()
+            "  deadlocks over zones, the tool and rights to move, found and resolved  {} \
+             (zone {}, tool {}, mixed {})",
+            log.deadlocks.len(),
+            self.deadlocks(DeadlockKind::Zone),
+            self.deadlocks(DeadlockKind::Tool),
+            self.deadlocks(DeadlockKind::Mixed)
         )?;
         writeln!(
             f,
             "  deadlocks of space and zones (an arm asleep at a border in the way of one it \
-             waits for), found and resolved  {}; victims that backed off  {}",
+             waits for), found and resolved  {} (zone {}, tool {}, mixed {}); \
+             victims that backed off  {}",
             log.in_the_way.len(),
+            self.in_the_way(DeadlockKind::Zone),
+            self.in_the_way(DeadlockKind::Tool),
+            self.in_the_way(DeadlockKind::Mixed),
             stats.victims
         )?;
         writeln!(

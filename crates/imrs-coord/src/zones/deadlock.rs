@@ -16,8 +16,63 @@ use super::{Resources, ZoneError};
 pub struct Deadlock {
     /// The robots in the cycle, each waiting for the next (the last for the first).
     pub cycle: Vec<Name>,
+    /// What each robot of the cycle sleeps on, in the same order: a zone or a tool.
+    pub waiting_on: Vec<Name>,
     /// The one that backs off: the last in name order, so the choice is reproducible.
     pub victim: Name,
+    /// What the cycle runs through.
+    pub kind: DeadlockKind,
+}
+
+/// What a deadlock's robots sleep on, as the seed tells the cases apart; a cycle through
+/// more than one is of the last kind it runs through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum DeadlockKind {
+    /// Exclusive zones only: the case in which "all the necessary conditions for deadlock
+    /// hold".
+    Zone,
+    /// A tool, and no right to move: tools "are still exclusive use shared resources",
+    /// whatever the zones.
+    Tool,
+    /// A right to move in a shared zone, kept by a robot asleep at another border: the
+    /// seed's robots give it up there, and then no such cycle can form.
+    Mixed,
+}
+
+impl std::fmt::Display for DeadlockKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Zone => "zone",
+            Self::Tool => "tool",
+            Self::Mixed => "mixed",
+        })
+    }
+}
+
+/// What a robot sleeps on: the resource, and which kind of wait it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wait {
+    Zone,
+    Tool,
+    Right,
+}
+
+impl Wait {
+    fn kind(self) -> DeadlockKind {
+        match self {
+            Self::Zone => DeadlockKind::Zone,
+            Self::Tool => DeadlockKind::Tool,
+            Self::Right => DeadlockKind::Mixed,
+        }
+    }
+}
+
+/// An edge of the wait-for graph: who holds the resource a sleeper sleeps on.
+#[derive(Debug, Clone)]
+struct Edge {
+    holder: Name,
+    resource: Name,
+    wait: Wait,
 }
 
 impl Resources {
@@ -32,56 +87,80 @@ impl Resources {
     /// sleeps.
     pub fn deadlock_among(&self, asleep: impl Fn(&Name) -> bool) -> Option<Deadlock> {
         let waits_for = self.waits_for(asleep);
-        let robots: Vec<Name> = waits_for.keys().cloned().collect();
-        for start in robots {
-            let mut path = vec![start.clone()];
+        for start in waits_for.keys() {
+            let mut path = vec![(start.clone(), None)];
             if let Some(cycle) = find_cycle(&waits_for, &mut path) {
-                let victim = cycle.iter().max_by_key(|r| r.as_str()).cloned()?;
-                return Some(Deadlock { cycle, victim });
+                let victim = cycle.iter().map(|(r, _)| r).max_by_key(|r| r.as_str())?;
+                let kinds = cycle.iter().map(|(_, edge)| edge.wait.kind());
+                let kind = kinds.max().unwrap_or(DeadlockKind::Zone);
+                return Some(Deadlock {
+                    victim: victim.clone(),
+                    waiting_on: cycle.iter().map(|(_, e)| e.resource.clone()).collect(),
+                    cycle: cycle.into_iter().map(|(robot, _)| robot).collect(),
+                    kind,
+                });
             }
         }
         None
     }
 
     /// Whether `sleeper`, asleep, waits (through the robots asleep for which `asleep`
-    /// holds, one holding what the next sleeps on) for something `holder` holds. A robot
-    /// in `sleeper`'s way that `sleeper` waits for in turn closes a cycle the books alone
-    /// do not show: one waiting on the other's zone, the other on its space.
-    pub fn waits_on(&self, sleeper: &str, holder: &str, asleep: impl Fn(&Name) -> bool) -> bool {
+    /// holds, one holding what the next sleeps on) for something `holder` holds: if so,
+    /// what the waits on the way run through. A robot in `sleeper`'s way that `sleeper`
+    /// waits for in turn closes a cycle the books alone do not show: one waiting on the
+    /// other's zone or tool, the other on its space.
+    pub fn waits_on(
+        &self,
+        sleeper: &str,
+        holder: &str,
+        asleep: impl Fn(&Name) -> bool,
+    ) -> Option<DeadlockKind> {
         let waits_for = self.waits_for(asleep);
         let mut seen: Vec<&Name> = Vec::new();
-        let mut next: Vec<&Name> = waits_for
+        let mut next: Vec<(&Name, DeadlockKind)> = waits_for
             .get_key_value(&Name::from(sleeper))
-            .map(|(name, _)| vec![name])
+            .map(|(name, _)| vec![(name, DeadlockKind::Zone)])
             .unwrap_or_default();
-        while let Some(robot) = next.pop() {
+        while let Some((robot, kind)) = next.pop() {
             if seen.contains(&robot) {
                 continue;
             }
             seen.push(robot);
-            for held_by in waits_for.get(robot).into_iter().flatten() {
-                if *held_by == holder {
-                    return true;
+            for edge in waits_for.get(robot).into_iter().flatten() {
+                let kind = kind.max(edge.wait.kind());
+                if edge.holder == holder {
+                    return Some(kind);
                 }
-                next.push(held_by);
+                next.push((&edge.holder, kind));
             }
         }
-        false
+        None
     }
 
     /// Each sleeper for which `asleep` holds, and who holds what it sleeps on.
-    fn waits_for(&self, asleep: impl Fn(&Name) -> bool) -> BTreeMap<Name, Vec<Name>> {
-        let mut waits_for: BTreeMap<Name, Vec<Name>> = BTreeMap::new();
-        for (_, holders, sleepers) in self
+    fn waits_for(&self, asleep: impl Fn(&Name) -> bool) -> BTreeMap<Name, Vec<Edge>> {
+        let mut waits_for: BTreeMap<Name, Vec<Edge>> = BTreeMap::new();
+        let exclusive = self
             .exclusive_waits()
             .into_iter()
-            .chain(self.shared_waits())
-        {
+            .map(|(resource, holders, sleepers)| {
+                let wait = if self.is_tool(resource.as_str()) {
+                    Wait::Tool
+                } else {
+                    Wait::Zone
+                };
+                (resource, holders, sleepers, wait)
+            });
+        let shared = (self.shared_waits().into_iter())
+            .map(|(resource, holders, sleepers)| (resource, holders, sleepers, Wait::Right));
+        for (resource, holders, sleepers, wait) in exclusive.chain(shared) {
             for sleeper in sleepers.iter().filter(|sleeper| asleep(sleeper)) {
-                waits_for
-                    .entry(sleeper.clone())
-                    .or_default()
-                    .extend(holders.iter().filter(|h| *h != sleeper).cloned());
+                let edges = holders.iter().filter(|h| *h != sleeper).map(|holder| Edge {
+                    holder: holder.clone(),
+                    resource: resource.clone(),
+                    wait,
+                });
+                waits_for.entry(sleeper.clone()).or_default().extend(edges);
             }
         }
         waits_for
@@ -96,14 +175,27 @@ impl Resources {
     }
 }
 
-/// Depth-first: a cycle through the last robot of `path` back to one on it.
-fn find_cycle(waits_for: &BTreeMap<Name, Vec<Name>>, path: &mut Vec<Name>) -> Option<Vec<Name>> {
-    let last = path.last()?.clone();
-    for next in waits_for.get(&last).into_iter().flatten() {
-        if let Some(at) = path.iter().position(|r| r == next) {
-            return Some(path[at..].to_vec());
+/// Depth-first: a cycle through the last robot of `path` back to one on it. Each robot on
+/// the path comes with the edge that led to it; each robot of the cycle found comes with
+/// the edge it waits on.
+fn find_cycle(
+    waits_for: &BTreeMap<Name, Vec<Edge>>,
+    path: &mut Vec<(Name, Option<Edge>)>,
+) -> Option<Vec<(Name, Edge)>> {
+    let last = path.last()?.0.clone();
+    for edge in waits_for.get(&last).into_iter().flatten() {
+        path.push((edge.holder.clone(), Some(edge.clone())));
+        if let Some(at) = path[..path.len() - 1]
+            .iter()
+            .position(|(robot, _)| *robot == edge.holder)
+        {
+            // Robot `at` waits on the edge that led to `at + 1`, and the last on this one.
+            let robots = path[at..path.len() - 1]
+                .iter()
+                .map(|(robot, _)| robot.clone());
+            let edges = path[at + 1..].iter().filter_map(|(_, edge)| edge.clone());
+            return Some(robots.zip(edges).collect());
         }
-        path.push(next.clone());
         if let Some(cycle) = find_cycle(waits_for, path) {
             return Some(cycle);
         }

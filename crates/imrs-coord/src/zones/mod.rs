@@ -39,7 +39,7 @@ mod space;
 mod sweep;
 mod table;
 
-pub use deadlock::Deadlock;
+pub use deadlock::{Deadlock, DeadlockKind};
 pub use detour::{Obstacle, detour, first_blocked};
 pub use pipeline::{Command, Next, Pipeline};
 pub use positions::{PARTING, Pose, Positions};
