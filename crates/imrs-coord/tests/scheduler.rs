@@ -22,6 +22,30 @@ fn the_run_time_scheduler_beats_static_programs_by_15_percent() {
     }
 }
 
+/// A task listed after a task that waits for it: the robot's program still does it first,
+/// and every unit is completed (in the order listed, the robot would wait for ever).
+#[test]
+fn a_program_does_a_prerequisite_listed_last_before_what_waits_for_it() {
+    // One robot that can do everything: its program holds every task.
+    let mut cell = Workcell::assembly();
+    cell.robots.truncate(1);
+    cell.robots[0].skills = vec![Skill::Place, Skill::Insert, Skill::Screw];
+    cell.robots[0].reach = ([0.0, 0.0], 10.0);
+    let first = cell.tasks[0].clone();
+    let mut extra = TaskSpec::new("check base", first.skill, 1.0, first.at, &[0], &[]);
+    extra.parts.clear();
+    cell.tasks.push(extra);
+    let last = cell.tasks.len() - 1;
+    for task in 1..last {
+        if cell.tasks[task].after.contains(&0) {
+            cell.tasks[task].after.push(last);
+        }
+    }
+    let arrivals = Arrivals::random(&cell, 20, 1);
+    let outcome = simulate(&cell, &arrivals, &mut Static::programs(&cell));
+    assert_eq!((outcome.units, outcome.refused), (20, 0));
+}
+
 /// Pruning the search never changes a choice: the same runs, pruned or not.
 #[test]
 fn pruning_finds_the_same_choices() {

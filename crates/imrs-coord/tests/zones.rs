@@ -407,8 +407,8 @@ fn a_cycle_among_robots_asleep_is_found_beside_one_whose_victim_is_awake() -> Re
     Ok(())
 }
 
-/// What a sleeper waits on through a chain of sleepers: the most telling kind of wait on
-/// the way — a tool, then a right to move.
+/// What a sleeper waits on through a chain of sleepers: the highest kind of wait on the
+/// way, in the order zone < tool < right to move.
 #[test]
 fn a_wait_through_the_tool_and_a_zone_is_of_the_tool() -> Result<(), ZoneError> {
     let mut table = table();

@@ -42,6 +42,9 @@ fn table() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    if seeds == 0 {
+        return Err("--seeds: at least one seed".into());
+    }
     println!(
         "{seeds} seeds × {hours} h each, arms going straight on; deadlocks found and resolved \
          by the coordinator (zone / tool / mixed), the rest measured by rapier"

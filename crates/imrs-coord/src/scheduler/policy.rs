@@ -16,7 +16,7 @@ pub trait Policy {
 ///
 /// Two ways to run it:
 /// - [`Static::programs`]: each robot runs its program — its tasks, unit by unit, in a
-///   fixed order — as an arm programmed in a language that assigns every task to an arm
+///   fixed order, each after those it waits for — as an arm programmed in a language that assigns every task to an arm
 ///   beforehand (the seed's ALMA) does: it waits for its next task's parts and
 ///   prerequisites rather than take another.
 /// - [`Static::dispatching`]: the assignment is fixed but the order is not: a robot takes,
@@ -72,7 +72,12 @@ impl Static {
             load[best] += spec.work / cell.robots[best].speed;
             plan[best].push(task);
         }
-        plan.iter_mut().for_each(|kinds| kinds.sort_unstable());
+        // Each program in the order its tasks can be done: after every task it waits for,
+        // wherever the cell lists them, so that no program waits for one of its own later
+        // tasks.
+        let depth = depths(cell);
+        plan.iter_mut()
+            .for_each(|kinds| kinds.sort_unstable_by_key(|&task| (depth[task], task)));
         plan
     }
 
@@ -80,6 +85,28 @@ impl Static {
     pub fn kinds(&self, robot: usize) -> &[usize] {
         &self.plan[robot]
     }
+}
+
+/// For each task, the longest chain of prerequisites before it. A cycle of prerequisites
+/// (which no unit can complete) stops at the number of tasks.
+fn depths(cell: &Workcell) -> Vec<usize> {
+    let count = cell.tasks.len();
+    let mut depth = vec![0; count];
+    for _ in 0..count {
+        let mut changed = false;
+        for (task, spec) in cell.tasks.iter().enumerate() {
+            let before = spec.after.iter().filter_map(|&b| depth.get(b));
+            let deepest = before.map(|d| (d + 1).min(count)).max().unwrap_or(0);
+            if deepest > depth[task] {
+                depth[task] = deepest;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    depth
 }
 
 impl Policy for Static {

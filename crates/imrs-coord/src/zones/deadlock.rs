@@ -24,8 +24,9 @@ pub struct Deadlock {
     pub kind: DeadlockKind,
 }
 
-/// What a deadlock's robots sleep on, as the seed tells the cases apart; a cycle through
-/// more than one is of the last kind it runs through.
+/// What a deadlock's robots sleep on, as the seed tells the cases apart. A cycle through
+/// more than one kind is of the highest it runs through, in the order `Zone < Tool <
+/// Mixed`; a cycle of rights to move alone is `Mixed` too.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum DeadlockKind {
     /// Exclusive zones only: the case in which "all the necessary conditions for deadlock
@@ -106,7 +107,7 @@ impl Resources {
 
     /// Whether `sleeper`, asleep, waits (through the robots asleep for which `asleep`
     /// holds, one holding what the next sleeps on) for something `holder` holds: if so,
-    /// what the waits on the way run through. A robot in `sleeper`'s way that `sleeper`
+    /// the highest kind of wait on the first such chain found (as for [`DeadlockKind`]). A robot in `sleeper`'s way that `sleeper`
     /// waits for in turn closes a cycle the books alone do not show: one waiting on the
     /// other's zone or tool, the other on its space.
     pub fn waits_on(
