@@ -460,6 +460,14 @@ pub struct CoordinatorLog {
     pub alternatives: (u32, u32),
 }
 
+impl CoordinatorLog {
+    /// Deadlocks found and resolved, of either sort: each has had its victim told to back
+    /// off.
+    pub fn resolved(&self) -> usize {
+        self.deadlocks.len() + self.in_the_way.len()
+    }
+}
+
 /// The coordinator module `name`: answers every message from `table`'s bookkeeping and the
 /// robots' told `positions`, wakes sleepers, resolves deadlocks, and passes alarms on to
 /// every robot. Its log is shared.

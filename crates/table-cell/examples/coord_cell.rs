@@ -2,7 +2,7 @@
 //! one screwdriver, under the zone coordinator and the run-time task scheduler.
 //!
 //! `cargo run --release --example coord_cell -- [--seed N] [--hours H] [--straight]
-//! [--variant seed|exclusive-tray|screwed-base|rights-kept] [--compare]`
+//! [--variant as-laid-out|exclusive-tray|screwed-base|rights-kept] [--compare]`
 //!
 //! With `--compare`, the same arrivals also run under the static assignment (each arm's
 //! fixed program, and the same assignment dispatched) and the part-driven variant, and the
@@ -14,7 +14,7 @@
 
 use std::process::ExitCode;
 
-use table_cell::{Assignment, CellConfig, Travel, Variant, run};
+use table_cell::{Assignment, CellConfig, Travel, run};
 
 fn main() -> ExitCode {
     match cell() {
@@ -46,19 +46,9 @@ fn cell() -> Result<(), Box<dyn std::error::Error>> {
             "--compare" => compare = true,
             "--straight" => config.travel = Travel::Straight,
             "--variant" => {
-                config.variant = match value("--variant")?.as_str() {
-                    "seed" => Variant::Seed,
-                    "exclusive-tray" => Variant::ExclusiveTray,
-                    "screwed-base" => Variant::ScrewedBase,
-                    "rights-kept" => Variant::RightsKept,
-                    other => {
-                        return Err(format!(
-                            "--variant: no variant {other}; use seed, exclusive-tray, \
-                             screwed-base or rights-kept"
-                        )
-                        .into());
-                    }
-                }
+                config.variant = value("--variant")?
+                    .parse()
+                    .map_err(|e| format!("--variant: {e}"))?
             }
             other => {
                 return Err(format!(

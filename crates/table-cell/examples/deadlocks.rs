@@ -9,7 +9,7 @@
 use std::process::ExitCode;
 
 use imrs_coord::zones::DeadlockKind;
-use table_cell::{CellConfig, Report, Travel, Variant, run};
+use table_cell::{CellConfig, Report, Travel, Variant, run_all};
 
 fn main() -> ExitCode {
     match table() {
@@ -55,21 +55,15 @@ fn table() -> Result<(), Box<dyn std::error::Error>> {
          zone conflicts | units / h |"
     );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
-    let variants = [
-        Variant::Seed,
-        Variant::ExclusiveTray,
-        Variant::ScrewedBase,
-        Variant::RightsKept,
-    ];
-    for variant in variants {
-        let mut reports = Vec::new();
-        for seed in 1..=seeds {
-            reports.push(run(&CellConfig {
+    for variant in Variant::ALL {
+        let configs: Vec<CellConfig> = (1..=seeds)
+            .map(|seed| CellConfig {
                 travel: Travel::Straight,
                 variant,
                 ..CellConfig::new(seed, hours)
-            })?);
-        }
+            })
+            .collect();
+        let reports = run_all(&configs)?;
         let sum = |count: &dyn Fn(&Report) -> usize| -> usize { reports.iter().map(count).sum() };
         let kinds = |count: &dyn Fn(&Report, DeadlockKind) -> usize| -> String {
             let each = [DeadlockKind::Zone, DeadlockKind::Tool, DeadlockKind::Mixed]

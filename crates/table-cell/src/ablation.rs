@@ -2,12 +2,9 @@
 //! mechanisms added one at a time, each row summing what rapier and the coordinator saw
 //! over every seed.
 
+use super::{Assignment, CellConfig, CellError, Coordination, Report, run_all};
 use std::fmt;
 use std::ops::RangeInclusive;
-use std::sync::Mutex;
-use std::thread;
-
-use super::{Assignment, CellConfig, CellError, Coordination, Report, lock, run};
 
 /// One row: a set of mechanisms over every seed.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,10 +46,7 @@ impl AblationRow {
     /// tool, and of space and zones (an arm asleep at a border in the way of one it waits
     /// for).
     pub fn deadlocks(&self) -> usize {
-        self.reports
-            .iter()
-            .map(|r| r.coordinator.deadlocks.len() + r.coordinator.in_the_way.len())
-            .sum()
+        self.reports.iter().map(|r| r.coordinator.resolved()).sum()
     }
 
     /// Requests answered with sleep, over every seed.
@@ -107,7 +101,7 @@ pub fn ablation(
             })
         })
         .collect();
-    let reports = run_all(configs)?;
+    let reports = run_all(&configs)?;
     let mut reports = reports.into_iter();
     Ok(Ablation {
         seeds: seeds.len(),
@@ -121,38 +115,6 @@ pub fn ablation(
             })
             .collect(),
     })
-}
-
-/// Runs every config, each on one thread of as many as there are cores; the reports in
-/// the configs' order.
-fn run_all(configs: Vec<CellConfig>) -> Result<Vec<Report>, CellError> {
-    let threads = thread::available_parallelism().map_or(1, usize::from);
-    let next = Mutex::new(0_usize);
-    let done: Mutex<Vec<Option<Result<Report, CellError>>>> =
-        Mutex::new(configs.iter().map(|_| None).collect());
-    thread::scope(|scope| {
-        for _ in 0..threads.min(configs.len()) {
-            scope.spawn(|| {
-                loop {
-                    let index = {
-                        let mut next = lock(&next);
-                        *next += 1;
-                        *next - 1
-                    };
-                    let Some(config) = configs.get(index) else {
-                        break;
-                    };
-                    let report = run(config);
-                    lock(&done)[index] = Some(report);
-                }
-            });
-        }
-    });
-    done.into_inner()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-        .into_iter()
-        .map(|report| report.unwrap_or(Err(CellError::Start("a run did not end".into()))))
-        .collect()
 }
 
 impl fmt::Display for Ablation {

@@ -27,7 +27,7 @@ use imrs_sim::scara::Scara;
 use imrs_sim::table::{ArmSpec, GRIPPER_RADIUS, TableArm, WORK_Z};
 use nalgebra::Point2;
 
-use super::layout::{ACCELERATION, RACK, SCREWDRIVER};
+use super::layout::{RACK, SCREWDRIVER};
 use super::schedule::{JobAsker, JobPort};
 use super::{CellStats, lock};
 use imrs_coord::coordinator::{CoordinatorPorts, Message, Refused, RobotLink};
@@ -79,6 +79,8 @@ struct Driver {
     arm: TableArm,
     scara: Scara,
     speed: f32,
+    /// How fast it speeds up and brakes, in m/s².
+    acceleration: f32,
     home: Point2<f32>,
     link: RobotLink,
     zones: Arc<Vec<ZoneDef>>,
@@ -138,6 +140,7 @@ pub(crate) fn arm_module(
                 index,
                 scara: spec.arm,
                 speed: spec.speed,
+                acceleration: spec.acceleration,
                 home: spec.home,
                 arm,
                 zones,
@@ -387,7 +390,7 @@ impl Driver {
             self.name.clone(),
             points.iter().map(|p| [p.x, p.y, WORK_Z]),
             self.speed,
-            ACCELERATION,
+            self.acceleration,
             SPACING,
         );
         if let Some(offset) = self.mechanisms.offset {
@@ -397,6 +400,19 @@ impl Driver {
         // The points allowed to the arm and not yet reached: how far along the leg each
         // lies, and the zones the arm has left once there.
         let mut allowed: VecDeque<(f32, Vec<Name>)> = VecDeque::new();
+        let zones = Arc::clone(&self.zones);
+        let zones_at = |point: [f32; 3]| -> Vec<Name> {
+            zones
+                .iter()
+                .filter(|zone| zone.touches(point, SWEPT))
+                .map(|zone| zone.name.clone())
+                .collect()
+        };
+        // The zones each point of the leg needs, for the way ahead.
+        let needs: Vec<Vec<Name>> = points
+            .iter()
+            .map(|p| zones_at([p.x, p.y, WORK_Z]))
+            .collect();
         let mut next = 0;
         loop {
             self.track(&mut allowed).await?;
@@ -406,14 +422,6 @@ impl Driver {
                 self.arm.step().await;
                 continue;
             }
-            let zones = Arc::clone(&self.zones);
-            let zones_at = |point: [f32; 3]| -> Vec<Name> {
-                zones
-                    .iter()
-                    .filter(|zone| zone.touches(point, SWEPT))
-                    .map(|zone| zone.name.clone())
-                    .collect()
-            };
             match pipeline.next(zones_at) {
                 Next::Request(zone) => {
                     // Every right to move in a shared zone it holds, the one it is in and
@@ -461,15 +469,10 @@ impl Driver {
                         // Past the points the pipeline checked, the way ahead ends at the
                         // border of a zone not granted: whoever is inside is the zone's to
                         // keep, and is waited for there, asleep, as the seed's robots do.
-                        let granted = |p: &Point2<f32>| {
-                            let zones = zones_at([p.x, p.y, WORK_Z]);
-                            zones
-                                .iter()
-                                .all(|zone| pipeline.holding().any(|h| h == zone))
+                        let granted = |i: usize| {
+                            (needs[i].iter()).all(|zone| pipeline.holding().any(|h| h == zone))
                         };
-                        let reach = (next..reach)
-                            .find(|&i| !granted(&points[i]))
-                            .unwrap_or(reach);
+                        let reach = (next..reach).find(|&i| !granted(i)).unwrap_or(reach);
                         let ahead = &points[next..reach];
                         let taken = (&pipeline, &mut allowed);
                         if let Some(leg) = self.clear(ahead, &to, taken, may_back_off).await? {

@@ -78,9 +78,9 @@ fn home(base: [f32; 2]) -> Point2<f32> {
 /// [`Travel::Straight`]: crate::Travel::Straight
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
-    /// As the seed would have it: the tray shared with restrictions, a right to move given
-    /// up at a border, one screw a unit. No deadlock can pass through the tray.
-    Seed,
+    /// As laid out, as the seed would have it: the tray shared with restrictions, a right to
+    /// move given up at a border, one screw a unit. No deadlock can pass through the tray.
+    AsLaidOut,
     /// The tray for exclusive use: an arm in it asks for the fixture, next to it, from
     /// inside, and one in the fixture asks for the tray — zone deadlocks.
     ExclusiveTray,
@@ -94,10 +94,34 @@ pub enum Variant {
     RightsKept,
 }
 
+/// A variant's [`flag`](Variant::flag) that names none.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NoVariant(pub String);
+
+impl fmt::Display for NoVariant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let flags: Vec<&str> = Variant::ALL.iter().map(|v| v.flag()).collect();
+        write!(f, "no variant {}; use {}", self.0, flags.join(", "))
+    }
+}
+
+impl std::error::Error for NoVariant {}
+
+impl std::str::FromStr for Variant {
+    type Err = NoVariant;
+
+    fn from_str(flag: &str) -> Result<Self, NoVariant> {
+        Self::ALL
+            .into_iter()
+            .find(|variant| variant.flag() == flag)
+            .ok_or_else(|| NoVariant(flag.into()))
+    }
+}
+
 impl fmt::Display for Variant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            Self::Seed => "as laid out",
+            Self::AsLaidOut => "as laid out",
             Self::ExclusiveTray => "tray exclusive",
             Self::ScrewedBase => "base screwed down",
             Self::RightsKept => "rights to move kept at a border",
@@ -106,6 +130,25 @@ impl fmt::Display for Variant {
 }
 
 impl Variant {
+    /// Every variant, the cell as laid out first.
+    pub const ALL: [Self; 4] = [
+        Self::AsLaidOut,
+        Self::ExclusiveTray,
+        Self::ScrewedBase,
+        Self::RightsKept,
+    ];
+
+    /// Its name on a command line: `as-laid-out`, `exclusive-tray`, `screwed-base`,
+    /// `rights-kept`.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Self::AsLaidOut => "as-laid-out",
+            Self::ExclusiveTray => "exclusive-tray",
+            Self::ScrewedBase => "screwed-base",
+            Self::RightsKept => "rights-kept",
+        }
+    }
+
     /// The simulated table.
     pub fn layout(self) -> TableLayout {
         let tray = if self == Self::ExclusiveTray {
@@ -114,7 +157,7 @@ impl Variant {
             ZoneUse::Shared
         };
         let mut layout = layout();
-        if let Some(zone) = layout.zones.iter_mut().find(|zone| zone.name == TRAY) {
+        for zone in layout.zones.iter_mut().filter(|zone| zone.name == TRAY) {
             zone.usage = tray;
         }
         layout
@@ -128,13 +171,7 @@ impl Variant {
             let screw = TaskSpec::new("screw base", Skill::Screw, 3.0, [0.02, 0.02], &[0], &[]);
             cell.tasks.push(screw);
             let screwed = cell.tasks.len() - 1;
-            let insert = cell
-                .tasks
-                .iter_mut()
-                .find(|task| task.name == "insert shaft");
-            if let Some(insert) = insert {
-                insert.after.push(screwed);
-            }
+            cell.tasks[INSERT_SHAFT].after.push(screwed);
         }
         cell
     }
@@ -176,6 +213,9 @@ pub fn layout() -> TableLayout {
 pub fn needs_tool(task: &TaskSpec) -> bool {
     task.skill == Skill::Screw
 }
+
+/// Where "insert shaft" is among the unit's tasks.
+const INSERT_SHAFT: usize = 3;
 
 /// The cell as the run-time scheduler sees it, as laid out: the four arms (skills, speeds, where they
 /// stand and how far they reach), the six tasks of a unit, and the fixture as its zone.

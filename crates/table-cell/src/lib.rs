@@ -39,6 +39,7 @@ mod ablation;
 mod arm;
 mod layout;
 mod report;
+mod runs;
 mod schedule;
 
 use std::fmt;
@@ -52,9 +53,11 @@ use imrs_sim::table::{LINK_RADIUS, Table, TableError, ZoneSpec, ZoneUse};
 
 pub use self::ablation::{Ablation, AblationRow, ablation};
 pub use self::layout::{
-    ACCELERATION, FIXTURE, RACK, SCREWDRIVER, TRAY, Variant, layout, needs_tool, workcell,
+    ACCELERATION, FIXTURE, NoVariant, RACK, SCREWDRIVER, TRAY, Variant, layout, needs_tool,
+    workcell,
 };
 pub use self::report::Report;
+pub use self::runs::run_all;
 pub use self::schedule::{Asking, Job, JobAsker, JobPort, SCHEDULER};
 
 use self::arm::{MARGIN, Mechanisms, arm_module};
@@ -173,7 +176,9 @@ pub struct CellConfig {
     pub coordination: Coordination,
     /// How an arm goes from one job to the next.
     pub travel: Travel,
-    /// The cell as laid out, or changed so that deadlocks of one kind happen.
+    /// The cell as laid out, or changed so that deadlocks of one kind happen: a variant
+    /// other than [`Variant::AsLaidOut`] runs only with [`Travel::Straight`], and is
+    /// refused by name otherwise.
     pub variant: Variant,
 }
 
@@ -187,7 +192,7 @@ impl CellConfig {
             assignment: Assignment::RunTime,
             coordination: Coordination::Full,
             travel: Travel::ViaHome,
-            variant: Variant::Seed,
+            variant: Variant::AsLaidOut,
         }
     }
 }
@@ -201,6 +206,9 @@ pub enum CellError {
     Table(TableError),
     /// A module could not be started.
     Start(String),
+    /// A variant made to provoke deadlocks, with arms that go home between jobs, where it
+    /// would provoke none.
+    Variant(Variant),
 }
 
 impl fmt::Display for CellError {
@@ -212,6 +220,12 @@ impl fmt::Display for CellError {
             ),
             Self::Table(error) => write!(f, "{error}"),
             Self::Start(why) => write!(f, "the cell could not start: {why}"),
+            Self::Variant(variant) => write!(
+                f,
+                "the variant {} makes its deadlocks only with arms that go straight on to \
+                 their next job (Travel::Straight)",
+                variant.flag()
+            ),
         }
     }
 }
@@ -251,6 +265,9 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 pub fn run(config: &CellConfig) -> Result<Report, CellError> {
     if !(config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS) {
         return Err(CellError::Hours(config.hours));
+    }
+    if config.variant != Variant::AsLaidOut && config.travel == Travel::ViaHome {
+        return Err(CellError::Variant(config.variant));
     }
     let wall = std::time::Instant::now();
     let runtime = tokio::runtime::Builder::new_current_thread()

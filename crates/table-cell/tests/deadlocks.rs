@@ -3,13 +3,10 @@
 //! deadlock is found by the coordinator and resolved, its victim gets out of the way, the
 //! work goes on, and rapier measures no collision and no conflict.
 
-use std::thread;
-
 use imrs_coord::zones::DeadlockKind::{Mixed, Tool, Zone};
-use table_cell::{Assignment, CellConfig, Report, Travel, Variant, run};
+use table_cell::{Assignment, CellConfig, CellError, Report, Travel, Variant, run, run_all};
 
-/// Seeds `seeds` of an hour for `variant`, arms going straight on, on two threads (the
-/// cell runs on one).
+/// Seeds `seeds` of an hour for `variant`, arms going straight on, one run on each core.
 fn run_variant(variant: Variant, seeds: std::ops::RangeInclusive<u64>) -> Vec<Report> {
     let configs: Vec<CellConfig> = seeds
         .map(|seed| CellConfig {
@@ -18,22 +15,7 @@ fn run_variant(variant: Variant, seeds: std::ops::RangeInclusive<u64>) -> Vec<Re
             ..CellConfig::new(seed, 1.0)
         })
         .collect();
-    let (even, odd): (Vec<_>, Vec<_>) = configs
-        .into_iter()
-        .enumerate()
-        .partition(|(i, _)| i % 2 == 0);
-    let spawn = |half: Vec<(usize, CellConfig)>| {
-        thread::spawn(move || {
-            (half.into_iter())
-                .map(|(i, config)| (i, run(&config).expect("the cell runs")))
-                .collect::<Vec<_>>()
-        })
-    };
-    let (a, b) = (spawn(even), spawn(odd));
-    let mut reports = a.join().unwrap();
-    reports.extend(b.join().unwrap());
-    reports.sort_by_key(|(i, _)| *i);
-    reports.into_iter().map(|(_, report)| report).collect()
+    run_all(&configs).expect("the cell runs")
 }
 
 /// Every run clean, every victim out of the way, and units made.
@@ -42,10 +24,9 @@ fn assert_resolved(reports: &[Report]) {
         assert!(report.is_clean(), "{report}");
         assert!(report.measured.closest.is_some_and(|c| c > 0.0), "{report}");
         assert!(report.units >= 100, "{report}");
-        let log = &report.coordinator;
         assert_eq!(
             report.stats.victims as usize,
-            log.deadlocks.len() + log.in_the_way.len(),
+            report.coordinator.resolved(),
             "{report}"
         );
     }
@@ -57,7 +38,7 @@ fn total(reports: &[Report], count: impl Fn(&Report) -> usize) -> usize {
 
 #[test]
 fn deadlocks_of_each_kind_happen_in_the_running_cell_and_are_resolved() {
-    let seed = run_variant(Variant::Seed, 1..=2);
+    let seed = run_variant(Variant::AsLaidOut, 1..=2);
     let exclusive_tray = run_variant(Variant::ExclusiveTray, 1..=2);
     let screwed_base = run_variant(Variant::ScrewedBase, 1..=2);
     // Mixed cycles are rare (two over the example's ten hours): all ten seeds.
@@ -110,6 +91,7 @@ fn the_cell_with_the_base_screwed_down_makes_units_under_every_assignment() {
     for assignment in assignments {
         let report = run(&CellConfig {
             assignment,
+            travel: Travel::Straight,
             variant: Variant::ScrewedBase,
             ..CellConfig::new(1, 0.2)
         })
@@ -117,4 +99,28 @@ fn the_cell_with_the_base_screwed_down_makes_units_under_every_assignment() {
         assert!(report.is_clean(), "{report}");
         assert!(report.units > 0, "{report}");
     }
+}
+
+/// A variant made to provoke deadlocks, with arms that go home between jobs, would provoke
+/// none: the run is refused, naming the variant.
+#[test]
+fn a_variant_with_arms_going_home_is_refused_by_name() {
+    for variant in Variant::ALL {
+        let config = CellConfig {
+            variant,
+            ..CellConfig::new(1, 0.01)
+        };
+        let refused = run(&config);
+        if variant == Variant::AsLaidOut {
+            assert!(refused.is_ok());
+            continue;
+        }
+        let error = refused.expect_err("a variant going home");
+        assert!(matches!(error, CellError::Variant(v) if v == variant));
+        assert!(error.to_string().contains(variant.flag()), "{error}");
+    }
+    // A flag that names no variant is refused, naming it and every variant.
+    let error = "rights-keep".parse::<Variant>().unwrap_err();
+    assert!(error.to_string().contains("rights-keep"), "{error}");
+    assert!(error.to_string().contains("rights-kept"), "{error}");
 }

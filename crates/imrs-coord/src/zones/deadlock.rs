@@ -50,30 +50,13 @@ impl std::fmt::Display for DeadlockKind {
     }
 }
 
-/// What a robot sleeps on: the resource, and which kind of wait it is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Wait {
-    Zone,
-    Tool,
-    Right,
-}
-
-impl Wait {
-    fn kind(self) -> DeadlockKind {
-        match self {
-            Self::Zone => DeadlockKind::Zone,
-            Self::Tool => DeadlockKind::Tool,
-            Self::Right => DeadlockKind::Mixed,
-        }
-    }
-}
-
 /// An edge of the wait-for graph: who holds the resource a sleeper sleeps on.
 #[derive(Debug, Clone)]
 struct Edge {
     holder: Name,
     resource: Name,
-    wait: Wait,
+    /// What kind of wait it is: for an exclusive zone, a tool, or a right to move.
+    kind: DeadlockKind,
 }
 
 impl Resources {
@@ -92,7 +75,7 @@ impl Resources {
             let mut path = vec![(start.clone(), None)];
             if let Some(cycle) = find_cycle(&waits_for, &mut path) {
                 let victim = cycle.iter().map(|(r, _)| r).max_by_key(|r| r.as_str())?;
-                let kinds = cycle.iter().map(|(_, edge)| edge.wait.kind());
+                let kinds = cycle.iter().map(|(_, edge)| edge.kind);
                 let kind = kinds.max().unwrap_or(DeadlockKind::Zone);
                 return Some(Deadlock {
                     victim: victim.clone(),
@@ -128,7 +111,7 @@ impl Resources {
             }
             seen.push(robot);
             for edge in waits_for.get(robot).into_iter().flatten() {
-                let kind = kind.max(edge.wait.kind());
+                let kind = kind.max(edge.kind);
                 if edge.holder == holder {
                     return Some(kind);
                 }
@@ -145,21 +128,22 @@ impl Resources {
             .exclusive_waits()
             .into_iter()
             .map(|(resource, holders, sleepers)| {
-                let wait = if self.is_tool(resource.as_str()) {
-                    Wait::Tool
+                let kind = if self.is_tool(resource.as_str()) {
+                    DeadlockKind::Tool
                 } else {
-                    Wait::Zone
+                    DeadlockKind::Zone
                 };
-                (resource, holders, sleepers, wait)
+                (resource, holders, sleepers, kind)
             });
-        let shared = (self.shared_waits().into_iter())
-            .map(|(resource, holders, sleepers)| (resource, holders, sleepers, Wait::Right));
-        for (resource, holders, sleepers, wait) in exclusive.chain(shared) {
+        let shared = (self.shared_waits().into_iter()).map(|(resource, holders, sleepers)| {
+            (resource, holders, sleepers, DeadlockKind::Mixed)
+        });
+        for (resource, holders, sleepers, kind) in exclusive.chain(shared) {
             for sleeper in sleepers.iter().filter(|sleeper| asleep(sleeper)) {
                 let edges = holders.iter().filter(|h| *h != sleeper).map(|holder| Edge {
                     holder: holder.clone(),
                     resource: resource.clone(),
-                    wait,
+                    kind,
                 });
                 waits_for.entry(sleeper.clone()).or_default().extend(edges);
             }

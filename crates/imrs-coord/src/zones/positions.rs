@@ -94,6 +94,11 @@ impl Positions {
                 // blocked if it comes nearer than they are now (less a tolerance for a way
                 // along the other, never down to touching).
                 let margin = here.map_or(self.margin, |here| {
+                    // Clear of each other by the margin (most robots, most of the time): no
+                    // distance to measure.
+                    if here.clear_of(theirs, self.margin) {
+                        return self.margin;
+                    }
                     let now = here.distance(theirs);
                     if now >= self.margin {
                         self.margin

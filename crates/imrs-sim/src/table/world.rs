@@ -129,8 +129,8 @@ impl TableWorld {
         Ok(())
     }
 
-    /// Places arm `arm`'s links and gripper as they are at `now`, and the tool with them if
-    /// it holds it.
+    /// Places arm `arm`'s links and gripper where its drive has them, and the tool with
+    /// them if it holds it.
     pub(crate) fn place_arm(&mut self, arm: usize) {
         let state = &self.arms[arm];
         let tool = state.tool();
