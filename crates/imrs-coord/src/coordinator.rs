@@ -172,6 +172,17 @@ pub enum Refused {
     Failed(String),
 }
 
+impl std::fmt::Display for Refused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::BackOff => f.write_str("told to back off, the victim of a deadlock"),
+            Self::Failed(why) => f.write_str(why),
+        }
+    }
+}
+
+impl std::error::Error for Refused {}
+
 /// A wake-up received, or why none could be.
 type Woken = Result<(Wake, imrs_ports::ReplyHandle<()>), imrs_ports::ReceiveError>;
 

@@ -41,6 +41,14 @@ fn table() -> Resources {
     )
 }
 
+/// Runs the cell to `seconds` of virtual time, then checks that each of `robots` finished.
+async fn run_until(clock: &VirtualClock, seconds: u64, robots: &mut [ModuleHandle]) {
+    imrs_core::time::drive(clock, Instant::from_start(Duration::from_secs(seconds))).await;
+    for robot in robots {
+        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
+    }
+}
+
 /// (robot, entered, left) for each stay in a zone, in seconds.
 type Stays = Arc<Mutex<Vec<(String, f64, f64)>>>;
 
@@ -80,32 +88,23 @@ async fn an_exclusive_zone_is_taken_in_turn_through_the_coordinator() {
             async move {
                 let mut link = ports.link(robot)?;
                 for _ in 0..5 {
-                    link.acquire("FIXTURE")
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.acquire("FIXTURE").await?;
                     let entered = seconds(&ctx);
                     ctx.delay(Duration::from_secs(1)).await;
                     stays
                         .lock()
                         .unwrap()
                         .push((robot.into(), entered, seconds(&ctx)));
-                    link.tell(Message::Release("FIXTURE".into()))
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.tell(Message::Release("FIXTURE".into())).await?;
                     ctx.delay(Duration::from_millis(300)).await;
                 }
-                link.tell(Message::TrajectoryEnd)
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::TrajectoryEnd).await?;
                 Ok(())
             }
         });
         robots.push(cell.start(spec).unwrap());
     }
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(30))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 30, &mut robots).await;
     let stays = stays.lock().unwrap().clone();
     assert_eq!(stays.len(), 10);
     for (i, a) in stays.iter().enumerate() {
@@ -139,16 +138,14 @@ async fn a_deadlock_between_two_robots_is_resolved_by_the_coordinator() {
             async move {
                 let mut link = ports.link(robot)?;
                 loop {
-                    link.acquire(first).await.map_err(|e| format!("{e:?}"))?;
+                    link.acquire(first).await?;
                     ctx.delay(Duration::from_secs(1)).await;
                     match link.acquire(second).await {
                         Ok(()) => break,
                         // The victim gets out of what it holds, says so, waits, and tries
                         // again.
                         Err(Refused::BackOff) => {
-                            link.tell(Message::Release(first.into()))
-                                .await
-                                .map_err(|e| format!("{e:?}"))?;
+                            link.tell(Message::Release(first.into())).await?;
                             ctx.delay(Duration::from_secs(3)).await;
                         }
                         Err(other) => return Err(format!("{other:?}").into()),
@@ -156,19 +153,14 @@ async fn a_deadlock_between_two_robots_is_resolved_by_the_coordinator() {
                 }
                 ctx.delay(Duration::from_secs(1)).await;
                 for zone in [first, second] {
-                    link.tell(Message::Release(zone.into()))
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.tell(Message::Release(zone.into())).await?;
                 }
                 Ok(())
             }
         });
         robots.push(cell.start(spec).unwrap());
     }
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(30))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 30, &mut robots).await;
     let victims: Vec<Name> = (log.lock().unwrap().deadlocks.iter())
         .map(|deadlock| deadlock.victim.clone())
         .collect();
@@ -185,7 +177,7 @@ async fn an_alarm_stops_every_robot_and_a_bad_name_is_refused() {
             let (ports, heard) = (ports.clone(), Arc::clone(&heard));
             async move {
                 let mut link = ports.link(robot)?;
-                let text = link.emergency().await.map_err(|e| format!("{e:?}"))?;
+                let text = link.emergency().await?;
                 heard.lock().unwrap().push((robot, text));
                 Ok(())
             }
@@ -201,10 +193,14 @@ async fn an_alarm_stops_every_robot_and_a_bad_name_is_refused() {
                 refused,
                 Refused::Failed("no zone or tool DOOR was defined before start".into())
             );
+            // Said as the coordinator said it, and an error a task can return with `?`.
+            let said: Box<dyn std::error::Error + Send + Sync> = refused.into();
+            assert_eq!(
+                said.to_string(),
+                "no zone or tool DOOR was defined before start"
+            );
             ctx.delay(Duration::from_secs(1)).await;
-            link.alarm("gripper jammed")
-                .await
-                .map_err(|e| format!("{e:?}"))?;
+            link.alarm("gripper jammed").await?;
             Ok(())
         }
     });
@@ -242,9 +238,9 @@ async fn a_way_is_checked_against_where_the_others_said_they_are() {
                 let mut link = ports.link("ROBOT_A")?;
                 // Its arm reaches across the line y = 0.05, its tool at (0.5, 0).
                 let across = [[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]];
-                link.at(across).await.map_err(|e| format!("{e:?}"))?;
+                link.at(across).await?;
                 ctx.delay(Duration::from_secs(2)).await;
-                link.at(along(1.0)).await.map_err(|e| format!("{e:?}"))?;
+                link.at(along(1.0)).await?;
                 Ok(())
             }
         })
@@ -257,15 +253,13 @@ async fn a_way_is_checked_against_where_the_others_said_they_are() {
             async move {
                 let mut link = ports.link("ROBOT_B")?;
                 let way = vec![along(0.05)];
-                let refused = |e| format!("{e:?}");
                 ctx.delay(Duration::from_secs(1)).await;
-                let blocked = link.check(way.clone()).await.map_err(refused)?;
+                let blocked = link.check(way.clone()).await?;
                 let round = link
                     .alternative([0.0, 0.05], [1.0, 0.05], blocked.clone())
-                    .await
-                    .map_err(refused)?;
+                    .await?;
                 ctx.delay(Duration::from_secs(2)).await;
-                let later = link.check(way).await.map_err(refused)?;
+                let later = link.check(way).await?;
                 let nowhere = link
                     .at([[f32::NAN, 0.0], [0.0, 0.0], [0.0, 0.0]])
                     .await
@@ -276,10 +270,7 @@ async fn a_way_is_checked_against_where_the_others_said_they_are() {
         })
     };
     let mut robots = [cell.start(a).unwrap(), cell.start(b).unwrap()];
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(5))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 5, &mut robots).await;
     let (blocked, round, later, nowhere) = seen.lock().unwrap().pop().expect("B checked");
     // Where A said it was, it blocked B's way; the alternative goes round it.
     assert_eq!(blocked, ["ROBOT_A"]);
@@ -311,13 +302,9 @@ async fn border_sleep(give_up: bool) -> (f64, Vec<String>) {
             let ports = ports.clone();
             async move {
                 let mut link = ports.link("ROBOT_C")?;
-                link.acquire("FIXTURE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("FIXTURE").await?;
                 ctx.delay(Duration::from_secs(2)).await;
-                link.tell(Message::Release("FIXTURE".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("FIXTURE".into())).await?;
                 Ok(())
             }
         })
@@ -329,32 +316,23 @@ async fn border_sleep(give_up: bool) -> (f64, Vec<String>) {
             async move {
                 let mut link = ports.link("ROBOT_A")?;
                 ctx.delay(Duration::from_millis(100)).await;
-                link.acquire("PASSAGE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("PASSAGE").await?;
                 let moving_in = if give_up {
                     vec!["PASSAGE".into()]
                 } else {
                     Vec::new()
                 };
-                let gave = link
-                    .acquire_giving_up("FIXTURE", &moving_in)
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                let gave = link.acquire_giving_up("FIXTURE", &moving_in).await?;
                 // It asks again for what it gave up before it moves on.
                 for zone in &gave {
-                    link.acquire(zone.as_str())
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.acquire(zone.as_str()).await?;
                 }
                 given_up
                     .lock()
                     .unwrap()
                     .extend(gave.iter().map(ToString::to_string));
                 for zone in ["FIXTURE", "PASSAGE"] {
-                    link.tell(Message::Release(zone.into()))
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.tell(Message::Release(zone.into())).await?;
                 }
                 Ok(())
             }
@@ -367,14 +345,10 @@ async fn border_sleep(give_up: bool) -> (f64, Vec<String>) {
             async move {
                 let mut link = ports.link("ROBOT_B")?;
                 ctx.delay(Duration::from_millis(500)).await;
-                link.acquire("PASSAGE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("PASSAGE").await?;
                 *granted.lock().unwrap() = Some(seconds(&ctx));
                 ctx.delay(Duration::from_millis(500)).await;
-                link.tell(Message::Release("PASSAGE".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("PASSAGE".into())).await?;
                 Ok(())
             }
         })
@@ -384,10 +358,7 @@ async fn border_sleep(give_up: bool) -> (f64, Vec<String>) {
         cell.start(a).unwrap(),
         cell.start(b).unwrap(),
     ];
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 10, &mut robots).await;
     assert!(log.lock().unwrap().refused.is_empty());
     let granted = granted.lock().unwrap().expect("B was granted PASSAGE");
     let given_up = given_up.lock().unwrap().clone();
@@ -425,13 +396,9 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
             let ports = ports.clone();
             async move {
                 let mut link = ports.link("ROBOT_C")?;
-                link.acquire("FIXTURE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("FIXTURE").await?;
                 ctx.delay(Duration::from_secs_f64(release)).await;
-                link.tell(Message::Release("FIXTURE".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("FIXTURE".into())).await?;
                 Ok(())
             }
         })
@@ -444,9 +411,7 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                 (ports.clone(), Arc::clone(&given_up), Arc::clone(&granted));
             async move {
                 let mut link = ports.link("ROBOT_A")?;
-                link.acquire("PASSAGE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("PASSAGE").await?;
                 ctx.delay(Duration::from_millis(100)).await;
                 let braking = &ctx;
                 let gave = link
@@ -455,13 +420,10 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                         // Stopped across the line y = 0.05.
                         (Some([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]]), true)
                     })
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                    .await?;
                 granted.lock().unwrap().1 = Some(seconds(&ctx));
                 for zone in &gave {
-                    link.acquire(zone.as_str())
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.acquire(zone.as_str()).await?;
                 }
                 given_up
                     .lock()
@@ -469,9 +431,7 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
                     .extend(gave.iter().map(ToString::to_string));
                 ctx.delay(Duration::from_millis(200)).await;
                 for zone in ["FIXTURE", "PASSAGE"] {
-                    link.tell(Message::Release(zone.into()))
-                        .await
-                        .map_err(|e| format!("{e:?}"))?;
+                    link.tell(Message::Release(zone.into())).await?;
                 }
                 Ok(())
             }
@@ -485,20 +445,13 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
             async move {
                 let mut link = ports.link("ROBOT_B")?;
                 ctx.delay(Duration::from_secs_f64(b_asks)).await;
-                link.acquire("PASSAGE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("PASSAGE").await?;
                 granted.lock().unwrap().0 = Some(seconds(&ctx));
                 // Where A stopped, if it said: in the way along y = 0.05.
-                let blocked = link
-                    .check(vec![along(0.05)])
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                let blocked = link.check(vec![along(0.05)]).await?;
                 seen_stopped.lock().unwrap().extend(blocked);
                 ctx.delay(Duration::from_millis(100)).await;
-                link.tell(Message::Release("PASSAGE".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("PASSAGE".into())).await?;
                 Ok(())
             }
         })
@@ -508,10 +461,7 @@ async fn stopping_at_border(release: f64, b_asks: f64) -> (f64, f64, Vec<String>
         cell.start(a).unwrap(),
         cell.start(b).unwrap(),
     ];
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 10, &mut robots).await;
     assert!(log.lock().unwrap().refused.is_empty());
     let (b, a) = *granted.lock().unwrap();
     let given_up = given_up.lock().unwrap().clone();
@@ -555,12 +505,10 @@ async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off()
             let ports = ports.clone();
             async move {
                 let mut link = ports.link("ROBOT_A")?;
-                link.acquire("FIXTURE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("FIXTURE").await?;
                 ctx.delay(Duration::from_secs(1)).await;
                 // Sleeps: ROBOT_B has TRAY; granted once B backs off.
-                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
+                link.acquire("TRAY").await?;
                 Ok(())
             }
         })
@@ -572,28 +520,25 @@ async fn a_victim_that_gives_up_a_shared_zone_as_it_sleeps_is_told_to_back_off()
             let (ports, outcome) = (ports.clone(), Arc::clone(&outcome));
             async move {
                 let mut link = ports.link("ROBOT_B")?;
-                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
-                link.acquire("PASSAGE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("TRAY").await?;
+                link.acquire("PASSAGE").await?;
                 ctx.delay(Duration::from_secs(2)).await;
                 // FIXTURE is A's, A waits for TRAY: B closes the cycle, and is its victim.
                 let asked = link.acquire_giving_up("FIXTURE", &["PASSAGE".into()]).await;
                 *outcome.lock().unwrap() = Some(asked);
                 // Backed off: it gets out of TRAY and says so.
-                link.tell(Message::Release("TRAY".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("TRAY".into())).await?;
                 Ok(())
             }
         })
     };
     let mut robots = [cell.start(a).unwrap(), cell.start(b).unwrap()];
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 10, &mut robots).await;
     assert_eq!(*outcome.lock().unwrap(), Some(Err(Refused::BackOff)));
+    assert_eq!(
+        Refused::BackOff.to_string(),
+        "told to back off, the victim of a deadlock"
+    );
     let victims: Vec<Name> = (log.lock().unwrap().deadlocks.iter())
         .map(|deadlock| deadlock.victim.clone())
         .collect();
@@ -613,29 +558,24 @@ async fn a_robot_woken_twice_before_it_asks_again_is_not_waited_for() {
             let (ports, moved) = (ports.clone(), Arc::clone(&moved));
             async move {
                 let mut link = ports.link(robot)?;
-                let refused = |e| format!("{e:?}");
                 match robot {
                     // Moves in PASSAGE, and at 1 s stops inside it.
                     "ROBOT_A" => {
-                        link.acquire("PASSAGE").await.map_err(refused)?;
+                        link.acquire("PASSAGE").await?;
                         ctx.delay(Duration::from_secs(1)).await;
-                        link.tell(Message::Position("PASSAGE".into()))
-                            .await
-                            .map_err(refused)?;
+                        link.tell(Message::Position("PASSAGE".into())).await?;
                     }
                     // At 1 s too, just after A, says it left PASSAGE, which it was never
                     // in: its timer is set later than A's for the same instant.
                     "ROBOT_B" => {
                         ctx.delay(Duration::from_millis(500)).await;
                         ctx.delay(Duration::from_millis(500)).await;
-                        link.tell(Message::Release("PASSAGE".into()))
-                            .await
-                            .map_err(refused)?;
+                        link.tell(Message::Release("PASSAGE".into())).await?;
                     }
                     // Waits to move in PASSAGE.
                     _ => {
                         ctx.delay(Duration::from_millis(100)).await;
-                        link.acquire("PASSAGE").await.map_err(refused)?;
+                        link.acquire("PASSAGE").await?;
                         *moved.lock().unwrap() = Some(seconds(&ctx));
                     }
                 }
@@ -667,11 +607,9 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, (String, f64), 
             let ports = ports.clone();
             async move {
                 let mut link = ports.link("ROBOT_C")?;
-                link.acquire("TRAY").await.map_err(|e| format!("{e:?}"))?;
+                link.acquire("TRAY").await?;
                 ctx.delay(Duration::from_secs(3)).await;
-                link.tell(Message::Release("TRAY".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("TRAY".into())).await?;
                 Ok(())
             }
         })
@@ -682,26 +620,17 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, (String, f64), 
             let (ports, found) = (ports.clone(), Arc::clone(&found));
             async move {
                 let mut link = ports.link("ROBOT_A")?;
-                link.acquire("FIXTURE")
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.acquire("FIXTURE").await?;
                 ctx.delay(Duration::from_secs(1)).await;
-                let blocked = link
-                    .check(vec![along(0.05)])
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                let blocked = link.check(vec![along(0.05)]).await?;
                 found
                     .lock()
                     .unwrap()
                     .extend(blocked.iter().map(ToString::to_string));
                 ctx.delay(Duration::from_millis(500)).await;
-                link.wait_on(vec![along(0.05)])
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.wait_on(vec![along(0.05)]).await?;
                 ctx.delay(Duration::from_millis(500)).await;
-                link.tell(Message::Release("FIXTURE".into()))
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.tell(Message::Release("FIXTURE".into())).await?;
                 Ok(())
             }
         })
@@ -714,9 +643,7 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, (String, f64), 
                 let mut link = ports.link("ROBOT_B")?;
                 ctx.delay(Duration::from_millis(500)).await;
                 // Its arm reaches across the line y = 0.05.
-                link.at([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]])
-                    .await
-                    .map_err(|e| format!("{e:?}"))?;
+                link.at([[0.5, -0.6], [0.5, -0.3], [0.5, 0.0]]).await?;
                 let asked = link.acquire(wants).await;
                 *heard.lock().unwrap() = (format!("{asked:?}"), seconds(&ctx));
                 Ok(())
@@ -728,10 +655,7 @@ async fn asleep_in_the_way(wants: &'static str) -> (Vec<String>, (String, f64), 
         cell.start(a).unwrap(),
         cell.start(b).unwrap(),
     ];
-    imrs_core::time::drive(&clock, Instant::from_start(Duration::from_secs(10))).await;
-    for robot in &mut robots {
-        assert_eq!(robot.finished().await, ModuleOutcome::Finished);
-    }
+    run_until(&clock, 10, &mut robots).await;
     let found = found.lock().unwrap().clone();
     let heard = heard.lock().unwrap().clone();
     let log = log.lock().unwrap().clone();

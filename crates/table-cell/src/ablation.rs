@@ -65,10 +65,10 @@ impl AblationRow {
         self.reports.iter().map(|r| r.stats.failures.len()).sum()
     }
 
-    /// Whether rapier saw neither a collision nor a zone conflict in any seed, and no arm
-    /// failed.
+    /// Whether every seed's run was clean ([`Report::is_clean`]): rapier saw neither a
+    /// collision nor a zone or tool conflict, and no arm failed.
     pub fn is_safe(&self) -> bool {
-        self.collisions() == 0 && self.zone_conflicts() == 0 && self.failures() == 0
+        self.reports.iter().all(Report::is_clean)
     }
 }
 
