@@ -3,7 +3,8 @@
 //! pipeline stopping before a zone it may not enter.
 
 use imrs_coord::zones::{
-    Answer, Command, DeadlockKind, Pipeline, Resources, ZoneDef, ZoneError, ZoneKind,
+    Answer, Command, DeadlockKind, Pipeline, Pose, Positions, Resources, ZoneDef, ZoneError,
+    ZoneKind,
 };
 
 fn table() -> Resources {
@@ -453,4 +454,69 @@ fn a_robot_that_stops_sleeping_leaves_its_queues_and_keeps_its_right_to_move()
     assert_eq!(table.request_move("ARM_B", "FEEDERS")?, Answer::Sleep);
     assert_eq!(table.stopped_inside("ARM_A", "FEEDERS")?, ["ARM_B"]);
     Ok(())
+}
+
+/// An arm along the x axis at height `y`, 50 cm long.
+fn along_x(y: f32) -> Pose {
+    [[0.0, y], [0.25, y], [0.5, y]]
+}
+
+/// The parting rule (`zones::PARTING`): two robots already nearer than the margin, where they
+/// told the coordinator they are, may part, and come no nearer than the rule allows.
+#[test]
+fn robots_already_within_the_margin_may_part_but_not_come_nearer() {
+    let mut positions = Positions::new(["A", "B"], 0.035, 0.03);
+    positions.tell("A", along_x(0.0)).unwrap();
+    // B's links 2 cm from A's (9 cm between the axes, 3.5 cm radius each).
+    positions.tell("B", along_x(0.09)).unwrap();
+    // Away from A: clear, though B is within the margin now.
+    assert!(
+        positions
+            .blockers("B", &vec![along_x(0.1)])
+            .unwrap()
+            .is_empty()
+    );
+    // As near as now: clear.
+    assert!(
+        positions
+            .blockers("B", &vec![along_x(0.09)])
+            .unwrap()
+            .is_empty()
+    );
+    // 5 mm nearer, or down to 2 mm: blocked, at any nearness.
+    assert_eq!(
+        positions.blockers("B", &vec![along_x(0.085)]).unwrap(),
+        ["A"]
+    );
+    assert_eq!(
+        positions.blockers("B", &vec![along_x(0.072)]).unwrap(),
+        ["A"]
+    );
+    // Through A: blocked.
+    assert_eq!(positions.blockers("B", &vec![along_x(0.0)]).unwrap(), ["A"]);
+    // At 1.5 cm (half the margin), a way 0.5 mm nearer is blocked: the tolerance stops
+    // there.
+    positions.tell("B", along_x(0.085)).unwrap();
+    assert_eq!(
+        positions.blockers("B", &vec![along_x(0.0845)]).unwrap(),
+        ["A"]
+    );
+    // B told it is 1 mm from A: it may part, and not come nearer at all.
+    positions.tell("B", along_x(0.071)).unwrap();
+    assert!(
+        positions
+            .blockers("B", &vec![along_x(0.08)])
+            .unwrap()
+            .is_empty()
+    );
+    assert!(
+        positions
+            .blockers("B", &vec![along_x(0.071)])
+            .unwrap()
+            .is_empty()
+    );
+    assert_eq!(
+        positions.blockers("B", &vec![along_x(0.0709)]).unwrap(),
+        ["A"]
+    );
 }

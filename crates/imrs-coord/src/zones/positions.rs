@@ -182,47 +182,6 @@ mod tests {
     }
 
     #[test]
-    fn robots_already_within_the_margin_may_part_but_not_come_nearer() {
-        let mut positions = Positions::new(["A", "B"], 0.035, 0.03);
-        positions.tell("A", arm(0.0)).unwrap();
-        // B's links 2 cm from A's (9 cm between the axes, 3.5 cm radius each).
-        positions.tell("B", arm(0.09)).unwrap();
-        // Away from A: clear, though B is within the margin now.
-        assert!(positions.blockers("B", &vec![arm(0.1)]).unwrap().is_empty());
-        // As near as now: clear.
-        assert!(
-            positions
-                .blockers("B", &vec![arm(0.09)])
-                .unwrap()
-                .is_empty()
-        );
-        // 5 mm nearer, or down to 2 mm: blocked, at any nearness.
-        assert_eq!(positions.blockers("B", &vec![arm(0.085)]).unwrap(), ["A"]);
-        assert_eq!(positions.blockers("B", &vec![arm(0.072)]).unwrap(), ["A"]);
-        // Through A: blocked.
-        assert_eq!(positions.blockers("B", &vec![arm(0.0)]).unwrap(), ["A"]);
-        // At 1.5 cm (half the margin), a way 0.5 mm nearer is blocked: the tolerance stops
-        // there.
-        positions.tell("B", arm(0.085)).unwrap();
-        assert_eq!(positions.blockers("B", &vec![arm(0.0845)]).unwrap(), ["A"]);
-        // B told it is 1 mm from A: it may part, and not come nearer at all.
-        positions.tell("B", arm(0.071)).unwrap();
-        assert!(
-            positions
-                .blockers("B", &vec![arm(0.08)])
-                .unwrap()
-                .is_empty()
-        );
-        assert!(
-            positions
-                .blockers("B", &vec![arm(0.071)])
-                .unwrap()
-                .is_empty()
-        );
-        assert_eq!(positions.blockers("B", &vec![arm(0.0709)]).unwrap(), ["A"]);
-    }
-
-    #[test]
     fn unknown_robots_and_poses_that_are_no_place_are_refused_by_name() {
         let mut positions = Positions::new(["A"], 0.035, 0.03);
         assert_eq!(
