@@ -112,9 +112,34 @@ pub(crate) struct Mechanisms {
 async fn braking(arm: TableArm) -> (Option<Pose>, bool) {
     arm.halt();
     let still = arm.step().await.at_rest();
-    let here = arm.at();
-    let pose = arm.scara().joints(&here).map(|j| j.map(|p| [p.x, p.y]));
-    (pose, still)
+    (pose(&arm.scara(), &arm.at()), still)
+}
+
+/// The links of `scara` with its tool at `tool`, if it reaches there.
+fn pose(scara: &Scara, tool: &Point2<f32>) -> Option<Pose> {
+    let joints = scara.joints(tool)?;
+    Some(joints.map(|joint| [joint.x, joint.y]))
+}
+
+/// The zones of `zones` that a ball of `radius` at `point`, at the working height, reaches
+/// into.
+fn zones_near(zones: &[ZoneDef], point: Point2<f32>, radius: f32) -> Vec<Name> {
+    let point = [point.x, point.y, WORK_Z];
+    zones
+        .iter()
+        .filter(|zone| zone.touches(point, radius))
+        .map(|zone| zone.name.clone())
+        .collect()
+}
+
+/// What a request came to: its answer, `None` if the robot was told to back off, or why it
+/// failed.
+fn answered<T>(asked: Result<T, Refused>) -> Result<Option<T>, String> {
+    match asked {
+        Ok(answer) => Ok(Some(answer)),
+        Err(Refused::BackOff) => Ok(None),
+        Err(Refused::Failed(why)) => Err(why),
+    }
 }
 
 /// The arm module for `arm` (the scheduler's robot `index`, laid out as `spec`), in a
@@ -234,13 +259,20 @@ impl Driver {
 
     /// Its links with the tool at `tool`, if it reaches there.
     fn pose(&self, tool: &Point2<f32>) -> Option<Pose> {
-        let joints = self.scara.joints(tool)?;
-        Some(joints.map(|joint| [joint.x, joint.y]))
+        pose(&self.scara, tool)
     }
 
     /// Its links at each of `points` it reaches.
     fn sweep(&self, points: &[Point2<f32>]) -> Sweep {
         points.iter().filter_map(|point| self.pose(point)).collect()
+    }
+
+    /// Tells the coordinator where its links are, if they moved since it last told.
+    async fn tell_if_moved(&mut self) -> Result<(), String> {
+        if self.last_told == Some(self.arm.at()) {
+            return Ok(());
+        }
+        self.tell_position().await
     }
 
     /// Tells the coordinator where its links are now (position information).
@@ -276,13 +308,9 @@ impl Driver {
             .map_err(|refused| format!("{refused:?}"))
     }
 
+    /// The zones its gripper is in, at `point`.
     fn zones_at(&self, point: Point2<f32>) -> Vec<Name> {
-        let point = [point.x, point.y, WORK_Z];
-        self.zones
-            .iter()
-            .filter(|zone| zone.touches(point, GRIPPER_RADIUS))
-            .map(|zone| zone.name.clone())
-            .collect()
+        zones_near(&self.zones, point, GRIPPER_RADIUS)
     }
 
     fn is_shared(&self, zone: &Name) -> bool {
@@ -312,14 +340,9 @@ impl Driver {
         resource: &Name,
         moving_in: &[Name],
     ) -> Result<Got, String> {
-        let given_up = match self
-            .link
-            .acquire_giving_up(resource.as_str(), moving_in)
-            .await
-        {
-            Ok(given_up) => given_up,
-            Err(Refused::BackOff) => return Ok(Got::BackOff),
-            Err(Refused::Failed(why)) => return Err(why),
+        let asked = self.link.acquire_giving_up(resource.as_str(), moving_in);
+        let Some(given_up) = answered(asked.await)? else {
+            return Ok(Got::BackOff);
         };
         lock(&self.stats).rights_given_up += given_up.len() as u32;
         self.reacquire_shared(given_up).await
@@ -331,10 +354,9 @@ impl Driver {
         let mut held: Vec<Name> = Vec::new();
         let mut pending: std::collections::VecDeque<Name> = shared.into();
         while let Some(zone) = pending.pop_front() {
-            let given_up = match self.link.acquire_giving_up(zone.as_str(), &held).await {
-                Ok(given_up) => given_up,
-                Err(Refused::BackOff) => return Ok(Got::BackOff),
-                Err(Refused::Failed(why)) => return Err(why),
+            let asked = self.link.acquire_giving_up(zone.as_str(), &held);
+            let Some(given_up) = answered(asked.await)? else {
+                return Ok(Got::BackOff);
             };
             held.retain(|h| !given_up.contains(h));
             pending.extend(given_up);
@@ -366,6 +388,7 @@ impl Driver {
                     legs.push((point, false, true));
                 }
                 Leg::Victim => {
+                    lock(&self.stats).victims += 1;
                     legs = vec![(self.home, false, true)];
                     arrived = false;
                 }
@@ -401,17 +424,12 @@ impl Driver {
         // lies, and the zones the arm has left once there.
         let mut allowed: VecDeque<(f32, Vec<Name>)> = VecDeque::new();
         let zones = Arc::clone(&self.zones);
-        let zones_at = |point: [f32; 3]| -> Vec<Name> {
-            zones
-                .iter()
-                .filter(|zone| zone.touches(point, SWEPT))
-                .map(|zone| zone.name.clone())
-                .collect()
-        };
+        // The points of the leg lie at the working height.
+        let zones_at = |point: [f32; 3]| zones_near(&zones, Point2::new(point[0], point[1]), SWEPT);
         // The zones each point of the leg needs, for the way ahead.
         let needs: Vec<Vec<Name>> = points
             .iter()
-            .map(|p| zones_at([p.x, p.y, WORK_Z]))
+            .map(|p| zones_near(&zones, *p, SWEPT))
             .collect();
         let mut next = 0;
         loop {
@@ -440,21 +458,19 @@ impl Driver {
                         .link
                         .acquire_stopping(zone.as_str(), &moving_in, || braking(arm.clone()))
                         .await;
-                    let got = match asked {
-                        Ok(given_up) => {
+                    let got = match answered(asked)? {
+                        Some(given_up) => {
                             // Granted: its own, even if it backs off before it moves on.
                             pipeline.granted(zone.clone());
                             lock(&self.stats).rights_given_up += given_up.len() as u32;
                             self.reacquire_shared(given_up).await?
                         }
-                        Err(Refused::BackOff) => Got::BackOff,
-                        Err(Refused::Failed(why)) => return Err(why),
+                        None => Got::BackOff,
                     };
                     if got == Got::BackOff {
                         // The victim of a deadlock: it gets out of the way, home, and
                         // comes back; the zones it is in stay its own until it has left.
                         self.halt().await?;
-                        lock(&self.stats).victims += 1;
                         self.abandon(&pipeline, &mut allowed).await?;
                         return Ok(Leg::Victim);
                     }
@@ -496,13 +512,7 @@ impl Driver {
                     self.track(&mut allowed).await?;
                     // Stopped in a shared zone: another may move there now.
                     // (Every shared zone the pipeline asked for here, within its reach.)
-                    let near: Vec<Name> = self
-                        .zones
-                        .iter()
-                        .filter(|zone| zone.touches([to.x, to.y, WORK_Z], SWEPT))
-                        .map(|zone| zone.name.clone())
-                        .collect();
-                    for zone in near {
+                    for zone in zones_near(&self.zones, to, SWEPT) {
                         if self.is_shared(&zone) {
                             self.tell(Message::Position(zone)).await?;
                         }
@@ -517,9 +527,7 @@ impl Driver {
     /// Tells the coordinator what the arm did since it last told: where its links are, if
     /// it moved, and the zones it has left at each allowed point it reached.
     async fn track(&mut self, allowed: &mut VecDeque<(f32, Vec<Name>)>) -> Result<(), String> {
-        if self.last_told != Some(self.arm.at()) {
-            self.tell_position().await?;
-        }
+        self.tell_if_moved().await?;
         let along = self.arm.progress().along;
         while allowed
             .front()
@@ -540,9 +548,7 @@ impl Driver {
         self.arm.halt();
         while !self.arm.progress().at_rest() {
             self.arm.step().await;
-            if self.last_told != Some(self.arm.at()) {
-                self.tell_position().await?;
-            }
+            self.tell_if_moved().await?;
         }
         Ok(())
     }
@@ -591,7 +597,6 @@ impl Driver {
                 }
                 if got == Got::BackOff {
                     // The victim of a deadlock: out of the way, home.
-                    lock(&self.stats).victims += 1;
                     return Ok(Some(Leg::Victim));
                 }
                 waiting = false;
