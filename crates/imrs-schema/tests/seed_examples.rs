@@ -3,12 +3,13 @@
 //! virtual finger's fingers moved and no other; and the guarded move over port arrays, two
 //! joints on one sensor and one joint on two sensors.
 
-use std::sync::Arc;
+use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
 use imrs_ports::{Clock, VirtualClock};
 use imrs_schema::seed::{
-    Closefinger, Desired, Grasp, Grip, GuardedMove, ObjectQ, ObjectQOnce, Reach, Vf,
+    Closefinger, Desired, Features, Grasp, Grip, GuardedMove, Judge, ObjectQ, ObjectQOnce, Reach,
+    Vf,
 };
 use imrs_schema::special::Vision;
 use imrs_schema::{Ending, Network, Si};
@@ -207,6 +208,123 @@ async fn example_3_object_search_tests_every_sef_in_parallel_and_reaches_the_mat
         "the palm is {error} m from its target over the ball"
     );
     assert_none_failed(&bench.net);
+}
+
+/// A test of the seed's features that takes its time: each of the first `expected` judges
+/// waits, for real and at most `PATIENCE`, until all of them have come in, and the room
+/// keeps the most it saw judging at once. Were the judges run one after the other, the
+/// first would wait alone and give up, and the most would be 1.
+#[derive(Clone)]
+struct Meeting {
+    desired: Desired,
+    expected: usize,
+    room: Arc<(Mutex<Room>, Condvar)>,
+}
+
+#[derive(Default)]
+struct Room {
+    arrived: usize,
+    inside: usize,
+    most: usize,
+}
+
+impl Meeting {
+    const PATIENCE: Duration = Duration::from_secs(10);
+
+    fn most(&self) -> usize {
+        self.room.0.lock().unwrap().most
+    }
+}
+
+impl Judge for Meeting {
+    fn judge(&self, features: &Features) -> bool {
+        let (room, changed) = &*self.room;
+        let mut guard = room.lock().unwrap();
+        guard.arrived += 1;
+        guard.inside += 1;
+        guard.most = guard.most.max(guard.inside);
+        changed.notify_all();
+        let (mut guard, _) = changed
+            .wait_timeout_while(guard, Self::PATIENCE, |r| r.arrived < self.expected)
+            .unwrap();
+        guard.inside -= 1;
+        self.desired.judge(features)
+    }
+}
+
+/// The parallel search measured: the judges of every SEF are seen judging at the same
+/// moment, each waiting in its test until the others have come in.
+#[tokio::test(start_paused = true)]
+async fn example_3_every_sef_is_judged_at_once() {
+    let bench = Bench::new();
+    let sefs = bench.hand.objects().len();
+    let ball = bench.index_of(Shape::Ball);
+    let meeting = Meeting {
+        desired: Desired {
+            shape: Shape::Ball,
+            size: 0.06,
+            tolerance: 0.005,
+        },
+        expected: sefs,
+        room: Arc::default(),
+    };
+    let found = Arc::new(Mutex::new(None));
+    let record = Arc::clone(&found);
+    bench
+        .net
+        .instantiate(ObjectQ::new(meeting.clone(), move |_, sef| {
+            *record.lock().unwrap() = Some(sef);
+            Ok(())
+        }))
+        .unwrap();
+    bench.run_for(1.0).await;
+    assert_eq!(
+        *found.lock().unwrap(),
+        Some(bench.sef_of(ball)),
+        "the search did not find the ball"
+    );
+    assert_eq!(
+        meeting.most(),
+        sefs,
+        "the SEFs' judges did not all judge at once"
+    );
+    assert_eq!(ended(&bench.net, "Object?_1"), Some(Ending::Stopped));
+    assert_none_failed(&bench.net);
+}
+
+/// A judge that panics fails its own `Objtest`, by name; the search goes on testing.
+#[tokio::test(start_paused = true)]
+async fn example_3_a_judge_that_panics_fails_its_test_by_name() {
+    #[derive(Clone)]
+    struct Panics;
+    impl Judge for Panics {
+        fn judge(&self, _: &Features) -> bool {
+            panic!("a recognizer's bug")
+        }
+    }
+    let bench = Bench::new();
+    bench
+        .net
+        .instantiate(ObjectQ::new(Panics, |_, _| Ok(())))
+        .unwrap();
+    bench.run_for(0.5).await;
+    let failed: Vec<_> = bench
+        .net
+        .trace()
+        .into_iter()
+        .filter_map(|e| match e.ended {
+            Some(Ending::Failed(error)) => Some(error.to_string()),
+            _ => None,
+        })
+        .collect();
+    assert!(
+        failed.contains(&"Objtest_2 failed: its judge panicked".to_string()),
+        "{failed:#?}"
+    );
+    assert!(
+        bench.net.forall::<ObjectQ<Panics>>().len() == 1,
+        "the search ended"
+    );
 }
 
 #[tokio::test(start_paused = true)]

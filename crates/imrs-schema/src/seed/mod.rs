@@ -27,7 +27,8 @@ pub use grip_automata::{
 };
 pub use guarded::{GuardedMove, GuardedMovePorts};
 pub use object::{
-    Desired, ObjectQ, ObjectQOnce, ObjectQPorts, Objtest, ObjtestPorts, ObjtestTrigger, Starter,
+    Desired, Features, Judge, ObjectQ, ObjectQOnce, ObjectQPorts, Objtest, ObjtestPorts,
+    ObjtestTrigger, Starter,
 };
 pub use reach::{RObject, RObjectPorts, Reach, ReachPorts};
 pub use vf::{Closefinger, ClosefingerPorts, Grasp, Vf};

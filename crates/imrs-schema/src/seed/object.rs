@@ -8,6 +8,29 @@ use nalgebra::{Point3, UnitQuaternion};
 use crate::special::{Sef, SefPorts, Vision};
 use crate::{Behavior, Cx, Declare, Flow, Schema, SchemaError, ports};
 
+/// The features `F1 … F4` a SEF gives of its object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Features {
+    /// `F1`: where it is.
+    pub position: Point3<f32>,
+    /// `F2`: how it is turned.
+    pub orientation: UnitQuaternion<f32>,
+    /// `F3`: its shape.
+    pub shape: Shape,
+    /// `F4`: its size.
+    pub size: f32,
+}
+
+/// `Objtest`'s test of a SEF's features against the object sought (`DF1 … DF4`).
+///
+/// [`Desired`] is the seed's test. A recognizer of one's own (a model matched against a
+/// point cloud) takes its place; it may take long. Each `Objtest` runs its test on a
+/// thread of tokio's blocking pool, so the tests of every SEF run at once.
+pub trait Judge: Clone + Send + Sync + 'static {
+    /// Whether `features` describe the object sought.
+    fn judge(&self, features: &Features) -> bool;
+}
+
 /// `DF1 … DF4`: the features of the object sought. Position and orientation may be anything;
 /// the shape must be the same and the size within `tolerance`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,6 +41,12 @@ pub struct Desired {
     pub size: f32,
     /// How far the size may be off.
     pub tolerance: f32,
+}
+
+impl Judge for Desired {
+    fn judge(&self, features: &Features) -> bool {
+        features.shape == self.shape && (features.size - self.size).abs() <= self.tolerance
+    }
 }
 
 ports! {
@@ -35,12 +64,12 @@ ports! {
 /// judgement and stops. The judgement is `i` on a match (the seed writes 1; the number
 /// tells `Object?` which SEF matched, for the task-unit it triggers) and 0 otherwise.
 #[derive(Debug, Clone, Copy)]
-pub struct Objtest {
-    /// `DF1 … DF4`.
-    pub desired: Desired,
+pub struct Objtest<J = Desired> {
+    /// `DF1 … DF4`, and the test against them.
+    pub desired: J,
 }
 
-impl Schema for Objtest {
+impl<J: Judge> Schema for Objtest<J> {
     const NAME: &'static str = "Objtest";
     type Ports = ObjtestPorts;
 
@@ -49,7 +78,7 @@ impl Schema for Objtest {
     }
 
     async fn behavior(&mut self, p: &ObjtestPorts, cx: &Cx) -> Behavior {
-        let matches = judge(&self.desired, p).await?;
+        let matches = judge(&self.desired, p, cx).await?;
         p.judgement
             .write(if matches { cx.number() } else { 0 })
             .await?;
@@ -71,12 +100,12 @@ type Trigger = Box<dyn FnMut(&Cx, u32) -> Result<(), SchemaError> + Send>;
 /// parallel, their judgements fanned in on `result`; on a match it starts `Tj` for the
 /// matching SEF and stops. It numbers each `Objtest` after its SEF, so that it never runs
 /// two tests of one SEF at once.
-pub struct ObjectQ {
-    desired: Desired,
+pub struct ObjectQ<J = Desired> {
+    desired: J,
     trigger: Trigger,
 }
 
-impl std::fmt::Debug for ObjectQ {
+impl<J: std::fmt::Debug> std::fmt::Debug for ObjectQ<J> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ObjectQ")
             .field("desired", &self.desired)
@@ -84,10 +113,10 @@ impl std::fmt::Debug for ObjectQ {
     }
 }
 
-impl ObjectQ {
-    /// A search for `desired`, starting `trigger(cx, k)` when `SEF_k` matches.
+impl<J: Judge> ObjectQ<J> {
+    /// A search for what `desired` accepts, starting `trigger(cx, k)` when `SEF_k` matches.
     pub fn new(
-        desired: Desired,
+        desired: J,
         trigger: impl FnMut(&Cx, u32) -> Result<(), SchemaError> + Send + 'static,
     ) -> Self {
         Self {
@@ -97,7 +126,7 @@ impl ObjectQ {
     }
 }
 
-impl Schema for ObjectQ {
+impl<J: Judge> Schema for ObjectQ<J> {
     const NAME: &'static str = "Object?";
     type Ports = ObjectQPorts;
 
@@ -115,7 +144,7 @@ impl Schema for ObjectQ {
             let test = match cx.instantiate_as(
                 sef.number(),
                 Objtest {
-                    desired: self.desired,
+                    desired: self.desired.clone(),
                 },
             ) {
                 Ok(test) => test,
@@ -134,7 +163,9 @@ impl Schema for ObjectQ {
         if matched == 0 {
             return Ok(Flow::Continue);
         }
-        cx.forall::<Objtest>().iter().for_each(|test| test.stop());
+        cx.forall::<Objtest<J>>()
+            .iter()
+            .for_each(|test| test.stop());
         (self.trigger)(cx, matched)?;
         Ok(Flow::Stop)
     }
@@ -171,7 +202,7 @@ impl Schema for ObjtestTrigger {
     }
 
     async fn behavior(&mut self, p: &ObjtestPorts, cx: &Cx) -> Behavior {
-        if judge(&self.desired, p).await? {
+        if judge(&self.desired, p, cx).await? {
             (self.start)(cx, cx.number())?;
         }
         Ok(Flow::Stop)
@@ -242,11 +273,32 @@ impl Schema for ObjectQOnce {
     }
 }
 
-/// Whether the features an `Objtest` reads from its SEF describe `desired`.
-async fn judge(desired: &Desired, p: &ObjtestPorts) -> Result<bool, SchemaError> {
-    let (_, _) = (p.f1.read().await?, p.f2.read().await?);
-    let (shape, size) = (p.f3.read().await?, p.f4.read().await?);
-    Ok(shape == desired.shape && (size - desired.size).abs() <= desired.tolerance)
+/// Whether the features an `Objtest` reads from its SEF pass `desired`'s test.
+///
+/// The test runs on tokio's blocking pool, a thread of its own, so that the tests of every
+/// SEF run at once however long each takes, while the processor goes on with the other
+/// instances. On a paused runtime the clock stands still until it is done.
+async fn judge<J: Judge>(desired: &J, p: &ObjtestPorts, cx: &Cx) -> Result<bool, SchemaError> {
+    let features = Features {
+        position: p.f1.read().await?,
+        orientation: p.f2.read().await?,
+        shape: p.f3.read().await?,
+        size: p.f4.read().await?,
+    };
+    let desired = desired.clone();
+    tokio::task::spawn_blocking(move || desired.judge(&features))
+        .await
+        .map_err(|error| SchemaError::Failed {
+            instance: cx.me().clone(),
+            reason: format!(
+                "its judge {}",
+                if error.is_panic() {
+                    "panicked"
+                } else {
+                    "was cancelled"
+                }
+            ),
+        })
 }
 
 /// `Objtest(F1 … F4) ← SEF_i(F1 … F4)`.
