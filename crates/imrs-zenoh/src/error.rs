@@ -1,0 +1,73 @@
+//! What can go wrong across hosts. Every error names the port, or the name refused.
+
+use std::fmt;
+
+/// Why a host could not be opened, or a port exported or imported.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ZenohError {
+    /// A cell, port or module name that cannot be part of a key expression.
+    BadName {
+        /// What the name is of: "cell", "port" or "module".
+        what: &'static str,
+        /// The name.
+        name: String,
+    },
+    /// An endpoint zenoh does not accept, or a session that could not be opened.
+    Session {
+        /// What zenoh said.
+        reason: String,
+    },
+    /// Nobody exports the port: no host answered its connection in time.
+    NoOwner {
+        /// The port.
+        port: String,
+    },
+    /// The owner's host refused the connection: the port's own wiring error (not on the
+    /// user list, too many users) or a declaration that does not match.
+    Refused {
+        /// The port.
+        port: String,
+        /// The owner's host's reason, naming the port.
+        reason: String,
+    },
+    /// A message that could not be encoded, or bytes that are not the port's message.
+    Encoding {
+        /// The port.
+        port: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl fmt::Display for ZenohError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadName { what, name } => write!(
+                f,
+                "{what} name {name:?} cannot cross hosts: it must be non-empty and hold none \
+                 of / * $ ? # @ or whitespace"
+            ),
+            Self::Session { reason } => write!(f, "zenoh session: {reason}"),
+            Self::NoOwner { port } => {
+                write!(
+                    f,
+                    "port {port}: no host exports it (no answer to the connection)"
+                )
+            }
+            Self::Refused { port, reason } => {
+                write!(f, "port {port}: its owner's host refused: {reason}")
+            }
+            Self::Encoding { port, reason } => write!(f, "port {port}: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for ZenohError {}
+
+impl ZenohError {
+    pub(crate) fn session(error: impl fmt::Display) -> Self {
+        Self::Session {
+            reason: error.to_string(),
+        }
+    }
+}

@@ -1,0 +1,317 @@
+//! The owner's host: a port exported to other hosts.
+//!
+//! Three things serve it while it is exported: a liveliness token that tells other hosts
+//! the owner is there; a queryable on the port's `connect` key, which attaches each remote
+//! module as the port's user (its restrictions checked then, as in one process); and a
+//! queryable on its request key, whose every query goes into the real port through the
+//! asking module's own end, and is answered with the reply. Each importing host holds a
+//! token per module; when it is gone (the host killed, cut off, or closed), that module's
+//! end is dropped and its presence marked gone, so the owner's waits on it end as they
+//! would for a module that ended.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use imrs_ports::transport::Presence;
+use imrs_ports::{Port, UserList, WireError, usage};
+use tokio::task::JoinHandle;
+use zenoh::query::Query;
+use zenoh::sample::SampleKind;
+
+use crate::connected::Connected;
+use crate::forward::Forward;
+use crate::key::{Keys, checked};
+use crate::message::{Message, decode, encode};
+use crate::{Host, ZenohError};
+
+/// A port exported to other hosts: served while this is held, withdrawn when dropped.
+pub struct Exported {
+    port: String,
+    tasks: Vec<JoinHandle<()>>,
+    _token: zenoh::liveliness::LivelinessToken,
+}
+
+impl Exported {
+    /// The port.
+    pub fn port(&self) -> &str {
+        &self.port
+    }
+}
+
+impl Drop for Exported {
+    fn drop(&mut self) {
+        self.tasks.iter().for_each(JoinHandle::abort);
+    }
+}
+
+impl std::fmt::Debug for Exported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Exported")
+            .field("port", &self.port)
+            .finish()
+    }
+}
+
+/// A port whose owner's host can export it: a port its owner receives on, or a `RESPONSE`
+/// port, of [`Message`] types.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` cannot cross hosts",
+    label = "not a port an IMRS port on zenoh can carry",
+    note = "a port crosses hosts when its owner receives on it or answers it with a response \
+            handler (`usage::Receive`, `usage::Response`), and its request and reply are \
+            `Message`s: serde types, encoded in CDR"
+)]
+pub trait Export: sealed::Exports {}
+
+/// Exports `port` to the other hosts of `host`'s cell, for their modules to use as its
+/// users: their sends reach its owner's `receive`, their queries its response handler,
+/// which runs when the owner's order says. Call it within the tokio runtime the cell runs
+/// on. Refused if another host already exports the port (as far as this host has heard:
+/// two hosts that export one port at the same moment may both be served).
+pub async fn export<P: Export>(host: &Host, port: &P) -> Result<Exported, ZenohError> {
+    port.export_to(host).await
+}
+
+/// The remote modules attached to the port, each with its end and its presence.
+struct Users<E> {
+    ends: Mutex<HashMap<String, Attached<E>>>,
+}
+
+struct Attached<E> {
+    end: Arc<tokio::sync::Mutex<E>>,
+    presence: Arc<Presence>,
+}
+
+impl<E> Users<E> {
+    /// `module`'s end, attached now with `attach` if it is not yet.
+    fn end(
+        &self,
+        module: &str,
+        attach: impl FnOnce(&str) -> Result<E, WireError>,
+    ) -> Result<Arc<tokio::sync::Mutex<E>>, WireError> {
+        let mut ends = self.ends.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(attached) = ends.get(module) {
+            return Ok(Arc::clone(&attached.end));
+        }
+        let presence = Presence::new(module);
+        // The end is held by the remote module's presence, so that its peers see it gone
+        // when the module's host is.
+        let end = {
+            let _held = Presence::enter(Some(Arc::clone(&presence)));
+            attach(module)?
+        };
+        let end = Arc::new(tokio::sync::Mutex::new(end));
+        let attached = Attached {
+            end: Arc::clone(&end),
+            presence,
+        };
+        ends.insert(module.to_owned(), attached);
+        Ok(end)
+    }
+
+    /// `module`'s host is gone: its end is let go, and whoever waits on it is told.
+    fn gone(&self, module: &str) {
+        let attached = self
+            .ends
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .remove(module);
+        if let Some(attached) = attached {
+            attached.presence.set_gone();
+        }
+    }
+}
+
+/// Serves `port_name` for the remote modules, each attached with `attach`.
+async fn serve<Req, Rep, E>(
+    host: &Host,
+    port_name: &str,
+    owner: String,
+    attach: impl Fn(&str) -> Result<E, WireError> + Send + Sync + 'static,
+) -> Result<Exported, ZenohError>
+where
+    Req: Message,
+    Rep: Message,
+    E: Forward<Req, Rep>,
+{
+    let keys = Keys::new(&host.cell, port_name)?;
+    let session = &host.session;
+    let others = session
+        .liveliness()
+        .get(&keys.live)
+        .await
+        .map_err(ZenohError::session)?;
+    if others.recv_async().await.is_ok() {
+        return Err(ZenohError::Refused {
+            port: port_name.to_owned(),
+            reason: "another host exports it already".to_owned(),
+        });
+    }
+    let connects = session
+        .declare_queryable(&keys.connect)
+        .await
+        .map_err(ZenohError::session)?;
+    let requests = session
+        .declare_queryable(&keys.request)
+        .await
+        .map_err(ZenohError::session)?;
+    let leaving = session
+        .liveliness()
+        .declare_subscriber(format!("{}/*", keys.user_prefix()))
+        .await
+        .map_err(ZenohError::session)?;
+    // Declared last: a host that sees the token sees the queryables too, as zenoh carries
+    // one host's declarations to another in order.
+    let token = session
+        .liveliness()
+        .declare_token(&keys.live)
+        .await
+        .map_err(ZenohError::session)?;
+    let users = Arc::new(Users::<E> {
+        ends: Mutex::default(),
+    });
+    let attach = Arc::new(attach);
+    let port: Arc<str> = port_name.into();
+
+    let connecting = {
+        let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+        tokio::spawn(async move {
+            let owner = owner;
+            while let Ok(query) = connects.recv_async().await {
+                let answer = module_of(&query).and_then(|module| {
+                    let end = users
+                        .end(&module, |m| attach(m))
+                        .map_err(|e| e.to_string())?;
+                    let timeout = end.try_lock().ok().and_then(|end| end.timeout());
+                    let connected = Connected {
+                        owner: owner.clone(),
+                        timeout_ms: timeout.map_or(0, |t| t.as_millis().max(1) as u64),
+                    };
+                    encode(&port, &connected).map_err(|e| e.to_string())
+                });
+                reply(&query, answer).await;
+            }
+        })
+    };
+    let serving = {
+        let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+        tokio::spawn(async move {
+            while let Ok(query) = requests.recv_async().await {
+                let (users, attach, port) =
+                    (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+                // Each request waits for its own rendezvous; the next is taken meanwhile.
+                tokio::spawn(async move {
+                    let answer = forward::<Req, Rep, E>(&query, &users, &*attach, &port).await;
+                    reply(&query, answer).await;
+                });
+            }
+        })
+    };
+    let watching = {
+        let users = Arc::clone(&users);
+        tokio::spawn(async move {
+            while let Ok(sample) = leaving.recv_async().await {
+                if sample.kind() == SampleKind::Delete
+                    && let Some(module) = sample.key_expr().as_str().rsplit('/').next()
+                {
+                    users.gone(module);
+                }
+            }
+        })
+    };
+    Ok(Exported {
+        port: port_name.to_owned(),
+        tasks: vec![connecting, serving, watching],
+        _token: token,
+    })
+}
+
+/// One remote request, through its module's end: the reply in CDR, or why there is none.
+async fn forward<Req, Rep, E>(
+    query: &Query,
+    users: &Users<E>,
+    attach: &(dyn Fn(&str) -> Result<E, WireError> + Send + Sync),
+    port: &str,
+) -> Result<Vec<u8>, String>
+where
+    Req: Message,
+    Rep: Message,
+    E: Forward<Req, Rep>,
+{
+    let module = module_of(query)?;
+    let end = users.end(&module, attach).map_err(|e| e.to_string())?;
+    let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
+    let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
+    // One request of a module at a time, as in one process: its next waits here.
+    let reply = end.lock().await.forward(request).await?;
+    encode(port, &reply).map_err(|e| e.to_string())
+}
+
+/// The module a query comes from: its attachment, the module's name in UTF-8.
+fn module_of(query: &Query) -> Result<String, String> {
+    let attachment = query
+        .attachment()
+        .ok_or("a request names no module: its attachment must be the module's name")?;
+    let module = String::from_utf8(attachment.to_bytes().into_owned())
+        .map_err(|_| "a request's module name is not UTF-8".to_owned())?;
+    checked("module", &module).map_err(|e| e.to_string())?;
+    Ok(module)
+}
+
+/// Answers `query`: a reply on its own key, or an error reply with the reason in UTF-8.
+async fn reply(query: &Query, answer: Result<Vec<u8>, String>) {
+    let sent = match answer {
+        Ok(bytes) => query.reply(query.key_expr().clone(), bytes).await,
+        Err(reason) => query.reply_err(reason).await,
+    };
+    if let Err(error) = sent {
+        tracing::debug!(%error, "a reply could not be sent: its asker is gone");
+    }
+}
+
+mod sealed {
+    use super::*;
+
+    pub trait Exports {
+        fn export_to(
+            &self,
+            host: &Host,
+        ) -> impl Future<Output = Result<Exported, ZenohError>> + Send;
+    }
+
+    impl<Req: Message, Rep: Message, L: UserList, const N: usize> Exports
+        for Port<Req, Rep, usage::Receive, L, N>
+    {
+        async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
+            let port = self.clone();
+            let owner = self.owner_module().to_string();
+            serve::<Req, Rep, _>(host, self.name().as_str(), owner, move |module| {
+                port.user_named(module)
+            })
+            .await
+        }
+    }
+
+    impl<Req: Message, Rep: Message, L: UserList, const N: usize> Exports
+        for Port<Req, Rep, usage::Response, L, N>
+    {
+        async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
+            let port = self.clone();
+            let owner = self.owner_module().to_string();
+            serve::<Req, Rep, _>(host, self.name().as_str(), owner, move |module| {
+                port.user_named(module)
+            })
+            .await
+        }
+    }
+}
+
+impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export
+    for Port<Req, Rep, usage::Receive, L, N>
+{
+}
+
+impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export
+    for Port<Req, Rep, usage::Response, L, N>
+{
+}

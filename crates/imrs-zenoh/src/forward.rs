@@ -1,0 +1,37 @@
+//! How a remote module's request goes into the real port on the owner's host: through that
+//! module's own end, with the primitive its usage gives it.
+
+use std::time::Duration;
+
+use imrs_ports::{End, usage};
+
+/// A remote module's end of the real port, through which its requests go in.
+pub(crate) trait Forward<Req, Rep>: Send + 'static {
+    /// The request, as the module's primitive on this port: its reply, or why there is
+    /// none (the port's own error, naming it).
+    fn forward(&mut self, request: Req) -> impl Future<Output = Result<Rep, String>> + Send + '_;
+
+    /// The port's TIMEOUT for this module, if it has one.
+    fn timeout(&self) -> Option<Duration>;
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
+    async fn forward(&mut self, request: Req) -> Result<Rep, String> {
+        self.send(request).await.map_err(|error| error.to_string())
+    }
+
+    fn timeout(&self) -> Option<Duration> {
+        End::timeout(self)
+    }
+}
+
+/// A query to the owner's response handler, which runs when the owner's order says.
+impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
+    async fn forward(&mut self, request: Req) -> Result<Rep, String> {
+        self.query(request).await.map_err(|error| error.to_string())
+    }
+
+    fn timeout(&self) -> Option<Duration> {
+        End::timeout(self)
+    }
+}

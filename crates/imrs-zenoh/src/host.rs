@@ -1,0 +1,126 @@
+//! A host of a cell: one zenoh session, with its endpoints and its lease.
+
+use std::time::Duration;
+
+use crate::ZenohError;
+use crate::key::checked;
+
+/// One host's view of a cell on zenoh: a zenoh session in peer mode, which finds other
+/// hosts through the endpoints it is given (no router, no multicast scouting), and the
+/// cell's name, which every key expression of its ports starts with.
+///
+/// Cheap to clone: clones share the session.
+#[derive(Clone)]
+pub struct Host {
+    pub(crate) session: zenoh::Session,
+    pub(crate) cell: String,
+    pub(crate) lease: Duration,
+}
+
+/// How to open a [`Host`]: its endpoints and lease.
+#[derive(Debug, Clone)]
+pub struct HostBuilder {
+    cell: String,
+    listen: Vec<String>,
+    connect: Vec<String>,
+    lease: Duration,
+}
+
+impl Host {
+    /// The lease a host's links have unless told otherwise: a peer killed or cut off is
+    /// seen gone within it.
+    pub const DEFAULT_LEASE: Duration = Duration::from_secs(2);
+
+    /// A host of cell `cell`, to be opened with [`HostBuilder::open`].
+    pub fn builder(cell: &str) -> HostBuilder {
+        HostBuilder {
+            cell: cell.to_owned(),
+            listen: Vec::new(),
+            connect: Vec::new(),
+            lease: Self::DEFAULT_LEASE,
+        }
+    }
+
+    /// The cell's name.
+    pub fn cell(&self) -> &str {
+        &self.cell
+    }
+
+    /// The lease of this host's links.
+    pub fn lease(&self) -> Duration {
+        self.lease
+    }
+
+    /// The zenoh session, for what this crate does not wrap.
+    pub fn session(&self) -> &zenoh::Session {
+        &self.session
+    }
+
+    /// Closes the session: every port it exports is withdrawn, and its peers see it gone.
+    pub async fn close(&self) -> Result<(), ZenohError> {
+        self.session.close().await.map_err(ZenohError::session)
+    }
+}
+
+impl HostBuilder {
+    /// Listens on `endpoint` (`tcp/10.0.0.1:7447`) for other hosts.
+    pub fn listen(mut self, endpoint: impl Into<String>) -> Self {
+        self.listen.push(endpoint.into());
+        self
+    }
+
+    /// Connects to `endpoint`, another host's (or a zenoh router's), and keeps trying while
+    /// it is unreachable.
+    pub fn connect(mut self, endpoint: impl Into<String>) -> Self {
+        self.connect.push(endpoint.into());
+        self
+    }
+
+    /// The lease of this host's links: how long a silent peer is kept before it is seen
+    /// gone. Four keep-alives are sent in each lease.
+    pub fn lease(mut self, lease: Duration) -> Self {
+        self.lease = lease;
+        self
+    }
+
+    /// Opens the session. Refused, naming it, if the cell's name cannot be part of a key
+    /// expression or zenoh refuses an endpoint.
+    pub async fn open(self) -> Result<Host, ZenohError> {
+        checked("cell", &self.cell)?;
+        let mut config = zenoh::Config::default();
+        let json = |value: &Vec<String>| serde_json_list(value);
+        let settings = [
+            ("mode", "\"peer\"".to_owned()),
+            ("scouting/multicast/enabled", "false".to_owned()),
+            ("listen/endpoints", json(&self.listen)),
+            ("connect/endpoints", json(&self.connect)),
+            (
+                "transport/link/tx/lease",
+                self.lease.as_millis().max(1).to_string(),
+            ),
+            // A host tries again an endpoint it lost within half a second, so that a host
+            // that comes back is found about as soon as it listens.
+            (
+                "connect/retry",
+                "{ period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2 }".to_owned(),
+            ),
+        ];
+        for (key, value) in settings {
+            config
+                .insert_json5(key, &value)
+                .map_err(|error| ZenohError::session(format!("{key} = {value}: {error}")))?;
+        }
+        let session = zenoh::open(config).await.map_err(ZenohError::session)?;
+        Ok(Host {
+            session,
+            cell: self.cell,
+            lease: self.lease,
+        })
+    }
+}
+
+/// `["a", "b"]`, each endpoint quoted as a JSON string.
+fn serde_json_list(items: &[String]) -> String {
+    let quoted: Vec<String> = items.iter().map(|item| format!("{item:?}")).collect();
+    format!("[{}]", quoted.join(", "))
+}

@@ -1,0 +1,392 @@
+//! A user's host: a port of another host, imported.
+//!
+//! Locally it is a port of the same name and types whose owner is a bridge, attached under
+//! the presence of the remote owner. The bridge takes each local send or query and asks
+//! the owner's host with a zenoh `get`, and hands the reply back. It watches the owner's
+//! liveliness token: when the owner's host is gone (killed, cut off past its lease, or
+//! closed), it marks the owner's presence gone and lets go of its end, so that waits on the
+//! port end with `PeerGone`, and the requests it had asked and not yet had answered end
+//! with `NoReply`. When the token comes back, the bridge attaches again and the port is
+//! served, with no new import.
+
+use std::future::poll_fn;
+use std::sync::Arc;
+use std::time::Duration;
+
+use imrs_ports::transport::Presence;
+use imrs_ports::usage::Usage;
+use imrs_ports::{
+    AnyUser, End, Port, PortSpec, ReceiveError, ReplyHandle, ResponseEnd, WireError, usage,
+};
+use tokio::task::{JoinHandle, JoinSet};
+use zenoh::sample::SampleKind;
+
+use crate::connected::Connected;
+use crate::key::{Keys, checked};
+use crate::message::{Message, decode, encode};
+use crate::{Host, ZenohError};
+
+/// How long the owner's host may take to be seen, and to answer a connection.
+const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// How long a request with no TIMEOUT may wait for its reply across hosts: zenoh's
+/// queries end, and a port without a TIMEOUT waits as long as its owner takes.
+const NO_TIMEOUT: Duration = Duration::from_secs(24 * 3600);
+
+/// A port imported from another host, and its bridge: usable while this is held.
+pub struct Imported<Req: Send + 'static, Rep: Send + 'static, U: Usage = usage::Receive> {
+    port: Port<Req, Rep, U, AnyUser, 1>,
+    bridge: JoinHandle<()>,
+    _token: zenoh::liveliness::LivelinessToken,
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
+    /// The local port: attach the importing module to it as to any port.
+    pub fn port(&self) -> &Port<Req, Rep, U, AnyUser, 1> {
+        &self.port
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> std::fmt::Debug for Imported<Req, Rep, U> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Imported")
+            .field("port", self.port.name())
+            .field("owner", self.port.owner_module())
+            .finish()
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Drop for Imported<Req, Rep, U> {
+    fn drop(&mut self) {
+        self.bridge.abort();
+    }
+}
+
+/// A port a user's host can import: an [`Imported`] whose owner receives or answers with
+/// a response handler, of [`Message`] types.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` cannot be imported across hosts",
+    label = "not a port an IMRS port on zenoh can carry",
+    note = "import an `Imported<Req, Rep, usage::Receive>` or `Imported<Req, Rep, \
+            usage::Response>` whose request and reply are `Message`s"
+)]
+pub trait Import: sealed::Imports {}
+
+/// Imports port `port`, owned by module `owner` on another host of `host`'s cell, for
+/// module `module` of this one. Connects at once: refused with the port's own wiring error
+/// (named in [`ZenohError::Refused`]) if `module` is not on its user list or the port has
+/// no room for it, or if `owner` does not own it; [`ZenohError::NoOwner`] if no host
+/// exports it. Call it within the tokio runtime the cell runs on.
+pub async fn import<I: Import>(
+    host: &Host,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<I, ZenohError> {
+    I::import_from(host, port, owner, module).await
+}
+
+/// The owner's side of the local port, as the bridge takes requests from it.
+trait Take<Req, Rep>: Send + Sized + 'static {
+    /// The next local request, and the right to reply to it.
+    fn next(
+        &mut self,
+    ) -> impl Future<Output = Result<(Req, ReplyHandle<Rep>), ReceiveError>> + Send + '_;
+}
+
+/// Attaching the owner's side of a local port of usage `U`.
+trait Attach<Req, Rep, U: Usage>: Sized {
+    fn attach_to(local: &Port<Req, Rep, U, AnyUser, 1>) -> Result<Self, WireError>;
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
+    async fn next(&mut self) -> Result<(Req, ReplyHandle<Rep>), ReceiveError> {
+        self.receive().await
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Attach<Req, Rep, usage::Receive>
+    for End<Req, Rep, usage::Receive>
+{
+    fn attach_to(local: &Port<Req, Rep, usage::Receive, AnyUser, 1>) -> Result<Self, WireError> {
+        local.owner()
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
+    async fn next(&mut self) -> Result<(Req, ReplyHandle<Rep>), ReceiveError> {
+        loop {
+            poll_fn(|cx| self.poll_pending(cx)).await?;
+            if let Some(taken) = self.take() {
+                return Ok(taken);
+            }
+        }
+    }
+}
+
+impl<Req: Send + 'static, Rep: Message> Attach<Req, Rep, usage::Response>
+    for ResponseEnd<Req, Rep, ()>
+{
+    fn attach_to(local: &Port<Req, Rep, usage::Response, AnyUser, 1>) -> Result<Self, WireError> {
+        // The handler never runs: the bridge takes each query and answers it with the
+        // owner's host's reply.
+        local.answer(local.owner_module().clone(), |_: &(), _: Req| {
+            unreachable!("a bridged RESPONSE port's queries are taken, never handled here")
+        })
+    }
+}
+
+/// Connects `module` to `port` and starts the bridge of its local side, `T`.
+async fn bridge<Req, Rep, U, T>(
+    host: &Host,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, U>, ZenohError>
+where
+    Req: Message,
+    Rep: Message,
+    U: Usage,
+    T: Take<Req, Rep> + Attach<Req, Rep, U>,
+{
+    let keys = Keys::new(&host.cell, port)?;
+    checked("module", owner)?;
+    checked("module", module)?;
+    let session = &host.session;
+    // The owner's token first: once it is seen, so is the owner's host's connect queryable.
+    let watch = session
+        .liveliness()
+        .declare_subscriber(&keys.live)
+        .history(true)
+        .await
+        .map_err(ZenohError::session)?;
+    let no_owner = || ZenohError::NoOwner {
+        port: port.to_owned(),
+    };
+    loop {
+        let seen = tokio::time::timeout(CONNECT_TIMEOUT, watch.recv_async()).await;
+        match seen
+            .map_err(|_| no_owner())?
+            .map_err(|_| no_owner())?
+            .kind()
+        {
+            SampleKind::Put => break,
+            SampleKind::Delete => {}
+        }
+    }
+    let connected = connect(host, &keys, port, module).await?;
+    if connected.owner != owner {
+        return Err(ZenohError::Refused {
+            port: port.to_owned(),
+            reason: format!("{owner} does not own it; {} does", connected.owner),
+        });
+    }
+    let mut spec = PortSpec::new(port, owner);
+    let timeout = (connected.timeout_ms > 0).then(|| Duration::from_millis(connected.timeout_ms));
+    if let Some(timeout) = timeout {
+        spec = spec.user_timeout(timeout);
+    }
+    let local = Port::<Req, Rep, U, AnyUser, 1>::new(spec);
+    let token = session
+        .liveliness()
+        .declare_token(keys.user(module))
+        .await
+        .map_err(ZenohError::session)?;
+    let asking = Asking {
+        session: session.clone(),
+        key: keys.request.clone(),
+        module: module.to_owned(),
+        port: port.to_owned(),
+        wait: timeout.map_or(NO_TIMEOUT, |t| t + host.lease),
+    };
+    let owner: Arc<str> = owner.into();
+    let bridged = local.clone();
+    let bridge = tokio::spawn(async move {
+        let mut live = true;
+        loop {
+            if live {
+                let presence = Presence::new(&*owner);
+                let end = {
+                    let _held = Presence::enter(Some(Arc::clone(&presence)));
+                    T::attach_to(&bridged)
+                };
+                let Ok(end) = end else { return };
+                if !serve_while_live::<Req, Rep, T>(end, &watch, &asking).await {
+                    return;
+                }
+                presence.set_gone();
+            }
+            // Gone: wait for the owner's host to come back.
+            match watch.recv_async().await {
+                Ok(sample) => live = sample.kind() == SampleKind::Put,
+                Err(_) => return,
+            }
+        }
+    });
+    Ok(Imported {
+        port: local,
+        bridge,
+        _token: token,
+    })
+}
+
+/// What the bridge needs to ask the owner's host.
+struct Asking {
+    session: zenoh::Session,
+    key: String,
+    module: String,
+    port: String,
+    /// How long a request waits for its reply: the port's TIMEOUT and a lease.
+    wait: Duration,
+}
+
+/// Takes local requests through `end` and asks the owner's host, until its token is gone
+/// (true: the requests asked meanwhile are dropped unanswered) or the bridge must end
+/// (false).
+async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
+    mut end: T,
+    watch: &zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    asking: &Asking,
+) -> bool {
+    let mut asked = JoinSet::new();
+    loop {
+        tokio::select! {
+            taken = end.next() => match taken {
+                Ok((request, reply)) => {
+                    asked.spawn(ask::<Req, Rep>(asking.clone_parts(), request, reply));
+                }
+                // Nobody can use the local port any more.
+                Err(_) => return false,
+            },
+            sample = watch.recv_async() => match sample {
+                Ok(sample) if sample.kind() == SampleKind::Delete => {
+                    asked.abort_all();
+                    return true;
+                }
+                Ok(_) => {}
+                Err(_) => return false,
+            },
+            Some(_) = asked.join_next(), if !asked.is_empty() => {}
+        }
+    }
+}
+
+impl Asking {
+    fn clone_parts(&self) -> Self {
+        Self {
+            session: self.session.clone(),
+            key: self.key.clone(),
+            module: self.module.clone(),
+            port: self.port.clone(),
+            wait: self.wait,
+        }
+    }
+}
+
+/// Asks the owner's host with `request`, and replies with its answer. Without one (an
+/// error reply, no reply in time, bytes that are no reply) the handle is dropped, and the
+/// local sender gets `NoReply`; the reason is logged.
+async fn ask<Req: Message, Rep: Message>(asking: Asking, request: Req, reply: ReplyHandle<Rep>) {
+    let bytes = encode(&asking.port, &request).map_err(|e| e.to_string());
+    drop(request);
+    let answer = async {
+        let replies = asking
+            .session
+            .get(&asking.key)
+            .payload(bytes?)
+            .attachment(asking.module.as_bytes())
+            .timeout(asking.wait)
+            .await
+            .map_err(|e| e.to_string())?;
+        let answer = replies
+            .recv_async()
+            .await
+            .map_err(|_| "no reply from the owner's host".to_owned())?;
+        match answer.into_result() {
+            Ok(sample) => {
+                decode::<Rep>(&asking.port, &sample.payload().to_bytes()).map_err(|e| e.to_string())
+            }
+            Err(error) => Err(String::from_utf8_lossy(&error.payload().to_bytes()).into_owned()),
+        }
+    };
+    match answer.await {
+        Ok(answer) => drop(reply.reply(answer)),
+        Err(reason) => {
+            tracing::debug!(port = %asking.port, %reason, "a request across hosts got no reply");
+        }
+    }
+}
+
+/// `module`'s connection to `port`: the owner's host's answer, or why there is none.
+async fn connect(
+    host: &Host,
+    keys: &Keys,
+    port: &str,
+    module: &str,
+) -> Result<Connected, ZenohError> {
+    let replies = host
+        .session
+        .get(&keys.connect)
+        .attachment(module.as_bytes())
+        .timeout(CONNECT_TIMEOUT)
+        .await
+        .map_err(ZenohError::session)?;
+    let reply = replies
+        .recv_async()
+        .await
+        .map_err(|_| ZenohError::NoOwner {
+            port: port.to_owned(),
+        })?;
+    match reply.into_result() {
+        Ok(sample) => decode(port, &sample.payload().to_bytes()),
+        Err(error) => Err(ZenohError::Refused {
+            port: port.to_owned(),
+            reason: String::from_utf8_lossy(&error.payload().to_bytes()).into_owned(),
+        }),
+    }
+}
+
+mod sealed {
+    use super::*;
+
+    pub trait Imports: Sized {
+        fn import_from(
+            host: &Host,
+            port: &str,
+            owner: &str,
+            module: &str,
+        ) -> impl Future<Output = Result<Self, ZenohError>> + Send;
+    }
+
+    impl<Req: Message, Rep: Message> Imports for Imported<Req, Rep, usage::Receive> {
+        async fn import_from(
+            host: &Host,
+            port: &str,
+            owner: &str,
+            module: &str,
+        ) -> Result<Self, ZenohError> {
+            bridge::<Req, Rep, usage::Receive, End<Req, Rep, usage::Receive>>(
+                host, port, owner, module,
+            )
+            .await
+        }
+    }
+
+    impl<Req: Message, Rep: Message> Imports for Imported<Req, Rep, usage::Response> {
+        async fn import_from(
+            host: &Host,
+            port: &str,
+            owner: &str,
+            module: &str,
+        ) -> Result<Self, ZenohError> {
+            bridge::<Req, Rep, usage::Response, ResponseEnd<Req, Rep, ()>>(
+                host, port, owner, module,
+            )
+            .await
+        }
+    }
+}
+
+impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, usage::Receive> {}
+
+impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, usage::Response> {}

@@ -1,0 +1,77 @@
+//! The key expressions a cell's ports use on zenoh, and the names allowed in them.
+//!
+//! - `imrs/<cell>/port/<PORT>`: a module's request (a send, a query) to the port's owner.
+//! - `imrs/<cell>/connect/<PORT>`: a module's connection, checked against the port's
+//!   restrictions before any request.
+//! - `imrs/<cell>/live/<PORT>`: a liveliness token, held by the owner's host while it
+//!   exports the port.
+//! - `imrs/<cell>/user/<PORT>/<MODULE>`: a liveliness token, held by a user's host while
+//!   it imports the port for the module.
+
+use crate::ZenohError;
+
+/// Refuses a name that would change the meaning of a key expression it is part of.
+pub(crate) fn checked<'a>(what: &'static str, name: &'a str) -> Result<&'a str, ZenohError> {
+    let bad = name.is_empty()
+        || name.starts_with('@')
+        || name
+            .chars()
+            .any(|c| matches!(c, '/' | '*' | '$' | '?' | '#') || c.is_whitespace());
+    if bad {
+        Err(ZenohError::BadName {
+            what,
+            name: name.to_owned(),
+        })
+    } else {
+        Ok(name)
+    }
+}
+
+/// The keys of one port of one cell.
+#[derive(Debug, Clone)]
+pub(crate) struct Keys {
+    pub(crate) request: String,
+    pub(crate) connect: String,
+    pub(crate) live: String,
+    user: String,
+}
+
+impl Keys {
+    pub(crate) fn new(cell: &str, port: &str) -> Result<Self, ZenohError> {
+        let port = checked("port", port)?;
+        Ok(Self {
+            request: format!("imrs/{cell}/port/{port}"),
+            connect: format!("imrs/{cell}/connect/{port}"),
+            live: format!("imrs/{cell}/live/{port}"),
+            user: format!("imrs/{cell}/user/{port}"),
+        })
+    }
+
+    /// The key under which the importing hosts' tokens for the port's users lie.
+    pub(crate) fn user_prefix(&self) -> &str {
+        &self.user
+    }
+
+    /// The token of `module`'s host while it uses the port.
+    pub(crate) fn user(&self, module: &str) -> String {
+        format!("{}/{module}", self.user)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_that_would_widen_a_key_expression_is_refused_by_name() {
+        for name in ["", "A/B", "*", "A**", "$x", "Q?", "#", "@live", "TWO WORDS"] {
+            let error = checked("module", name).unwrap_err();
+            assert!(error.to_string().contains(&format!("{name:?}")), "{error}");
+        }
+        assert_eq!(checked("module", "ROBOT_1").unwrap(), "ROBOT_1");
+        assert_eq!(
+            Keys::new("cell", "DOUBLE").unwrap().request,
+            "imrs/cell/port/DOUBLE"
+        );
+    }
+}

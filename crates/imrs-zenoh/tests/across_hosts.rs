@@ -1,0 +1,222 @@
+//! Ports across hosts on zenoh, over loopback: every test opens its hosts on endpoints of
+//! its own, as two hosts of one cell would.
+
+mod common;
+
+use std::time::Duration;
+
+use common::{PROMPTLY, free_endpoint, listening, two_hosts, within};
+use imrs_ports::{AnyUser, Port, PortSpec, SendError, usage};
+use imrs_zenoh::{Host, Imported, ZenohError, export, import};
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_send_crosses_hosts_and_its_reply_comes_back() {
+    let (owner_host, user_host) = two_hosts("send_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive, AnyUser, 4> =
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let mut doubler = port.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((n, reply)) = doubler.receive().await {
+            reply.reply(2 * n);
+        }
+    });
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "DOUBLE", "DOUBLER", "ASKER")
+            .await
+            .unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    for n in 0..100 {
+        assert_eq!(
+            within(PROMPTLY, "a round trip", asker.send(n))
+                .await
+                .unwrap(),
+            2 * n
+        );
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_query_is_answered_by_the_owners_response_handler() {
+    let (owner_host, user_host) = two_hosts("query_cell", &free_endpoint()).await;
+    let port: Port<String, String, usage::Response, AnyUser, 2> =
+        Port::new(PortSpec::new("STATUS", "ROBOT"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let mut handler = port
+        .answer("ROBOT", |joints: &Vec<f64>, asked: String| {
+            format!("{asked}: {} joints", joints.len())
+        })
+        .unwrap();
+    tokio::spawn(async move {
+        let joints = vec![0.0; 6];
+        while handler.serve(&joints).await.is_ok() {}
+    });
+    let imported: Imported<String, String, usage::Response> =
+        import(&user_host, "STATUS", "ROBOT", "PANEL")
+            .await
+            .unwrap();
+    let mut panel = imported.port().user_named("PANEL").unwrap();
+    let answer = within(PROMPTLY, "a query", panel.query("status".into())).await;
+    assert_eq!(answer.unwrap(), "status: 6 joints");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_module_off_the_user_list_is_refused_naming_the_port_and_the_module() {
+    let (owner_host, user_host) = two_hosts("list_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive, AnyUser, 4> =
+        Port::new(PortSpec::new("GRIP", "GRIPPER").user_list(["ROBOT"]));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let refused =
+        import::<Imported<u64, u64, usage::Receive>>(&user_host, "GRIP", "GRIPPER", "ROGUE")
+            .await
+            .unwrap_err();
+    let ZenohError::Refused { port, reason } = &refused else {
+        panic!("not refused: {refused}");
+    };
+    assert_eq!(port, "GRIP");
+    assert!(
+        reason.contains("ROGUE") && reason.contains("GRIP"),
+        "{refused}"
+    );
+    // The module on the list is served.
+    let robot: Imported<u64, u64, usage::Receive> = import(&user_host, "GRIP", "GRIPPER", "ROBOT")
+        .await
+        .unwrap();
+    assert_eq!(robot.port().name().as_str(), "GRIP");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_port_full_of_users_refuses_one_more_and_a_wrong_owner_is_named() {
+    let (owner_host, user_host) = two_hosts("full_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("FEED", "FEEDER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let _first: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "FEED", "FEEDER", "FIRST").await.unwrap();
+    let second =
+        import::<Imported<u64, u64, usage::Receive>>(&user_host, "FEED", "FEEDER", "SECOND")
+            .await
+            .unwrap_err();
+    assert!(
+        matches!(&second, ZenohError::Refused { port, reason } if port == "FEED" && reason.contains("SECOND")),
+        "{second}"
+    );
+    let wrong = import::<Imported<u64, u64, usage::Receive>>(&user_host, "FEED", "GATE", "FIRST")
+        .await
+        .unwrap_err();
+    assert_eq!(
+        wrong.to_string(),
+        "port FEED: its owner's host refused: GATE does not own it; FEEDER does"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_import_nobody_exports_and_a_second_export_are_refused_by_name() {
+    let (owner_host, user_host) = two_hosts("none_cell", &free_endpoint()).await;
+    let missing = within(
+        PROMPTLY,
+        "an import of nothing",
+        import::<Imported<u64, u64, usage::Receive>>(&user_host, "NOBODY", "NOONE", "ASKER"),
+    )
+    .await
+    .unwrap_err();
+    assert_eq!(
+        missing,
+        ZenohError::NoOwner {
+            port: "NOBODY".into()
+        }
+    );
+    let port: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("ONCE", "OWNER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    // Once the user's host has seen the owner's (an import waits for that)…
+    let _seen: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "ONCE", "OWNER", "ASKER").await.unwrap();
+    // …it cannot export the port too.
+    let again: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("ONCE", "OWNER"));
+    let twice = export(&user_host, &again).await.unwrap_err();
+    assert_eq!(
+        twice.to_string(),
+        "port ONCE: its owner's host refused: another host exports it already"
+    );
+    let bad = Host::builder("a/cell").open().await.err().unwrap();
+    assert!(bad.to_string().starts_with("cell name \"a/cell\""), "{bad}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_ports_timeout_holds_across_hosts() {
+    let (owner_host, user_host) = two_hosts("timeout_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive> =
+        Port::new(PortSpec::new("SLOW", "SLUGGARD").user_timeout(Duration::from_millis(300)));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    // The owner attaches and never receives.
+    let _sluggard = port.owner().unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "SLOW", "SLUGGARD", "ASKER")
+            .await
+            .unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(asker.timeout(), Some(Duration::from_millis(300)));
+    let started = std::time::Instant::now();
+    let late = within(PROMPTLY, "a send past its timeout", asker.send(1)).await;
+    assert!(
+        matches!(late, Err(SendError::ReplyTimeout { ref port }) if port.as_str() == "SLOW"),
+        "{late:?}"
+    );
+    assert!(started.elapsed() >= Duration::from_millis(300));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_closed_owner_host_ends_waits_with_peer_gone_and_its_return_is_served() {
+    let endpoint = free_endpoint();
+    let (owner_host, user_host) = two_hosts("gone_cell", &endpoint).await;
+    let port: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("HOLD", "HOLDER"));
+    let exported = export(&owner_host, &port).await.unwrap();
+    let holder = port.owner().unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "HOLD", "HOLDER", "ASKER").await.unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    // A send the owner never takes; then its host goes.
+    let waiting = tokio::spawn(async move {
+        let lost = asker.send(7).await;
+        (asker, lost)
+    });
+    tokio::task::yield_now().await;
+    drop(exported);
+    owner_host.close().await.unwrap();
+    drop(holder);
+    let (mut asker, lost) = within(PROMPTLY, "the lost request's end", waiting)
+        .await
+        .unwrap();
+    assert!(matches!(lost, Err(SendError::NoReply { .. })), "{lost:?}");
+    // Once the owner's host is seen gone, a send fails at once, naming the owner.
+    let gone = within(PROMPTLY, "the owner seen gone", async {
+        loop {
+            match asker.send(8).await {
+                Err(SendError::PeerGone { module, .. }) => break module,
+                _ => tokio::task::yield_now().await,
+            }
+        }
+    })
+    .await;
+    assert_eq!(gone.as_str(), "HOLDER");
+    // The owner's host comes back on the same endpoint: the same import is served.
+    let back_host = listening("gone_cell", &endpoint).await;
+    let back: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("HOLD", "HOLDER"));
+    let _exported = export(&back_host, &back).await.unwrap();
+    let mut holder = back.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((n, reply)) = holder.receive().await {
+            reply.reply(n + 1);
+        }
+    });
+    let served = within(PROMPTLY, "the returned owner served", async {
+        loop {
+            match asker.send(41).await {
+                Ok(reply) => break reply,
+                Err(_) => tokio::task::yield_now().await,
+            }
+        }
+    })
+    .await;
+    assert_eq!(served, 42);
+}
