@@ -220,3 +220,39 @@ async fn a_closed_owner_host_ends_waits_with_peer_gone_and_its_return_is_served(
     .await;
     assert_eq!(served, 42);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_user_host_that_goes_ends_its_owners_wait_with_peer_gone() {
+    let (owner_host, user_host) = two_hosts("user_gone_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("WORK", "WORKER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "WORK", "WORKER", "FEEDER")
+            .await
+            .unwrap();
+    let mut feeder = imported.port().user_named("FEEDER").unwrap();
+    let mut worker = port.owner().unwrap();
+    let serving = tokio::spawn(async move {
+        let (n, reply) = worker.receive().await.unwrap();
+        reply.reply(n);
+        // The feeder's host goes before it sends again.
+        worker.receive().await.map(|(n, _)| n)
+    });
+    assert_eq!(
+        within(PROMPTLY, "a round trip", feeder.send(5))
+            .await
+            .unwrap(),
+        5
+    );
+    drop(feeder);
+    drop(imported);
+    user_host.close().await.unwrap();
+    let waited = within(PROMPTLY, "the worker's wait", serving)
+        .await
+        .unwrap();
+    assert!(
+        matches!(&waited, Err(imrs_ports::ReceiveError::PeerGone { module, .. }) if module.as_str() == "FEEDER"),
+        "{waited:?}"
+    );
+}

@@ -1,0 +1,268 @@
+//! Hosts apart: the owner's host in a process of its own (`zenoh_peer`), killed with
+//! SIGKILL; and in a network namespace of its own, joined by a veth link that is set down
+//! mid-rendezvous and brought back. Where namespaces cannot be made (not root, no `ip`),
+//! the namespace test says so loudly and runs over loopback, its cut made by a kill.
+
+mod common;
+
+use std::process::Stdio;
+use std::time::Duration;
+
+use common::{PROMPTLY, free_endpoint, within};
+use imrs_ports::{SendError, usage};
+use imrs_zenoh::{Host, Imported, import};
+use tokio::io::{AsyncBufReadExt, BufReader};
+use tokio::process::{Child, Command};
+
+/// The owner's host, `zenoh_peer`, started (inside `netns` if given) and ready.
+async fn peer(cell: &str, endpoint: &str, netns: Option<&str>) -> Child {
+    let exe = env!("CARGO_BIN_EXE_zenoh_peer");
+    let mut command = match netns {
+        Some(ns) => {
+            let mut c = Command::new("ip");
+            c.args(["netns", "exec", ns, exe]);
+            c
+        }
+        None => Command::new(exe),
+    };
+    let mut child = command
+        .args([cell, endpoint])
+        .stdout(Stdio::piped())
+        .kill_on_drop(true)
+        .spawn()
+        .expect("zenoh_peer starts");
+    let stdout = child.stdout.take().expect("its stdout");
+    let mut lines = BufReader::new(stdout).lines();
+    let line = within(PROMPTLY, "the peer's start", lines.next_line()).await;
+    assert_eq!(
+        line.unwrap().as_deref(),
+        Some("ready"),
+        "zenoh_peer did not start"
+    );
+    child
+}
+
+/// A send of 0, which the peer holds for ever, ends when the owner's host is cut off: with
+/// `NoReply` (its reply is lost).
+async fn held_send_ends_with_no_reply(
+    asker: &mut imrs_ports::End<u64, u64, usage::Send>,
+    cut: impl Future<Output = ()>,
+    bound: Duration,
+) {
+    let held = asker.send(0);
+    let (lost, ()) = tokio::join!(within(bound, "the held request's end", held), cut);
+    assert!(matches!(lost, Err(SendError::NoReply { .. })), "{lost:?}");
+}
+
+/// Sends until one fails with `PeerGone`, naming the owner: the owner's host is seen gone.
+async fn seen_gone(asker: &mut imrs_ports::End<u64, u64, usage::Send>, bound: Duration) {
+    let gone = within(bound, "the owner seen gone", async {
+        loop {
+            match asker.send(1).await {
+                Err(SendError::PeerGone { module, .. }) => break module,
+                _ => tokio::task::yield_now().await,
+            }
+        }
+    })
+    .await;
+    assert_eq!(gone.as_str(), "DOUBLER");
+}
+
+/// Sends until one is served: the owner's host is back, through the same import.
+async fn served_again(asker: &mut imrs_ports::End<u64, u64, usage::Send>, bound: Duration) {
+    let doubled = within(bound, "the owner served again", async {
+        loop {
+            match asker.send(21).await {
+                Ok(doubled) => break doubled,
+                Err(_) => tokio::task::yield_now().await,
+            }
+        }
+    })
+    .await;
+    assert_eq!(doubled, 42);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_owner_process_killed_ends_waits_and_its_restart_is_served() {
+    let endpoint = free_endpoint();
+    let mut owner = peer("kill_cell", &endpoint, None).await;
+    let host = Host::builder("kill_cell")
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&host, "DOUBLE", "DOUBLER", "ASKER").await.unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(
+        within(PROMPTLY, "a round trip", asker.send(4))
+            .await
+            .unwrap(),
+        8
+    );
+    let kill = async {
+        tokio::task::yield_now().await;
+        owner.start_kill().expect("SIGKILL");
+        owner.wait().await.expect("the peer reaped");
+    };
+    let lease = host.lease();
+    held_send_ends_with_no_reply(&mut asker, kill, 2 * lease + PROMPTLY).await;
+    seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
+    let _restarted = peer("kill_cell", &endpoint, None).await;
+    served_again(&mut asker, PROMPTLY).await;
+}
+
+/// A network namespace and the veth link that joins it to this one, removed when dropped.
+struct Netns {
+    name: String,
+    outside: String,
+    inside_address: String,
+}
+
+impl Netns {
+    /// Makes one, or says why it cannot.
+    fn make() -> Result<Self, String> {
+        let id = std::process::id() % 100_000;
+        let (name, outside, inside) = (
+            format!("imrs-{id}"),
+            format!("imrso{id}"),
+            format!("imrsi{id}"),
+        );
+        let subnet = format!("10.{}.{}", 100 + id % 100, id / 100 % 250);
+        let netns = Self {
+            name: name.clone(),
+            outside: outside.clone(),
+            inside_address: format!("{subnet}.2"),
+        };
+        let steps: [Vec<String>; 7] = [
+            vec!["netns".into(), "add".into(), name.clone()],
+            vec![
+                "link", "add", &outside, "type", "veth", "peer", "name", &inside, "netns", &name,
+            ]
+            .into_iter()
+            .map(String::from)
+            .collect(),
+            vec![
+                "addr".into(),
+                "add".into(),
+                format!("{subnet}.1/30"),
+                "dev".into(),
+                outside.clone(),
+            ],
+            vec!["link".into(), "set".into(), outside.clone(), "up".into()],
+            netns.inside(&["addr", "add", &format!("{subnet}.2/30"), "dev", &inside]),
+            netns.inside(&["link", "set", &inside, "up"]),
+            netns.inside(&["link", "set", "lo", "up"]),
+        ];
+        for step in steps {
+            ip(&step)?;
+        }
+        Ok(netns)
+    }
+
+    fn inside(&self, args: &[&str]) -> Vec<String> {
+        ["-n", &self.name]
+            .iter()
+            .chain(args)
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    fn set_link(&self, state: &str) {
+        ip(&[
+            "link".into(),
+            "set".into(),
+            self.outside.clone(),
+            state.into(),
+        ])
+        .expect("the veth link set");
+    }
+}
+
+impl Drop for Netns {
+    fn drop(&mut self) {
+        // Deleting the namespace deletes its end of the link, and with it ours.
+        let _ = ip(&["netns".into(), "del".into(), self.name.clone()]);
+    }
+}
+
+/// Runs `ip args`, or says what it printed.
+fn ip(args: &[String]) -> Result<(), String> {
+    let output = std::process::Command::new("ip")
+        .args(args)
+        .output()
+        .map_err(|error| format!("ip {}: {error}", args.join(" ")))?;
+    if output.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "ip {}: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&output.stderr).trim()
+        ))
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
+    let netns = match Netns::make() {
+        Ok(netns) => netns,
+        Err(why) => {
+            eprintln!(
+                "\n!!! NETWORK NAMESPACES UNAVAILABLE ({why}): this test runs over loopback, \
+                 its link cut by killing the owner's host !!!\n"
+            );
+            return an_owner_process_killed_ends_waits_and_its_restart_is_served_over_loopback()
+                .await;
+        }
+    };
+    let endpoint = format!("tcp/{}:7447", netns.inside_address);
+    let _owner = peer("netns_cell", &endpoint, Some(&netns.name)).await;
+    let host = Host::builder("netns_cell")
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&host, "DOUBLE", "DOUBLER", "ASKER").await.unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    assert_eq!(
+        within(PROMPTLY, "a round trip", asker.send(4))
+            .await
+            .unwrap(),
+        8
+    );
+    let lease = host.lease();
+    let cut = async {
+        tokio::task::yield_now().await;
+        netns.set_link("down");
+    };
+    // Nothing tells this host the link is gone: the lease does.
+    held_send_ends_with_no_reply(&mut asker, cut, 2 * lease + PROMPTLY).await;
+    seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
+    netns.set_link("up");
+    served_again(&mut asker, PROMPTLY + 2 * lease).await;
+}
+
+/// The namespace test's fallback: the same cut, made by killing the owner's host.
+async fn an_owner_process_killed_ends_waits_and_its_restart_is_served_over_loopback() {
+    let endpoint = free_endpoint();
+    let mut owner = peer("loopback_cell", &endpoint, None).await;
+    let host = Host::builder("loopback_cell")
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&host, "DOUBLE", "DOUBLER", "ASKER").await.unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    let lease = host.lease();
+    let kill = async {
+        owner.start_kill().expect("SIGKILL");
+        owner.wait().await.expect("the peer reaped");
+    };
+    held_send_ends_with_no_reply(&mut asker, kill, 2 * lease + PROMPTLY).await;
+    seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
+    let _restarted = peer("loopback_cell", &endpoint, None).await;
+    served_again(&mut asker, PROMPTLY).await;
+}

@@ -1,0 +1,75 @@
+"""An outside client of an IMRS cell on zenoh, written only from the documented wire format.
+
+Usage: outside_client.py ENDPOINT CELL
+
+Asks the DOUBLE port (u64 -> u64, owned by DOUBLER) to double 21, queries the STATUS port
+(a RESPONSE port, string -> string), and asks DOUBLE as a module off its user list. Prints
+one line per answer; exits non-zero on anything unexpected.
+"""
+
+import struct
+import sys
+import time
+
+import zenoh
+
+HEADER = b"\x00\x01\x00\x00"  # CDR, little-endian
+
+
+def cdr_u64(n):
+    return HEADER + struct.pack("<Q", n)
+
+
+def cdr_string(s):
+    data = s.encode() + b"\x00"
+    return HEADER + struct.pack("<I", len(data)) + data
+
+
+def read_u64(payload):
+    assert payload[:4] == HEADER, payload
+    return struct.unpack("<Q", payload[4:12])[0]
+
+
+def read_string(payload):
+    assert payload[:4] == HEADER, payload
+    (length,) = struct.unpack("<I", payload[4:8])
+    return payload[8 : 8 + length - 1].decode()
+
+
+def ask(session, key, payload, module):
+    replies = list(session.get(key, payload=payload, attachment=module.encode(), timeout=10.0))
+    assert len(replies) == 1, f"{key}: {len(replies)} replies"
+    reply = replies[0]
+    if reply.ok is not None:
+        return True, reply.ok.payload.to_bytes()
+    return False, reply.err.payload.to_bytes().decode()
+
+
+def main():
+    endpoint, cell = sys.argv[1], sys.argv[2]
+    config = zenoh.Config()
+    config.insert_json5("mode", '"peer"')
+    config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("connect/endpoints", f'["{endpoint}"]')
+    session = zenoh.open(config)
+    # The owner's liveliness token says the port is served.
+    for _ in range(100):
+        if list(session.liveliness().get(f"imrs/{cell}/live/DOUBLE", timeout=1.0)):
+            break
+        time.sleep(0.1)
+    else:
+        sys.exit("DOUBLE's owner never seen")
+    ok, doubled = ask(session, f"imrs/{cell}/port/DOUBLE", cdr_u64(21), "PYTHON")
+    assert ok, doubled
+    print(f"DOUBLE 21 -> {read_u64(doubled)}")
+    ok, status = ask(session, f"imrs/{cell}/port/STATUS", cdr_string("status"), "PYTHON")
+    assert ok, status
+    print(f"STATUS -> {read_string(status)}")
+    ok, refused = ask(session, f"imrs/{cell}/port/DOUBLE", cdr_u64(1), "ROGUE")
+    assert not ok, refused
+    print(f"ROGUE refused: {refused}")
+    session.close()
+
+
+if __name__ == "__main__":
+    main()

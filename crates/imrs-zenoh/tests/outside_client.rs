@@ -1,0 +1,82 @@
+//! A client that is not ours — Python's `eclipse-zenoh`, speaking only the documented key
+//! expressions and CDR — sends to a port, queries a response handler, and is refused off
+//! the user list, by name.
+
+mod common;
+
+use std::process::Command;
+
+use common::{PROMPTLY, free_endpoint, listening, within};
+use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_zenoh::export;
+
+/// The Python package the test drives, at the version of the zenoh crate.
+const CLIENT: &str = "eclipse-zenoh==1.10.2";
+
+/// Python 3 with `zenoh` importable, installed with pip where it is missing.
+fn python_with_zenoh() -> &'static str {
+    let has_zenoh = || {
+        Command::new("python3")
+            .args(["-c", "import zenoh"])
+            .status()
+            .is_ok_and(|status| status.success())
+    };
+    if !has_zenoh() {
+        let installed = Command::new("python3")
+            .args(["-m", "pip", "install", "--quiet", CLIENT])
+            .status()
+            .expect("python3 runs");
+        assert!(installed.success(), "pip could not install {CLIENT}");
+        assert!(has_zenoh(), "{CLIENT} installed, yet `import zenoh` fails");
+    }
+    "python3"
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_python_client_sends_queries_and_is_refused_off_the_list() {
+    let python = python_with_zenoh();
+    let endpoint = free_endpoint();
+    let host = listening("python_cell", &endpoint).await;
+    let double: Port<u64, u64, usage::Receive, AnyUser, 2> =
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(["PYTHON"]));
+    let _double = export(&host, &double).await.unwrap();
+    let mut doubler = double.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((n, reply)) = doubler.receive().await {
+            reply.reply(2 * n);
+        }
+    });
+    let status: Port<String, String, usage::Response, AnyUser, 2> =
+        Port::new(PortSpec::new("STATUS", "CELL"));
+    let _status = export(&host, &status).await.unwrap();
+    let mut handler = status
+        .answer("CELL", |running: &bool, asked: String| {
+            format!("{asked}: {}", if *running { "running" } else { "stopped" })
+        })
+        .unwrap();
+    tokio::spawn(async move { while handler.serve(&true).await.is_ok() {} });
+
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/outside_client.py");
+    let client = tokio::process::Command::new(python)
+        .args([script, &endpoint, "python_cell"])
+        .output();
+    let output = within(PROMPTLY * 3, "the Python client", client)
+        .await
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "the client failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines[0], "DOUBLE 21 -> 42");
+    assert_eq!(lines[1], "STATUS -> status: running");
+    assert!(
+        lines[2].starts_with("ROGUE refused:")
+            && lines[2].contains("ROGUE")
+            && lines[2].contains("DOUBLE"),
+        "{}",
+        lines[2]
+    );
+}
