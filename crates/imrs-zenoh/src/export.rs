@@ -28,6 +28,7 @@ use crate::{Host, ZenohError};
 pub struct Exported {
     port: String,
     tasks: Vec<JoinHandle<()>>,
+    _serving: zenoh::query::Queryable<()>,
     _token: zenoh::liveliness::LivelinessToken,
 }
 
@@ -151,20 +152,9 @@ where
         .declare_queryable(&keys.connect)
         .await
         .map_err(ZenohError::session)?;
-    let requests = session
-        .declare_queryable(&keys.request)
-        .await
-        .map_err(ZenohError::session)?;
     let leaving = session
         .liveliness()
         .declare_subscriber(format!("{}/*", keys.user_prefix()))
-        .await
-        .map_err(ZenohError::session)?;
-    // Declared last: a host that sees the token sees the queryables too, as zenoh carries
-    // one host's declarations to another in order.
-    let token = session
-        .liveliness()
-        .declare_token(&keys.live)
         .await
         .map_err(ZenohError::session)?;
     let users = Arc::new(Users::<E> {
@@ -173,6 +163,31 @@ where
     let attach = Arc::new(attach);
     let port: Arc<str> = port_name.into();
 
+    // Each request is taken in zenoh's own thread as it comes, and waits for its own
+    // rendezvous in a task of the cell's runtime; the next is taken meanwhile.
+    let runtime = tokio::runtime::Handle::current();
+    let serving = {
+        let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+        session
+            .declare_queryable(&keys.request)
+            .callback(move |query| {
+                let (users, attach, port) =
+                    (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+                runtime.spawn(async move {
+                    let answer = forward::<Req, Rep, E>(&query, &users, &*attach, &port).await;
+                    reply(&query, answer).await;
+                });
+            })
+            .await
+            .map_err(ZenohError::session)?
+    };
+    // Declared last: a host that sees the token sees the queryables too, as zenoh carries
+    // one host's declarations to another in order.
+    let token = session
+        .liveliness()
+        .declare_token(&keys.live)
+        .await
+        .map_err(ZenohError::session)?;
     let connecting = {
         let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
         tokio::spawn(async move {
@@ -193,20 +208,6 @@ where
             }
         })
     };
-    let serving = {
-        let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
-        tokio::spawn(async move {
-            while let Ok(query) = requests.recv_async().await {
-                let (users, attach, port) =
-                    (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
-                // Each request waits for its own rendezvous; the next is taken meanwhile.
-                tokio::spawn(async move {
-                    let answer = forward::<Req, Rep, E>(&query, &users, &*attach, &port).await;
-                    reply(&query, answer).await;
-                });
-            }
-        })
-    };
     let watching = {
         let users = Arc::clone(&users);
         tokio::spawn(async move {
@@ -221,7 +222,8 @@ where
     };
     Ok(Exported {
         port: port_name.to_owned(),
-        tasks: vec![connecting, serving, watching],
+        tasks: vec![connecting, watching],
+        _serving: serving,
         _token: token,
     })
 }

@@ -18,7 +18,7 @@ use imrs_ports::usage::Usage;
 use imrs_ports::{
     AnyUser, End, Port, PortSpec, ReceiveError, ReplyHandle, ResponseEnd, WireError, usage,
 };
-use tokio::task::{JoinHandle, JoinSet};
+use tokio::task::JoinHandle;
 use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
@@ -240,45 +240,40 @@ struct Asking {
     wait: Duration,
 }
 
-/// Takes local requests through `end` and asks the owner's host, until its token is gone
-/// (true: the requests asked meanwhile are dropped unanswered) or the bridge must end
-/// (false).
+/// Takes local requests through `end` and asks the owner's host, one at a time as its one
+/// local user sends them, until its token is gone (true: a request asked meanwhile is
+/// dropped unanswered) or the bridge must end (false).
 async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
     mut end: T,
-    watch: &zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    watch: &Watch,
     asking: &Asking,
 ) -> bool {
-    let mut asked = JoinSet::new();
     loop {
         tokio::select! {
             taken = end.next() => match taken {
-                Ok((request, reply)) => {
-                    asked.spawn(ask::<Req, Rep>(asking.clone_parts(), request, reply));
-                }
+                Ok((request, reply)) => tokio::select! {
+                    () = ask::<Req, Rep>(asking, request, reply) => {}
+                    live = gone(watch) => return live,
+                },
                 // Nobody can use the local port any more.
                 Err(_) => return false,
             },
-            sample = watch.recv_async() => match sample {
-                Ok(sample) if sample.kind() == SampleKind::Delete => {
-                    asked.abort_all();
-                    return true;
-                }
-                Ok(_) => {}
-                Err(_) => return false,
-            },
-            Some(_) = asked.join_next(), if !asked.is_empty() => {}
+            live = gone(watch) => return live,
         }
     }
 }
 
-impl Asking {
-    fn clone_parts(&self) -> Self {
-        Self {
-            session: self.session.clone(),
-            key: self.key.clone(),
-            module: self.module.clone(),
-            port: self.port.clone(),
-            wait: self.wait,
+/// The owner's liveliness, as this host hears of it.
+type Watch = zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
+
+/// Completes when the owner's token is gone (true), or when nothing more can be heard of
+/// it (false: the session is closed).
+async fn gone(watch: &Watch) -> bool {
+    loop {
+        match watch.recv_async().await {
+            Ok(sample) if sample.kind() == SampleKind::Delete => return true,
+            Ok(_) => {}
+            Err(_) => return false,
         }
     }
 }
@@ -286,7 +281,7 @@ impl Asking {
 /// Asks the owner's host with `request`, and replies with its answer. Without one (an
 /// error reply, no reply in time, bytes that are no reply) the handle is dropped, and the
 /// local sender gets `NoReply`; the reason is logged.
-async fn ask<Req: Message, Rep: Message>(asking: Asking, request: Req, reply: ReplyHandle<Rep>) {
+async fn ask<Req: Message, Rep: Message>(asking: &Asking, request: Req, reply: ReplyHandle<Rep>) {
     let bytes = encode(&asking.port, &request).map_err(|e| e.to_string());
     drop(request);
     let answer = async {
