@@ -23,6 +23,10 @@ pub mod time {}
 #[doc = include_str!("across-processes.md")]
 pub mod across_processes {}
 
+/// Ports across hosts, on zenoh.
+#[doc = include_str!("across-hosts.md")]
+pub mod across_hosts {}
+
 /// Recordings, Foxglove and the timeline.
 #[doc = include_str!("recording.md")]
 pub mod recording {}
