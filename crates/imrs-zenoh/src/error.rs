@@ -17,7 +17,8 @@ pub enum ZenohError {
         /// What zenoh said.
         reason: String,
     },
-    /// Nobody exports the port: no host answered its connection in time.
+    /// No host answered the port's connection in time: nobody exports it, or this host is
+    /// not admitted to it.
     NoOwner {
         /// The port.
         port: String,
@@ -51,7 +52,8 @@ impl fmt::Display for ZenohError {
             Self::NoOwner { port } => {
                 write!(
                     f,
-                    "port {port}: no host exports it (no answer to the connection)"
+                    "port {port}: no host answered this host's connection (nobody exports it, \
+                     or this host is not admitted to it)"
                 )
             }
             Self::Refused { port, reason } => {

@@ -3,6 +3,7 @@
 use std::time::Duration;
 
 use crate::ZenohError;
+use crate::access::{Admitted, TlsFiles, access_control, tls_settings};
 use crate::key::checked;
 
 /// One host's view of a cell on zenoh: a zenoh session in peer mode, which finds other
@@ -24,6 +25,8 @@ pub struct HostBuilder {
     listen: Vec<String>,
     connect: Vec<String>,
     lease: Duration,
+    tls: Option<TlsFiles>,
+    admitted: Vec<Admitted>,
 }
 
 impl Host {
@@ -38,6 +41,8 @@ impl Host {
             listen: Vec::new(),
             connect: Vec::new(),
             lease: Self::DEFAULT_LEASE,
+            tls: None,
+            admitted: Vec::new(),
         }
     }
 
@@ -83,10 +88,45 @@ impl HostBuilder {
         self
     }
 
+    /// Mutual TLS with the cell's other hosts: each proves who it is with a certificate
+    /// signed by the cell's authority. Give `tls/<address>:<port>` endpoints.
+    pub fn tls(mut self, files: TlsFiles) -> Self {
+        self.tls = Some(files);
+        self
+    }
+
+    /// Admits to port `port`'s keys on this host only `owner_host`, the host of its owner,
+    /// which alone may serve it, and `user_hosts`, the hosts of the modules on its user list,
+    /// which may ask it; each host is named by its certificate's common name. Once any port
+    /// is admitted, this host lets no other host do anything else: every port that crosses
+    /// to or from it must be admitted, on the owner's host and on each user's. Needs
+    /// [`tls`](Self::tls).
+    pub fn admit<S: Into<String>>(
+        mut self,
+        port: &str,
+        owner_host: &str,
+        user_hosts: impl IntoIterator<Item = S>,
+    ) -> Self {
+        self.admitted.push(Admitted {
+            port: port.to_owned(),
+            owner: owner_host.to_owned(),
+            users: user_hosts.into_iter().map(Into::into).collect(),
+        });
+        self
+    }
+
     /// Opens the session. Refused, naming it, if the cell's name cannot be part of a key
-    /// expression or zenoh refuses an endpoint.
+    /// expression, ports are admitted without TLS, or zenoh refuses an endpoint or a file.
     pub async fn open(self) -> Result<Host, ZenohError> {
         checked("cell", &self.cell)?;
+        if let (None, Some(first)) = (&self.tls, self.admitted.first()) {
+            return Err(ZenohError::Session {
+                reason: format!(
+                    "port {} admits hosts by their certificates, and this host has no TLS",
+                    first.port
+                ),
+            });
+        }
         let mut config = zenoh::Config::default();
         let json = |value: &Vec<String>| serde_json_list(value);
         let settings = [
@@ -105,6 +145,16 @@ impl HostBuilder {
                 "{ period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2 }".to_owned(),
             ),
         ];
+        let mut settings = settings.to_vec();
+        if let Some(files) = &self.tls {
+            settings.extend(tls_settings(files));
+        }
+        if !self.admitted.is_empty() {
+            settings.push((
+                "access_control",
+                access_control(&self.cell, &self.admitted)?,
+            ));
+        }
         for (key, value) in settings {
             config
                 .insert_json5(key, &value)

@@ -65,6 +65,7 @@
 //! its eight bytes. A message is refused, naming the port, if it does not decode, or would
 //! take more than [`MAX_MESSAGE`] bytes.
 
+mod access;
 mod connected;
 mod error;
 mod export;
@@ -74,6 +75,7 @@ mod import;
 mod key;
 mod message;
 
+pub use access::TlsFiles;
 pub use error::ZenohError;
 pub use export::{Export, Exported, export};
 pub use host::{Host, HostBuilder};

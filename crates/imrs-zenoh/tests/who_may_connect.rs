@@ -1,0 +1,183 @@
+//! Who may connect: hosts prove who they are with certificates made here, signed by the
+//! cell's authority, over mutual TLS; on each port's keys, zenoh's access control lets in
+//! only the host of its owner and the hosts of the modules on its user list. A host without
+//! a certificate, and one with a valid certificate that is not admitted, get nothing — not
+//! even under a module name on the list — and cannot pass for the owner.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{PROMPTLY, within};
+use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_zenoh::{Host, Imported, TlsFiles, ZenohError, export, import};
+use rcgen::{BasicConstraints, CertificateParams, DnType, IsCa, Issuer, KeyPair};
+
+/// A cell's certificate authority, and the files of the hosts it signs, in a directory of
+/// this test's own.
+struct Authority {
+    dir: PathBuf,
+    issuer: Issuer<'static, KeyPair>,
+}
+
+impl Authority {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("imrs-tls-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let key = KeyPair::generate().unwrap();
+        let mut params = CertificateParams::new(Vec::<String>::new()).unwrap();
+        params.is_ca = IsCa::Ca(BasicConstraints::Unconstrained);
+        params
+            .distinguished_name
+            .push(DnType::CommonName, "the cell's authority");
+        let certificate = params.self_signed(&key).unwrap();
+        std::fs::write(dir.join("authority.pem"), certificate.pem()).unwrap();
+        Self {
+            dir,
+            issuer: Issuer::new(params, key),
+        }
+    }
+
+    /// The files of host `name`: its certificate (common name `name`) and key.
+    fn host(&self, name: &str) -> TlsFiles {
+        let key = KeyPair::generate().unwrap();
+        let mut params = CertificateParams::new(vec!["localhost".to_owned()]).unwrap();
+        params.distinguished_name.push(DnType::CommonName, name);
+        let certificate = params.signed_by(&key, &self.issuer).unwrap();
+        let (cert, key_file) = (
+            self.path(&format!("{name}.pem")),
+            self.path(&format!("{name}.key")),
+        );
+        std::fs::write(&cert, certificate.pem()).unwrap();
+        std::fs::write(&key_file, key.serialize_pem()).unwrap();
+        TlsFiles {
+            authority: self.path("authority.pem"),
+            certificate: cert,
+            key: key_file,
+        }
+    }
+
+    fn path(&self, file: &str) -> PathBuf {
+        self.dir.join(file)
+    }
+}
+
+impl Drop for Authority {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// A TLS endpoint on loopback that nothing listens on now.
+fn tls_endpoint() -> String {
+    common::free_endpoint().replacen("tcp/", "tls/", 1)
+}
+
+/// A host of the cell with `files`, admitting GRIP as the wiring says, listening or
+/// connecting on `endpoint`.
+async fn host(files: TlsFiles, endpoint: &str, listens: bool) -> Host {
+    let builder =
+        Host::builder("tls_cell")
+            .tls(files)
+            .admit("GRIP", "gripper-host", ["robot-host"]);
+    let builder = if listens {
+        builder.listen(endpoint)
+    } else {
+        builder.connect(endpoint)
+    };
+    builder.open().await.unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn only_admitted_hosts_reach_a_port_and_none_passes_for_its_owner() {
+    let authority = Authority::new("admit");
+    let endpoint = tls_endpoint();
+    let robot_host = host(authority.host("robot-host"), &endpoint, true).await;
+
+    // A host with a valid certificate that is not admitted claims GRIP, owned by GRIPPER,
+    // before the gripper's host is up: its answers are the opposite of the gripper's.
+    let intruder_host = Host::builder("tls_cell")
+        .tls(authority.host("intruder-host"))
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let fake: Port<f32, bool, usage::Receive, AnyUser, 2> =
+        Port::new(PortSpec::new("GRIP", "GRIPPER"));
+    let fake_export = export(&intruder_host, &fake).await.unwrap();
+    let mut faker = fake.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((width, reply)) = faker.receive().await {
+            reply.reply(width >= 0.05);
+        }
+    });
+    // The robot's host hears nothing of it.
+    let claimed =
+        import::<Imported<f32, bool, usage::Receive>>(&robot_host, "GRIP", "GRIPPER", "ROBOT")
+            .await
+            .unwrap_err();
+    assert_eq!(
+        claimed,
+        ZenohError::NoOwner {
+            port: "GRIP".into()
+        }
+    );
+
+    // The gripper's host comes up: the robot is served by it, and by it alone.
+    let gripper_host = host(authority.host("gripper-host"), &endpoint, false).await;
+    let grip: Port<f32, bool, usage::Receive, AnyUser, 2> =
+        Port::new(PortSpec::new("GRIP", "GRIPPER").user_list(["ROBOT"]));
+    let _exported = export(&gripper_host, &grip).await.unwrap();
+    let mut gripper = grip.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((width, reply)) = gripper.receive().await {
+            reply.reply(width < 0.05);
+        }
+    });
+    let robot: Imported<f32, bool, usage::Receive> =
+        import(&robot_host, "GRIP", "GRIPPER", "ROBOT")
+            .await
+            .unwrap();
+    let mut robot = robot.port().user_named("ROBOT").unwrap();
+    for _ in 0..20 {
+        let closed = within(PROMPTLY, "a round trip over TLS", robot.send(0.01)).await;
+        assert!(closed.unwrap(), "an answer that was not the gripper's");
+    }
+
+    // Neither the intruder, claiming ROBOT's name, nor a host with no certificate at all,
+    // reaches the gripper's GRIP.
+    let plain_host = Host::builder("tls_cell")
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let (intruding, plain) = tokio::join!(
+        import::<Imported<f32, bool, usage::Receive>>(&intruder_host, "GRIP", "GRIPPER", "ROBOT"),
+        import::<Imported<f32, bool, usage::Receive>>(&plain_host, "GRIP", "GRIPPER", "ROBOT"),
+    );
+    // The intruder sees its own export only: a GRIP owned by itself, never the gripper's.
+    let intruding = intruding.map(|imported| imported.port().users_attached());
+    assert!(intruding.is_err() || intruding == Ok(0), "{intruding:?}");
+    let plain = plain.unwrap_err();
+    assert_eq!(
+        plain,
+        ZenohError::NoOwner {
+            port: "GRIP".into()
+        }
+    );
+    assert!(plain.to_string().contains("not admitted"), "{plain}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn admitting_ports_without_tls_is_refused_by_name() {
+    let refused = Host::builder("tls_cell")
+        .admit("GRIP", "gripper-host", ["robot-host"])
+        .open()
+        .await
+        .err()
+        .unwrap();
+    assert_eq!(
+        refused.to_string(),
+        "zenoh session: port GRIP admits hosts by their certificates, and this host has no TLS"
+    );
+}
