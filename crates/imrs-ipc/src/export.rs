@@ -54,8 +54,38 @@ impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Re
 pub(crate) enum Refusal {
     /// The port's own wiring error.
     Wire(WireError),
+    /// The module is not on the port's user list (its name, not kept).
+    NotOnUserList,
+    /// Every user place of the port is taken.
+    Full {
+        /// The port's number of users.
+        capacity: usize,
+    },
     /// Something else failed (a relay back to the module's process).
     Failed,
+}
+
+/// Refuses remote module `module`'s claim on `port` by its text alone, before its name is
+/// made: a name is kept for the life of the process, so a peer that claimed names without
+/// end would otherwise grow this process without bound. Only a module that may attach
+/// gets a name.
+pub(crate) fn claim<M, R, U, L, const N: usize>(
+    port: &Port<M, R, U, L, N>,
+    module: &str,
+) -> Result<(), Refusal>
+where
+    M: Send + 'static,
+    R: Send + 'static,
+    U: Usage,
+    L: UserList,
+{
+    if !port.admits(module) {
+        Err(Refusal::NotOnUserList)
+    } else if port.is_full() {
+        Err(Refusal::Full { capacity: N })
+    } else {
+        Ok(())
+    }
 }
 
 impl From<WireError> for Refusal {
@@ -213,6 +243,7 @@ where
         false,
         tight,
         move |module: &str| {
+            claim(&attached, module)?;
             // The remote module's end waits in the bridge's task, which a spinning wait
             // would keep off its worker: it parks, whatever the port's process type.
             let mut end = attached.user_named(module)?;
@@ -589,10 +620,12 @@ fn user<E>(
             users.insert(module.to_owned(), Arc::clone(&end));
             Ok(end)
         }
-        Err(Refusal::Wire(WireError::NotOnUserList { .. })) => Err((NOT_ON_USER_LIST, 0)),
-        Err(Refusal::Wire(WireError::TooManyUsers { capacity, .. })) => {
-            Err((TOO_MANY_USERS, u32::try_from(capacity).unwrap_or(u32::MAX)))
+        Err(Refusal::Wire(WireError::NotOnUserList { .. }) | Refusal::NotOnUserList) => {
+            Err((NOT_ON_USER_LIST, 0))
         }
+        Err(
+            Refusal::Wire(WireError::TooManyUsers { capacity, .. }) | Refusal::Full { capacity },
+        ) => Err((TOO_MANY_USERS, u32::try_from(capacity).unwrap_or(u32::MAX))),
         Err(_) => Err((REFUSED, 0)),
     }
 }

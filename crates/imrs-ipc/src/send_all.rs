@@ -15,7 +15,7 @@ use std::sync::{Arc, Mutex};
 
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
-use crate::export::{Forward, Refusal, bridge};
+use crate::export::{Forward, Refusal, bridge, claim};
 use crate::import::{Relay, SharedAsker, Take, connect, keep_attached, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
@@ -256,6 +256,7 @@ where
     // kept off tokio's workers.
     let (exported, _) =
         bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, false, move |module: &str| {
+            claim(&port, module)?;
             // The module's own end of the real port: what it receives goes to its process.
             let end = user_end(&port, module)?;
             let _entered = runtime.enter();
@@ -374,7 +375,7 @@ where
         Port::new(PortSpec::new(name.clone(), owner).user_list([module]));
     // First the service the owner's process will relay to, so that it is there when the
     // owner answers the connection by relaying.
-    let (serving, expected, port_name) = (local.clone(), Name::from(owner), name.clone());
+    let (serving, expected) = (local.clone(), Name::from(owner));
     // Its one user is the owner's relay.
     let (server, _) = bridge::<W, Rep, X, R, _, _>(
         remote,
@@ -384,10 +385,7 @@ where
         false,
         move |relay_module: &str| {
             if relay_module != expected.as_str() {
-                return Err(Refusal::Wire(WireError::NotOnUserList {
-                    port: port_name.clone(),
-                    module: relay_module.into(),
-                }));
+                return Err(Refusal::NotOnUserList);
             }
             Ok(serve(serving.owner()?))
         },

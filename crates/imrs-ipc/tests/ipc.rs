@@ -9,7 +9,8 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_ipc::{FromBytes, Imported, IpcError, Remote, ZeroCopySend, export, import};
 use imrs_ports::{
-    AnyUser, End, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError, usage,
+    AnyUser, End, Name, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError,
+    usage,
 };
 
 /// The peer's message: the same by name, size and alignment.
@@ -1835,4 +1836,52 @@ async fn answers_an_owner_killed_and_started_again(
     }
     // The new owner found every answer five times its question.
     assert!(exit_status(&mut second).await.success());
+}
+
+/// The trust boundary: a process of the same user claims module names. Each claim that is
+/// refused — off the user list, or past the number of users — leaves no name behind in the
+/// owner's process, so that claims without end grow nothing there.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_refused_claim_leaves_no_name_in_the_owners_process() {
+    let cell = cell("claims");
+    let remote = Remote::new(&cell).unwrap();
+    let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
+    let _exported = export(&remote, &port).unwrap();
+    let mut owner = port.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((number, reply)) = owner.receive().await {
+            reply.reply(Number {
+                value: 2 * number.value,
+            });
+        }
+    });
+    let claim = |module: &str| {
+        let mut claimer = user(&cell, module, "1");
+        let status = claimer.0.wait().unwrap();
+        assert_eq!(status.code(), Some(2), "{module}'s claim was not refused");
+    };
+    // Off the list.
+    let off_list: Vec<String> = (0..20)
+        .map(|i| format!("ROGUE_{}_{i}", std::process::id()))
+        .collect();
+    off_list.iter().for_each(|module| claim(module));
+    // On the list, but past the number of users: ASKER holds the one place.
+    let asker: Imported<Number, Number, usage::Receive> =
+        imrs_ipc::import(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
+    let _asking = asker.port().user_named("ASKER").unwrap();
+    let open =
+        Port::<Number, Number, usage::Receive, AnyUser, 1>::new(PortSpec::new("OPEN", "OPENER"));
+    let _open = export(&remote, &open).unwrap();
+    let _first = open.user_named("FIRST").unwrap();
+    let past: Vec<String> = (0..5)
+        .map(|i| format!("LATE_{}_{i}", std::process::id()))
+        .collect();
+    for module in &past {
+        let mut claimer = peer(&["user", &cell, "OPEN", module, "1"]);
+        assert_eq!(claimer.0.wait().unwrap().code(), Some(2), "{module}");
+    }
+    for module in off_list.iter().chain(&past) {
+        assert_eq!(Name::known(module), None, "{module} was kept");
+    }
 }

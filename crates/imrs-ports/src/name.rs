@@ -47,6 +47,16 @@ impl Name {
         Self(kept)
     }
 
+    /// The name `text`, if it has been made already; never keeps a new one. For text from
+    /// outside the process (a peer's message), which is kept only once it is accepted.
+    pub fn known(text: &str) -> Option<Self> {
+        interned()
+            .read()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get(text)
+            .map(|known| Self(known))
+    }
+
     /// The name as text.
     pub fn as_str(&self) -> &'static str {
         self.0
@@ -134,6 +144,14 @@ mod tests {
         assert_ne!(a, Name::from("SHARE_FEEDER1"));
         let (a, b) = (Name::from("A"), Name::from("B"));
         assert_eq!(a.cmp(&b), Ordering::Less);
+    }
+
+    #[test]
+    fn a_name_looked_up_is_not_kept() {
+        assert_eq!(Name::known("NEVER_MADE_BY_ANYONE"), None);
+        assert_eq!(Name::known("NEVER_MADE_BY_ANYONE"), None);
+        let made = Name::from("MADE_ONCE");
+        assert_eq!(Name::known("MADE_ONCE"), Some(made));
     }
 
     #[test]

@@ -252,6 +252,19 @@ where
         self.core.users_attached()
     }
 
+    /// Whether module `module` may attach as a user as far as its name goes: it is on the
+    /// port's user list, or the port has none. Looks at the text only, so that a name a
+    /// peer claims is not kept (see [`Name`]) when it is refused: a transport checks this,
+    /// and [`Port::is_full`], before it attaches a remote module.
+    pub fn admits(&self, module: &str) -> bool {
+        self.core.meta.admits(module)
+    }
+
+    /// Whether every user place is taken: one more user would be refused.
+    pub fn is_full(&self) -> bool {
+        self.core.users_attached() >= self.core.capacity()
+    }
+
     /// Attaches the owner end. One owner end at a time; after it is dropped (its module
     /// died), a new copy of the module may attach again.
     pub fn owner(&self) -> Result<End<Req, Rep, U>, WireError>

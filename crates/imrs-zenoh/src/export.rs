@@ -84,22 +84,26 @@ struct Attached<E> {
 }
 
 impl<E> Users<E> {
-    /// `module`'s end, attached now with `attach` if it is not yet.
+    /// `module`'s end, attached now with `attach` if it is not yet and `claim` lets it.
     fn end(
         &self,
         module: &str,
+        claim: &Claim,
         attach: impl FnOnce(&str) -> Result<E, WireError>,
-    ) -> Result<Arc<tokio::sync::Mutex<E>>, WireError> {
+    ) -> Result<Arc<tokio::sync::Mutex<E>>, String> {
         let mut ends = self.ends.lock().unwrap_or_else(PoisonError::into_inner);
         if let Some(attached) = ends.get(module) {
             return Ok(Arc::clone(&attached.end));
         }
+        // Refused by its text alone, before its name is made (names are kept for the life
+        // of the process): a peer that claims names without end grows nothing here.
+        claim(module)?;
         let presence = Presence::new(module);
         // The end is held by the remote module's presence, so that its peers see it gone
         // when the module's host is.
         let end = {
             let _held = Presence::enter(Some(Arc::clone(&presence)));
-            attach(module)?
+            attach(module).map_err(|error| error.to_string())?
         };
         let end = Arc::new(tokio::sync::Mutex::new(end));
         let attached = Attached {
@@ -123,11 +127,43 @@ impl<E> Users<E> {
     }
 }
 
-/// Serves `port_name` for the remote modules, each attached with `attach`.
+/// Whether a remote module may attach, by its name's text: why not, naming the port.
+type Claim = dyn Fn(&str) -> Result<(), String> + Send + Sync;
+
+/// `port`'s answer to a remote module's claim: refused, in the words of its wiring error,
+/// if the module is off its user list or every user place is taken.
+fn claim<Req, Rep, U, L, const N: usize>(
+    port: &Port<Req, Rep, U, L, N>,
+    module: &str,
+) -> Result<(), String>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: imrs_ports::usage::Usage,
+    L: UserList,
+{
+    let name = port.name();
+    if !port.admits(module) {
+        Err(format!(
+            "module {module} is not on the user list of port {name}"
+        ))
+    } else if port.is_full() {
+        Err(format!(
+            "module {module} cannot use port {name}: it allows {N} active user(s) and all are \
+             attached"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// Serves `port_name` for the remote modules, each claimed with `claim` and attached with
+/// `attach`.
 async fn serve<Req, Rep, E>(
     host: &Host,
     port_name: &str,
     owner: String,
+    claim: Box<Claim>,
     attach: impl Fn(&str) -> Result<E, WireError> + Send + Sync + 'static,
 ) -> Result<Exported, ZenohError>
 where
@@ -161,6 +197,7 @@ where
         ends: Mutex::default(),
     });
     let attach = Arc::new(attach);
+    let claim: Arc<Claim> = claim.into();
     let port: Arc<str> = port_name.into();
 
     // Each request is taken in zenoh's own thread as it comes, and waits for its own
@@ -168,13 +205,16 @@ where
     let runtime = tokio::runtime::Handle::current();
     let serving = {
         let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+        let claim = Arc::clone(&claim);
         session
             .declare_queryable(&keys.request)
             .callback(move |query| {
                 let (users, attach, port) =
                     (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+                let claim = Arc::clone(&claim);
                 runtime.spawn(async move {
-                    let answer = forward::<Req, Rep, E>(&query, &users, &*attach, &port).await;
+                    let answer =
+                        forward::<Req, Rep, E>(&query, &users, &*claim, &*attach, &port).await;
                     reply(&query, answer).await;
                 });
             })
@@ -190,13 +230,12 @@ where
         .map_err(ZenohError::session)?;
     let connecting = {
         let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
+        let claim = Arc::clone(&claim);
         tokio::spawn(async move {
             let owner = owner;
             while let Ok(query) = connects.recv_async().await {
                 let answer = module_of(&query).and_then(|module| {
-                    let end = users
-                        .end(&module, |m| attach(m))
-                        .map_err(|e| e.to_string())?;
+                    let end = users.end(&module, &*claim, |m| attach(m))?;
                     let timeout = end.try_lock().ok().and_then(|end| end.timeout());
                     let connected = Connected {
                         owner: owner.clone(),
@@ -232,6 +271,7 @@ where
 async fn forward<Req, Rep, E>(
     query: &Query,
     users: &Users<E>,
+    claim: &Claim,
     attach: &(dyn Fn(&str) -> Result<E, WireError> + Send + Sync),
     port: &str,
 ) -> Result<Vec<u8>, String>
@@ -241,7 +281,7 @@ where
     E: Forward<Req, Rep>,
 {
     let module = module_of(query)?;
-    let end = users.end(&module, attach).map_err(|e| e.to_string())?;
+    let end = users.end(&module, claim, attach)?;
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
     let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
     // One request of a module at a time, as in one process: its next waits here.
@@ -287,7 +327,9 @@ mod sealed {
         async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
             let port = self.clone();
             let owner = self.owner_module().to_string();
-            serve::<Req, Rep, _>(host, self.name().as_str(), owner, move |module| {
+            let claims = self.clone();
+            let claim = Box::new(move |module: &str| claim(&claims, module));
+            serve::<Req, Rep, _>(host, self.name().as_str(), owner, claim, move |module| {
                 port.user_named(module)
             })
             .await
@@ -300,7 +342,9 @@ mod sealed {
         async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
             let port = self.clone();
             let owner = self.owner_module().to_string();
-            serve::<Req, Rep, _>(host, self.name().as_str(), owner, move |module| {
+            let claims = self.clone();
+            let claim = Box::new(move |module: &str| claim(&claims, module));
+            serve::<Req, Rep, _>(host, self.name().as_str(), owner, claim, move |module| {
                 port.user_named(module)
             })
             .await

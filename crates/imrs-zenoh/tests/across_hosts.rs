@@ -256,3 +256,48 @@ async fn a_user_host_that_goes_ends_its_owners_wait_with_peer_gone() {
         "{waited:?}"
     );
 }
+
+/// A hostile peer, speaking zenoh directly, claims module names without end: each claim
+/// refused is answered with the reason, naming the port, and leaves no name behind.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_refused_claim_is_answered_by_name_and_leaves_no_name_behind() {
+    let (owner_host, peer_host) = two_hosts("claim_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("GATE", "GATEKEEPER").user_list(["ROBOT"]));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let mut gatekeeper = port.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((n, reply)) = gatekeeper.receive().await {
+            reply.reply(n);
+        }
+    });
+    // The owner is seen (an import waits for it), then the claims come raw.
+    let _robot: Imported<u64, u64, usage::Receive> =
+        import(&peer_host, "GATE", "GATEKEEPER", "ROBOT")
+            .await
+            .unwrap();
+    let claims: Vec<String> = (0..50)
+        .map(|i| format!("CLAIM_{}_{i}", std::process::id()))
+        .collect();
+    for module in &claims {
+        let replies = peer_host
+            .session()
+            .get("imrs/claim_cell/port/GATE")
+            .payload(vec![0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0])
+            .attachment(module.as_bytes())
+            .await
+            .unwrap();
+        let reply = within(PROMPTLY, "a claim's answer", replies.recv_async())
+            .await
+            .unwrap();
+        let reason = reply.into_result().unwrap_err();
+        let reason = String::from_utf8(reason.payload().to_bytes().into_owned()).unwrap();
+        assert_eq!(
+            reason,
+            format!("module {module} is not on the user list of port GATE")
+        );
+    }
+    for module in &claims {
+        assert_eq!(imrs_ports::Name::known(module), None, "{module} was kept");
+    }
+}
