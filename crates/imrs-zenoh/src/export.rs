@@ -28,11 +28,26 @@ use crate::{Host, ZenohError};
 pub struct Exported {
     port: String,
     tasks: Vec<JoinHandle<()>>,
-    _serving: zenoh::query::Queryable<()>,
+    /// What serves the port besides the tasks: a queryable, or the relays to its users.
+    _held: Box<dyn Send + Sync>,
     _token: zenoh::liveliness::LivelinessToken,
 }
 
 impl Exported {
+    pub(crate) fn new(
+        port: &str,
+        tasks: Vec<JoinHandle<()>>,
+        held: Box<dyn Send + Sync>,
+        token: zenoh::liveliness::LivelinessToken,
+    ) -> Self {
+        Self {
+            port: port.to_owned(),
+            tasks,
+            _held: held,
+            _token: token,
+        }
+    }
+
     /// The port.
     pub fn port(&self) -> &str {
         &self.port
@@ -53,14 +68,15 @@ impl std::fmt::Debug for Exported {
     }
 }
 
-/// A port whose owner's host can export it: a port its owner receives on, or a `RESPONSE`
-/// port, of [`Message`] types.
+/// A port whose owner's host can export it, of [`Message`] types: a port its owner receives
+/// on, a `RESPONSE` port, or a port whose owner starts each rendezvous (`SENDALL` and
+/// `CALLALL`, whose requests are `Clone`; and `QUERY`; the replies of all three `Default`).
 #[diagnostic::on_unimplemented(
     message = "`{Self}` cannot cross hosts",
     label = "not a port an IMRS port on zenoh can carry",
-    note = "a port crosses hosts when its owner receives on it or answers it with a response \
-            handler (`usage::Receive`, `usage::Response`), and its request and reply are \
-            `Message`s: serde types, encoded in CDR"
+    note = "a port crosses hosts when its request and reply are `Message`s: serde types, \
+            encoded in CDR (for `SENDALL` and `CALLALL` the request is also `Clone`, and for \
+            those and `QUERY` the reply is also `Default`)"
 )]
 pub trait Export: sealed::Exports {}
 
@@ -128,11 +144,11 @@ impl<E> Users<E> {
 }
 
 /// Whether a remote module may attach, by its name's text: why not, naming the port.
-type Claim = dyn Fn(&str) -> Result<(), String> + Send + Sync;
+pub(crate) type Claim = dyn Fn(&str) -> Result<(), String> + Send + Sync;
 
 /// `port`'s answer to a remote module's claim: refused, in the words of its wiring error,
 /// if the module is off its user list or every user place is taken.
-fn claim<Req, Rep, U, L, const N: usize>(
+pub(crate) fn claim<Req, Rep, U, L, const N: usize>(
     port: &Port<Req, Rep, U, L, N>,
     module: &str,
 ) -> Result<(), String>
@@ -173,17 +189,7 @@ where
 {
     let keys = Keys::new(&host.cell, port_name)?;
     let session = &host.session;
-    let others = session
-        .liveliness()
-        .get(&keys.live)
-        .await
-        .map_err(ZenohError::session)?;
-    if others.recv_async().await.is_ok() {
-        return Err(ZenohError::Refused {
-            port: port_name.to_owned(),
-            reason: "another host exports it already".to_owned(),
-        });
-    }
+    first_exporter(host, &keys, port_name).await?;
     let connects = session
         .declare_queryable(&keys.connect)
         .await
@@ -259,12 +265,29 @@ where
             }
         })
     };
-    Ok(Exported {
-        port: port_name.to_owned(),
-        tasks: vec![connecting, watching],
-        _serving: serving,
-        _token: token,
-    })
+    Ok(Exported::new(
+        port_name,
+        vec![connecting, watching],
+        Box::new(serving),
+        token,
+    ))
+}
+
+/// Refuses to export a port another host exports already, as far as this host has heard.
+pub(crate) async fn first_exporter(host: &Host, keys: &Keys, port: &str) -> Result<(), ZenohError> {
+    let others = host
+        .session
+        .liveliness()
+        .get(&keys.live)
+        .await
+        .map_err(ZenohError::session)?;
+    if others.recv_async().await.is_ok() {
+        return Err(ZenohError::Refused {
+            port: port.to_owned(),
+            reason: "another host exports it already".to_owned(),
+        });
+    }
+    Ok(())
 }
 
 /// One remote request, through its module's end: the reply in CDR, or why there is none.
@@ -290,7 +313,7 @@ where
 }
 
 /// The module a query comes from: its attachment, the module's name in UTF-8.
-fn module_of(query: &Query) -> Result<String, String> {
+pub(crate) fn module_of(query: &Query) -> Result<String, String> {
     let attachment = query
         .attachment()
         .ok_or("a request names no module: its attachment must be the module's name")?;
@@ -301,7 +324,7 @@ fn module_of(query: &Query) -> Result<String, String> {
 }
 
 /// Answers `query`: a reply on its own key, or an error reply with the reason in UTF-8.
-async fn reply(query: &Query, answer: Result<Vec<u8>, String>) {
+pub(crate) async fn reply(query: &Query, answer: Result<Vec<u8>, String>) {
     let sent = match answer {
         Ok(bytes) => query.reply(query.key_expr().clone(), bytes).await,
         Err(reason) => query.reply_err(reason).await,
@@ -350,6 +373,79 @@ mod sealed {
             .await
         }
     }
+}
+
+/// Exports with [`crate::relay`], for a port whose owner starts each rendezvous.
+macro_rules! relayed {
+    ($usage:ty, $($bound:tt)*) => {
+        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize>
+            sealed::Exports for Port<Req, Rep, $usage, L, N>
+        {
+            async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
+                let owner = self.owner_module().to_string();
+                let (claims, port) = (self.clone(), self.clone());
+                let claim = Box::new(move |module: &str| claim(&claims, module));
+                crate::relay::export_relayed::<Req, Rep, _>(
+                    host,
+                    self.name().as_str(),
+                    owner,
+                    claim,
+                    move |module| port.attach_relayed(module),
+                )
+                .await
+            }
+        }
+
+        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize> Export
+            for Port<Req, Rep, $usage, L, N>
+        {
+        }
+    };
+}
+
+relayed!(usage::SendAll, Clone);
+relayed!(usage::CallAll, Clone);
+relayed!(usage::Query, Send);
+
+/// A remote module's end of a port whose owner starts each rendezvous: the end it
+/// receives broadcasts on, or its response end (whose handler never runs: the relay takes
+/// each query and answers it with the module's host's answer).
+trait AttachRelayed<Req, Rep> {
+    type End;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError>;
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::SendAll, L, N>
+{
+    type End = imrs_ports::End<Req, Rep, usage::Receive>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.user_named(module)
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::CallAll, L, N>
+{
+    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.answer(module, never_handled::<Req, Rep>)
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::Query, L, N>
+{
+    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.answer(module, never_handled::<Req, Rep>)
+    }
+}
+
+/// The handler of a relayed response end: never run, as the relay takes each query and
+/// answers it with the module's host's answer.
+fn never_handled<Req, Rep>(_: &(), _: Req) -> Rep {
+    unreachable!("a relayed port's queries are taken, never handled here")
 }
 
 impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export

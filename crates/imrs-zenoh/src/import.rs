@@ -9,38 +9,52 @@
 //! with `NoReply`. When the token comes back, the bridge attaches again and the port is
 //! served, with no new import.
 
-use std::future::poll_fn;
 use std::sync::Arc;
 use std::time::Duration;
 
 use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
-use imrs_ports::{
-    AnyUser, End, Port, PortSpec, ReceiveError, ReplyHandle, ResponseEnd, WireError, usage,
-};
+use imrs_ports::{AnyUser, End, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage};
 use tokio::task::JoinHandle;
 use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
 use crate::key::{Keys, checked};
 use crate::message::{Message, decode, encode};
+use crate::take::Take;
 use crate::{Host, ZenohError};
 
 /// How long the owner's host may take to be seen, and to answer a connection.
-const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
+pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// How long a request with no TIMEOUT may wait for its reply across hosts: zenoh's
 /// queries end, and a port without a TIMEOUT waits as long as its owner takes.
-const NO_TIMEOUT: Duration = Duration::from_secs(24 * 3600);
+pub(crate) const NO_TIMEOUT: Duration = Duration::from_secs(24 * 3600);
 
 /// A port imported from another host, and its bridge: usable while this is held.
 pub struct Imported<Req: Send + 'static, Rep: Send + 'static, U: Usage = usage::Receive> {
     port: Port<Req, Rep, U, AnyUser, 1>,
     bridge: JoinHandle<()>,
     _token: zenoh::liveliness::LivelinessToken,
+    /// For a port whose owner starts each rendezvous: the queryable it reaches the module by.
+    _held: Option<Box<dyn Send + Sync>>,
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Imported<Req, Rep, U> {
+    pub(crate) fn relayed(
+        port: Port<Req, Rep, U, AnyUser, 1>,
+        bridge: JoinHandle<()>,
+        token: zenoh::liveliness::LivelinessToken,
+        held: Box<dyn Send + Sync>,
+    ) -> Self {
+        Self {
+            port,
+            bridge,
+            _token: token,
+            _held: Some(held),
+        }
+    }
+
     /// The local port: attach the importing module to it as to any port.
     pub fn port(&self) -> &Port<Req, Rep, U, AnyUser, 1> {
         &self.port
@@ -62,13 +76,13 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Drop for Imported<Req, 
     }
 }
 
-/// A port a user's host can import: an [`Imported`] whose owner receives or answers with
-/// a response handler, of [`Message`] types.
+/// A port a user's host can import: an [`Imported`] of [`Message`] types, of any usage the
+/// owner's host can export (see [`Export`](crate::Export)).
 #[diagnostic::on_unimplemented(
     message = "`{Self}` cannot be imported across hosts",
     label = "not a port an IMRS port on zenoh can carry",
-    note = "import an `Imported<Req, Rep, usage::Receive>` or `Imported<Req, Rep, \
-            usage::Response>` whose request and reply are `Message`s"
+    note = "import an `Imported<Req, Rep, Usage>` whose request and reply are `Message`s, \
+            with the bounds `Export` names for its usage"
 )]
 pub trait Import: sealed::Imports {}
 
@@ -86,23 +100,9 @@ pub async fn import<I: Import>(
     I::import_from(host, port, owner, module).await
 }
 
-/// The owner's side of the local port, as the bridge takes requests from it.
-trait Take<Req, Rep>: Send + Sized + 'static {
-    /// The next local request, and the right to reply to it.
-    fn next(
-        &mut self,
-    ) -> impl Future<Output = Result<(Req, ReplyHandle<Rep>), ReceiveError>> + Send + '_;
-}
-
 /// Attaching the owner's side of a local port of usage `U`.
 trait Attach<Req, Rep, U: Usage>: Sized {
     fn attach_to(local: &Port<Req, Rep, U, AnyUser, 1>) -> Result<Self, WireError>;
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for End<Req, Rep, usage::Receive> {
-    async fn next(&mut self) -> Result<(Req, ReplyHandle<Rep>), ReceiveError> {
-        self.receive().await
-    }
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static> Attach<Req, Rep, usage::Receive>
@@ -110,17 +110,6 @@ impl<Req: Send + 'static, Rep: Send + 'static> Attach<Req, Rep, usage::Receive>
 {
     fn attach_to(local: &Port<Req, Rep, usage::Receive, AnyUser, 1>) -> Result<Self, WireError> {
         local.owner()
-    }
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static> Take<Req, Rep> for ResponseEnd<Req, Rep, ()> {
-    async fn next(&mut self) -> Result<(Req, ReplyHandle<Rep>), ReceiveError> {
-        loop {
-            poll_fn(|cx| self.poll_pending(cx)).await?;
-            if let Some(taken) = self.take() {
-                return Ok(taken);
-            }
-        }
     }
 }
 
@@ -227,17 +216,18 @@ where
         port: local,
         bridge,
         _token: token,
+        _held: None,
     })
 }
 
 /// What the bridge needs to ask the owner's host.
-struct Asking {
-    session: zenoh::Session,
-    key: String,
-    module: String,
-    port: String,
+pub(crate) struct Asking {
+    pub(crate) session: zenoh::Session,
+    pub(crate) key: String,
+    pub(crate) module: String,
+    pub(crate) port: String,
     /// How long a request waits for its reply: the port's TIMEOUT and a lease.
-    wait: Duration,
+    pub(crate) wait: Duration,
 }
 
 /// Takes local requests through `end` and asks the owner's host, one at a time as its one
@@ -264,11 +254,12 @@ async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
 }
 
 /// The owner's liveliness, as this host hears of it.
-type Watch = zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
+pub(crate) type Watch =
+    zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
 
 /// Completes when the owner's token is gone (true), or when nothing more can be heard of
 /// it (false: the session is closed).
-async fn gone(watch: &Watch) -> bool {
+pub(crate) async fn gone(watch: &Watch) -> bool {
     loop {
         match watch.recv_async().await {
             Ok(sample) if sample.kind() == SampleKind::Delete => return true,
@@ -281,7 +272,11 @@ async fn gone(watch: &Watch) -> bool {
 /// Asks the owner's host with `request`, and replies with its answer. Without one (an
 /// error reply, no reply in time, bytes that are no reply) the handle is dropped, and the
 /// local sender gets `NoReply`; the reason is logged.
-async fn ask<Req: Message, Rep: Message>(asking: &Asking, request: Req, reply: ReplyHandle<Rep>) {
+pub(crate) async fn ask<Req: Message, Rep: Message>(
+    asking: &Asking,
+    request: Req,
+    reply: ReplyHandle<Rep>,
+) {
     let bytes = encode(&asking.port, &request).map_err(|e| e.to_string());
     drop(request);
     let answer = async {
@@ -313,7 +308,7 @@ async fn ask<Req: Message, Rep: Message>(asking: &Asking, request: Req, reply: R
 }
 
 /// `module`'s connection to `port`: the owner's host's answer, or why there is none.
-async fn connect(
+pub(crate) async fn connect(
     host: &Host,
     keys: &Keys,
     port: &str,
@@ -381,6 +376,33 @@ mod sealed {
         }
     }
 }
+
+/// Imports with [`crate::relay`], for a port whose owner starts each rendezvous.
+macro_rules! relayed {
+    ($usage:ty, $($bound:tt)*) => {
+        impl<Req: Message + $($bound)*, Rep: Message + Default> sealed::Imports
+            for Imported<Req, Rep, $usage>
+        {
+            async fn import_from(
+                host: &Host,
+                port: &str,
+                owner: &str,
+                module: &str,
+            ) -> Result<Self, ZenohError> {
+                crate::relay::import_relayed::<Req, Rep, $usage>(host, port, owner, module).await
+            }
+        }
+
+        impl<Req: Message + $($bound)*, Rep: Message + Default> Import
+            for Imported<Req, Rep, $usage>
+        {
+        }
+    };
+}
+
+relayed!(usage::SendAll, Clone);
+relayed!(usage::CallAll, Clone);
+relayed!(usage::Query, Send);
 
 impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, usage::Receive> {}
 

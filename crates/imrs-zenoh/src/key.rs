@@ -7,6 +7,9 @@
 //!   exports the port.
 //! - `imrs/<cell>/user/<PORT>/<MODULE>`: a liveliness token, held by a user's host while
 //!   it imports the port for the module.
+//! - `imrs/<cell>/deliver/<PORT>/<MODULE>`: for a port whose owner starts each rendezvous
+//!   (`SENDALL`, `CALLALL`, `QUERY`), the user's host's queryable, where the owner's
+//!   broadcasts and queries reach the module.
 
 use crate::ZenohError;
 
@@ -34,6 +37,7 @@ pub(crate) struct Keys {
     pub(crate) connect: String,
     pub(crate) live: String,
     user: String,
+    deliver: String,
 }
 
 impl Keys {
@@ -44,12 +48,19 @@ impl Keys {
             connect: format!("imrs/{cell}/connect/{port}"),
             live: format!("imrs/{cell}/live/{port}"),
             user: format!("imrs/{cell}/user/{port}"),
+            deliver: format!("imrs/{cell}/deliver/{port}"),
         })
     }
 
     /// The key under which the importing hosts' tokens for the port's users lie.
     pub(crate) fn user_prefix(&self) -> &str {
         &self.user
+    }
+
+    /// Where the owner's broadcasts and queries reach `module`'s host: a queryable of that
+    /// host's, for a port whose owner starts each rendezvous.
+    pub(crate) fn deliver(&self, module: &str) -> String {
+        format!("{}/{module}", self.deliver)
     }
 
     /// The token of `module`'s host while it uses the port.

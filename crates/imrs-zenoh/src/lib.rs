@@ -74,6 +74,8 @@ mod host;
 mod import;
 mod key;
 mod message;
+mod relay;
+mod take;
 
 pub use access::TlsFiles;
 pub use error::ZenohError;

@@ -1,0 +1,358 @@
+//! Ports whose owner starts each rendezvous (`SENDALL`, `CALLALL`, `QUERY`), across hosts.
+//!
+//! On the owner's host, each remote module that connects is attached as the port's user
+//! (its claim checked first, as for any port), and a relay takes what the owner broadcasts
+//! or asks through that module's end, and asks the module's host with a zenoh `get` on the
+//! module's `deliver` key; the answer comes back as the module's reply. On the user's
+//! host, the imported port's owner is a bridge, attached under the owner's presence: a
+//! queryable on the module's `deliver` key hands each broadcast or query to the local
+//! module (`send_all`, `call_all` or `query` on the local port) and answers with its reply.
+//! When the module's host is gone, its relay ends and its end is let go, as for a module
+//! that ended; when the owner's host is gone, the local module's waits end with
+//! `PeerGone`, and when it comes back the module connects again, with no new import.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use imrs_ports::transport::Presence;
+use imrs_ports::usage::Usage;
+use imrs_ports::{AnyUser, End, Port, PortSpec, WireError, usage};
+use tokio::task::JoinHandle;
+use zenoh::sample::SampleKind;
+
+use crate::connected::Connected;
+use crate::export::{Claim, Exported, first_exporter, module_of, reply};
+use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, Watch, ask, connect, gone};
+use crate::key::{Keys, checked};
+use crate::message::{Message, decode, encode};
+use crate::take::Take;
+use crate::{Host, Imported, ZenohError};
+
+/// A remote module's relay, and its presence.
+type Relay = (JoinHandle<()>, Arc<Presence>);
+
+/// The relays of an exported port, one per remote module.
+#[derive(Default)]
+struct Relays {
+    running: Mutex<HashMap<String, Relay>>,
+}
+
+impl Relays {
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Relay>> {
+        self.running.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// `module`'s host is gone: its relay ends, its end is let go, its presence is gone.
+    fn gone(&self, module: &str) {
+        if let Some((relay, presence)) = self.lock().remove(module) {
+            relay.abort();
+            presence.set_gone();
+        }
+    }
+}
+
+impl Drop for Relays {
+    fn drop(&mut self) {
+        self.lock().values().for_each(|(relay, _)| relay.abort());
+    }
+}
+
+/// Exports `port_name` (owned by `owner`), relaying to each remote module through its end,
+/// claimed with `claim` and attached with `attach`.
+pub(crate) async fn export_relayed<Req, Rep, T>(
+    host: &Host,
+    port_name: &str,
+    owner: String,
+    claim: Box<Claim>,
+    attach: impl Fn(&str) -> Result<T, WireError> + Send + Sync + 'static,
+) -> Result<Exported, ZenohError>
+where
+    Req: Message,
+    Rep: Message,
+    T: Take<Req, Rep>,
+{
+    let keys = Keys::new(&host.cell, port_name)?;
+    let session = &host.session;
+    first_exporter(host, &keys, port_name).await?;
+    let connects = session
+        .declare_queryable(&keys.connect)
+        .await
+        .map_err(ZenohError::session)?;
+    let leaving = session
+        .liveliness()
+        .declare_subscriber(format!("{}/*", keys.user_prefix()))
+        .await
+        .map_err(ZenohError::session)?;
+    let token = session
+        .liveliness()
+        .declare_token(&keys.live)
+        .await
+        .map_err(ZenohError::session)?;
+    let relays = Arc::new(Relays::default());
+    let connecting = {
+        let (relays, session, port) = (Arc::clone(&relays), session.clone(), port_name.to_owned());
+        tokio::spawn(async move {
+            while let Ok(query) = connects.recv_async().await {
+                let answer = module_of(&query).and_then(|module| {
+                    if let std::collections::hash_map::Entry::Vacant(vacant) =
+                        relays.lock().entry(module)
+                    {
+                        let module = vacant.key();
+                        claim(module)?;
+                        let presence = Presence::new(module.as_str());
+                        let end = {
+                            let _held = Presence::enter(Some(Arc::clone(&presence)));
+                            attach(module).map_err(|e| e.to_string())?
+                        };
+                        let asking = Asking {
+                            session: session.clone(),
+                            key: keys.deliver(module),
+                            module: owner.clone(),
+                            port: port.clone(),
+                            wait: NO_TIMEOUT,
+                        };
+                        let relay = tokio::spawn(relay::<Req, Rep, T>(end, asking));
+                        vacant.insert((relay, presence));
+                    }
+                    let connected = Connected {
+                        owner: owner.clone(),
+                        timeout_ms: 0,
+                    };
+                    encode(&port, &connected).map_err(|e| e.to_string())
+                });
+                reply(&query, answer).await;
+            }
+        })
+    };
+    let watching = {
+        let relays = Arc::clone(&relays);
+        tokio::spawn(async move {
+            while let Ok(sample) = leaving.recv_async().await {
+                if sample.kind() == SampleKind::Delete
+                    && let Some(module) = sample.key_expr().as_str().rsplit('/').next()
+                {
+                    relays.gone(module);
+                }
+            }
+        })
+    };
+    Ok(Exported::new(
+        port_name,
+        vec![connecting, watching],
+        Box::new(relays),
+        token,
+    ))
+}
+
+/// Takes each broadcast or query the owner makes through a remote module's `end`, and asks
+/// the module's host; its answer is the module's reply.
+async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(mut end: T, asking: Asking) {
+    while let Ok((request, reply)) = end.next().await {
+        ask::<Req, Rep>(&asking, request, reply).await;
+    }
+}
+
+/// The local port's owner end on a user's host: hands a broadcast or query from the
+/// owner's host to the one local module, and gives back its reply.
+pub(crate) trait Deliver<Req, Rep>: Send + 'static {
+    fn deliver(&mut self, request: Req) -> impl Future<Output = Option<Rep>> + Send + '_;
+}
+
+impl<Req: Clone + Send + 'static, Rep: Default + Send + 'static> Deliver<Req, Rep>
+    for End<Req, Rep, usage::SendAll>
+{
+    async fn deliver(&mut self, request: Req) -> Option<Rep> {
+        self.peer_attached().await;
+        let mut broadcast = self.send_all(request).await.ok()?;
+        // Taken, not moved: the broadcast lets go of its request when dropped.
+        Some(std::mem::take(&mut broadcast.first))
+    }
+}
+
+impl<Req: Clone + Send + 'static, Rep: Default + Send + 'static> Deliver<Req, Rep>
+    for End<Req, Rep, usage::CallAll>
+{
+    async fn deliver(&mut self, request: Req) -> Option<Rep> {
+        self.peer_attached().await;
+        let mut broadcast = self.call_all(request).await.ok()?;
+        Some(std::mem::take(&mut broadcast.first))
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static> Deliver<Req, Rep> for End<Req, Rep, usage::Query> {
+    async fn deliver(&mut self, request: Req) -> Option<Rep> {
+        self.peer_attached().await;
+        self.query(request).await.ok()
+    }
+}
+
+/// The local owner end, while the owner's host is there.
+type Slot<Req, Rep, U> = Arc<tokio::sync::Mutex<Option<End<Req, Rep, U>>>>;
+
+/// Imports `port` (owned by `owner`) for `module`: the owner's broadcasts or queries reach
+/// `module` on the local port.
+pub(crate) async fn import_relayed<Req, Rep, U>(
+    host: &Host,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, U>, ZenohError>
+where
+    Req: Message,
+    Rep: Message,
+    U: Usage + imrs_ports::usage::Plain,
+    End<Req, Rep, U>: Deliver<Req, Rep>,
+{
+    let keys = Keys::new(&host.cell, port)?;
+    checked("module", owner)?;
+    checked("module", module)?;
+    let session = &host.session;
+    let watch = session
+        .liveliness()
+        .declare_subscriber(&keys.live)
+        .history(true)
+        .await
+        .map_err(ZenohError::session)?;
+    seen(&watch, port).await?;
+    let local =
+        Port::<Req, Rep, U, AnyUser, 1>::new(PortSpec::new(port, owner).user_list([module]));
+    let slot: Slot<Req, Rep, U> = Arc::default();
+    let mut presence = attach_owner(&local, owner, &slot).await?;
+    let runtime = tokio::runtime::Handle::current();
+    let delivering = {
+        let (slot, owner, port) = (Arc::clone(&slot), owner.to_owned(), port.to_owned());
+        session
+            .declare_queryable(keys.deliver(module))
+            .callback(move |query| {
+                let (slot, owner, port) = (Arc::clone(&slot), owner.clone(), port.clone());
+                runtime.spawn(async move {
+                    let answer = deliver::<Req, Rep, U>(&query, &slot, &owner, &port).await;
+                    reply(&query, answer).await;
+                });
+            })
+            .await
+            .map_err(ZenohError::session)?
+    };
+    let token = session
+        .liveliness()
+        .declare_token(keys.user(module))
+        .await
+        .map_err(ZenohError::session)?;
+    check_owner(connect(host, &keys, port, module).await?, port, owner)?;
+    let bridge = {
+        let (host, local, owner, port, module) = (
+            host.clone(),
+            local.clone(),
+            owner.to_owned(),
+            port.to_owned(),
+            module.to_owned(),
+        );
+        tokio::spawn(async move {
+            loop {
+                if !gone(&watch).await {
+                    return;
+                }
+                presence.set_gone();
+                drop(slot.lock().await.take());
+                // Gone: wait for the owner's host to come back, then connect again, so
+                // that it attaches the module again.
+                if seen(&watch, &port).await.is_err() {
+                    return;
+                }
+                let Ok(back) = attach_owner(&local, &owner, &slot).await else {
+                    return;
+                };
+                presence = back;
+                let _ = connect(&host, &keys, &port, &module).await;
+            }
+        })
+    };
+    Ok(Imported::relayed(
+        local,
+        bridge,
+        token,
+        Box::new(delivering),
+    ))
+}
+
+/// Waits (at most [`CONNECT_TIMEOUT`]) until the owner's token is seen.
+async fn seen(watch: &Watch, port: &str) -> Result<(), ZenohError> {
+    let no_owner = || ZenohError::NoOwner {
+        port: port.to_owned(),
+    };
+    loop {
+        let sample = tokio::time::timeout(CONNECT_TIMEOUT, watch.recv_async())
+            .await
+            .map_err(|_| no_owner())?
+            .map_err(|_| no_owner())?;
+        if sample.kind() == SampleKind::Put {
+            return Ok(());
+        }
+    }
+}
+
+/// Attaches the local port's owner end under a presence of `owner`, into `slot`.
+async fn attach_owner<Req, Rep, U>(
+    local: &Port<Req, Rep, U, AnyUser, 1>,
+    owner: &str,
+    slot: &Slot<Req, Rep, U>,
+) -> Result<Arc<Presence>, ZenohError>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: Usage + imrs_ports::usage::Plain,
+{
+    let presence = Presence::new(owner);
+    let end = {
+        let _held = Presence::enter(Some(Arc::clone(&presence)));
+        local.owner()
+    };
+    let end = end.map_err(|error| ZenohError::Refused {
+        port: local.name().to_string(),
+        reason: error.to_string(),
+    })?;
+    *slot.lock().await = Some(end);
+    Ok(presence)
+}
+
+/// Refuses a connection whose port another module than `owner` owns.
+fn check_owner(connected: Connected, port: &str, owner: &str) -> Result<(), ZenohError> {
+    if connected.owner == owner {
+        Ok(())
+    } else {
+        Err(ZenohError::Refused {
+            port: port.to_owned(),
+            reason: format!("{owner} does not own it; {} does", connected.owner),
+        })
+    }
+}
+
+/// One broadcast or query from the owner's host, handed to the local module: its reply in
+/// CDR, or why there is none.
+async fn deliver<Req, Rep, U>(
+    query: &zenoh::query::Query,
+    slot: &Slot<Req, Rep, U>,
+    owner: &str,
+    port: &str,
+) -> Result<Vec<u8>, String>
+where
+    Req: Message,
+    Rep: Message,
+    U: Usage,
+    End<Req, Rep, U>: Deliver<Req, Rep>,
+{
+    if module_of(query)? != owner {
+        return Err(format!("only {owner} broadcasts on port {port}"));
+    }
+    let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
+    let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
+    let mut slot = slot.lock().await;
+    let end = slot
+        .as_mut()
+        .ok_or_else(|| format!("port {port}: its owner is gone"))?;
+    let answer = end
+        .deliver(request)
+        .await
+        .ok_or_else(|| format!("port {port}: the module did not answer"))?;
+    encode(port, &answer).map_err(|e| e.to_string())
+}
