@@ -28,8 +28,8 @@ use crate::message::{Message, decode, encode};
 use crate::take::Take;
 use crate::{Host, Imported, ZenohError};
 
-/// A remote module's relay, and its presence.
-type Relay = (JoinHandle<()>, Arc<Presence>);
+/// A remote module's relay, and what tells it to stop.
+type Relay = (JoinHandle<()>, Arc<tokio::sync::Notify>);
 
 /// The relays of an exported port, one per remote module.
 #[derive(Default)]
@@ -42,11 +42,11 @@ impl Relays {
         self.running.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// `module`'s host is gone: its relay ends, its end is let go, its presence is gone.
+    /// `module`'s host is gone: its relay ends once what it asked there has ended (the
+    /// answer may have come before the host went), then lets its end go.
     fn gone(&self, module: &str) {
-        if let Some((relay, presence)) = self.lock().remove(module) {
-            relay.abort();
-            presence.set_gone();
+        if let Some((_, stop)) = self.lock().remove(module) {
+            stop.notify_one();
         }
     }
 }
@@ -89,6 +89,7 @@ where
         .await
         .map_err(ZenohError::session)?;
     let relays = Arc::new(Relays::default());
+    let lease = host.lease;
     let connecting = {
         let (relays, session, port) = (Arc::clone(&relays), session.clone(), port_name.to_owned());
         tokio::spawn(async move {
@@ -111,8 +112,10 @@ where
                             port: port.clone(),
                             wait: NO_TIMEOUT,
                         };
-                        let relay = tokio::spawn(relay::<Req, Rep, T>(end, asking));
-                        vacant.insert((relay, presence));
+                        let stop = Arc::new(tokio::sync::Notify::new());
+                        let relay =
+                            relay::<Req, Rep, T>(end, asking, presence, Arc::clone(&stop), lease);
+                        vacant.insert((tokio::spawn(relay), stop));
                     }
                     let connected = Connected {
                         owner: owner.clone(),
@@ -145,11 +148,36 @@ where
 }
 
 /// Takes each broadcast or query the owner makes through a remote module's `end`, and asks
-/// the module's host; its answer is the module's reply.
-async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(mut end: T, asking: Asking) {
-    while let Ok((request, reply)) = end.next().await {
-        ask::<Req, Rep>(&asking, request, reply).await;
+/// the module's host; its answer is the module's reply. Told to `stop` (the module's host
+/// is gone), it lets the end go and marks the module's presence gone, so that the owner's
+/// waits on it end as for a module that ended.
+async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(
+    mut end: T,
+    asking: Asking,
+    presence: Arc<Presence>,
+    stop: Arc<tokio::sync::Notify>,
+    grace: std::time::Duration,
+) {
+    loop {
+        tokio::select! {
+            biased;
+            () = stop.notified() => break,
+            taken = end.next() => match taken {
+                // A host that is gone ends the query, with its answer if it gave one first;
+                // one cut off is given a lease to, then the reply is dropped (`NoReply`).
+                Ok((request, reply)) => tokio::select! {
+                    () = ask::<Req, Rep>(&asking, request, reply) => {}
+                    () = async {
+                        stop.notified().await;
+                        tokio::time::sleep(grace).await;
+                    } => break,
+                },
+                Err(_) => break,
+            },
+        }
     }
+    drop(end);
+    presence.set_gone();
 }
 
 /// The local port's owner end on a user's host: hands a broadcast or query from the

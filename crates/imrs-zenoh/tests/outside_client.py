@@ -3,12 +3,15 @@
 Usage: outside_client.py ENDPOINT CELL
 
 Asks the DOUBLE port (u64 -> u64, owned by DOUBLER) to double 21, queries the STATUS port
-(a RESPONSE port, string -> string), and asks DOUBLE as a module off its user list. Prints
-one line per answer; exits non-zero on anything unexpected.
+(a RESPONSE port, string -> string), and asks DOUBLE as a module off its user list. Then
+listens to the ALARM port (a SENDALL port of strings, answered with a u32, owned by LINE)
+as module PYTHON: connects, holds its token, reads one broadcast and answers it with its
+length. Prints one line per answer; exits non-zero on anything unexpected.
 """
 
 import struct
 import sys
+import threading
 import time
 
 import zenoh
@@ -68,6 +71,27 @@ def main():
     ok, refused = ask(session, f"imrs/{cell}/port/DOUBLE", cdr_u64(1), "ROGUE")
     assert not ok, refused
     print(f"ROGUE refused: {refused}")
+
+    # A listener of ALARM: its deliver queryable first, then its token, then its connection.
+    heard = []
+    done = threading.Event()
+
+    def on_broadcast(query):
+        alarm = read_string(query.payload.to_bytes())
+        heard.append((query.attachment.to_bytes().decode(), alarm))
+        query.reply(query.key_expr, HEADER + struct.pack("<I", len(alarm)))
+        done.set()
+
+    deliver = session.declare_queryable(f"imrs/{cell}/deliver/ALARM/PYTHON", on_broadcast)
+    token = session.liveliness().declare_token(f"imrs/{cell}/user/ALARM/PYTHON")
+    ok, connected = ask(session, f"imrs/{cell}/connect/ALARM", b"", "PYTHON")
+    assert ok, connected
+    if not done.wait(10.0):
+        sys.exit("no broadcast on ALARM")
+    owner, alarm = heard[0]
+    print(f"ALARM from {owner}: {alarm}")
+    token.undeclare()
+    deliver.undeclare()
     session.close()
 
 

@@ -1,6 +1,6 @@
 //! A client that is not ours — Python's `eclipse-zenoh`, speaking only the documented key
-//! expressions and CDR — sends to a port, queries a response handler, and is refused off
-//! the user list, by name.
+//! expressions and CDR — sends to a port, queries a response handler, is refused off the
+//! user list by name, and listens to a `SENDALL` port: it reads a broadcast and answers it.
 
 mod common;
 
@@ -33,7 +33,7 @@ fn python_with_zenoh() -> &'static str {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_python_client_sends_queries_and_is_refused_off_the_list() {
+async fn a_python_client_sends_queries_listens_and_is_refused_off_the_list() {
     let python = python_with_zenoh();
     let endpoint = free_endpoint();
     let host = listening("python_cell", &endpoint).await;
@@ -55,6 +55,18 @@ async fn a_python_client_sends_queries_and_is_refused_off_the_list() {
         })
         .unwrap();
     tokio::spawn(async move { while handler.serve(&true).await.is_ok() {} });
+    let alarm: Port<String, u32, usage::SendAll, AnyUser, 1> =
+        Port::new(PortSpec::new("ALARM", "LINE"));
+    let _alarm = export(&host, &alarm).await.unwrap();
+    let mut line = alarm.owner().unwrap();
+    let broadcasting = tokio::spawn(async move {
+        while alarm.users_attached() < 1 {
+            tokio::task::yield_now().await;
+        }
+        line.send_all("feeder 3 empty".to_owned())
+            .await
+            .map(|broadcast| broadcast.first)
+    });
 
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/outside_client.py");
     let client = tokio::process::Command::new(python)
@@ -72,6 +84,9 @@ async fn a_python_client_sends_queries_and_is_refused_off_the_list() {
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(lines[0], "DOUBLE 21 -> 42");
     assert_eq!(lines[1], "STATUS -> status: running");
+    assert_eq!(lines[3], "ALARM from LINE: feeder 3 empty");
+    let answer = within(PROMPTLY, "the broadcast's answer", broadcasting).await;
+    assert_eq!(answer.unwrap().unwrap(), 14);
     assert!(
         lines[2].starts_with("ROGUE refused:")
             && lines[2].contains("ROGUE")
