@@ -30,16 +30,21 @@
 //! # Ok(()) }
 //! ```
 //!
-//! Two usages cross: ports whose owner receives (each send reaches its `receive`, and the
-//! reply comes back), and `RESPONSE` ports (a query waits for the owner's response
-//! handler, which runs when the owner's order says). The restrictions hold across hosts:
+//! Every usage crosses: ports whose owner receives (each send reaches its `receive`, and
+//! the reply comes back); `RESPONSE` ports (a query waits for the owner's response
+//! handler, which runs when the owner's order says); and ports whose owner starts each
+//! rendezvous — `SENDALL` (a broadcast reaches modules on other hosts, and their replies
+//! come back), `CALLALL` (answered by their response handlers) and `QUERY` (the owner asks
+//! a module on another host). The restrictions hold across hosts:
 //! a module not on the port's user list, or beyond its number of users, is refused when it
 //! imports, with the port's own wiring error; the port's TIMEOUT for the module is learnt
 //! when it connects, and its local side waits as long.
 //!
 //! Hosts find each other through the endpoints they are given: one listens, the others
 //! connect (peer mode, no multicast scouting, no router needed). A zenoh router is an
-//! option: each host connects to it instead.
+//! option: each host connects to it instead. With [`TlsFiles`], hosts connect over mutual
+//! TLS, and [`HostBuilder::admit`] lets onto a port's keys only the hosts of its owner and
+//! of the modules on its user list, by their certificates' common names.
 //!
 //! A host that is killed, cut off past its lease ([`Host::DEFAULT_LEASE`], 2 s), or closed
 //! is seen gone through zenoh's liveliness tokens: waits on its ports end with `PeerGone`,
@@ -59,6 +64,7 @@
 //! | `imrs/<cell>/connect/<PORT>` | a module's connection: a query with the module's name as attachment; answered with the owner's name and the port's TIMEOUT in milliseconds (a CDR struct of a string and a `u64`, 0 for none), or an error reply naming the port and the restriction refused |
 //! | `imrs/<cell>/live/<PORT>` | a liveliness token, held by the owner's host while it exports the port |
 //! | `imrs/<cell>/user/<PORT>/<MODULE>` | a liveliness token, held by a user's host while it imports the port for the module |
+//! | `imrs/<cell>/deliver/<PORT>/<MODULE>` | for `SENDALL`, `CALLALL` and `QUERY` ports: the user's host's queryable, where the owner's broadcasts and queries reach the module (attachment: the owner's name), answered with the module's reply in CDR |
 //!
 //! Messages are [`Message`]s, any `serde` type, in little-endian CDR after the four-byte
 //! encapsulation header `00 01 00 00`, as ROS 2 encodes them: a `u64` is that header and
