@@ -97,7 +97,16 @@ struct Users<E> {
 struct Attached<E> {
     end: Arc<tokio::sync::Mutex<E>>,
     presence: Arc<Presence>,
+    /// Set when the module's host is gone: its requests still waiting are dropped, so that
+    /// the last hold on its end goes and its user place is free again.
+    gone: tokio::sync::watch::Sender<bool>,
 }
+
+/// A remote module's end, and the word that its host is gone.
+type Held<E> = (
+    Arc<tokio::sync::Mutex<E>>,
+    tokio::sync::watch::Receiver<bool>,
+);
 
 impl<E> Users<E> {
     /// `module`'s end, attached now with `attach` if it is not yet and `claim` lets it.
@@ -106,10 +115,10 @@ impl<E> Users<E> {
         module: &str,
         claim: &Claim,
         attach: impl FnOnce(&str) -> Result<E, WireError>,
-    ) -> Result<Arc<tokio::sync::Mutex<E>>, String> {
+    ) -> Result<Held<E>, String> {
         let mut ends = self.ends.lock().unwrap_or_else(PoisonError::into_inner);
         if let Some(attached) = ends.get(module) {
-            return Ok(Arc::clone(&attached.end));
+            return Ok((Arc::clone(&attached.end), attached.gone.subscribe()));
         }
         // Refused by its text alone, before its name is made (names are kept for the life
         // of the process): a peer that claims names without end grows nothing here.
@@ -122,12 +131,34 @@ impl<E> Users<E> {
             attach(module).map_err(|error| error.to_string())?
         };
         let end = Arc::new(tokio::sync::Mutex::new(end));
+        let (gone, told) = tokio::sync::watch::channel(false);
         let attached = Attached {
             end: Arc::clone(&end),
             presence,
+            gone,
         };
         ends.insert(module.to_owned(), attached);
-        Ok(end)
+        Ok((end, told))
+    }
+
+    /// `module` connects (again): its host has just imported the port, or has seen this host
+    /// come back, and what it asked before has ended on its side (`NoReply`). Its requests
+    /// still waiting here are dropped with its end, which is let go before it is attached
+    /// afresh, so that they hold neither its user place nor its turn.
+    async fn renew(&self, module: &str) {
+        let old = self
+            .ends
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .remove(module);
+        let Some(old) = old else { return };
+        old.gone.send_replace(true);
+        let mut end = old.end;
+        // Each request told drops its hold on the end at its next poll.
+        while let Err(held) = Arc::try_unwrap(end) {
+            end = held;
+            tokio::task::yield_now().await;
+        }
     }
 
     /// `module`'s host is gone: its end is let go, and whoever waits on it is told.
@@ -138,6 +169,7 @@ impl<E> Users<E> {
             .unwrap_or_else(PoisonError::into_inner)
             .remove(module);
         if let Some(attached) = attached {
+            attached.gone.send_replace(true);
             attached.presence.set_gone();
         }
     }
@@ -240,8 +272,11 @@ where
         tokio::spawn(async move {
             let owner = owner;
             while let Ok(query) = connects.recv_async().await {
+                if let Ok(module) = module_of(&query) {
+                    users.renew(&module).await;
+                }
                 let answer = module_of(&query).and_then(|module| {
-                    let end = users.end(&module, &*claim, |m| attach(m))?;
+                    let (end, _) = users.end(&module, &*claim, |m| attach(m))?;
                     let timeout = end.try_lock().ok().and_then(|end| end.timeout());
                     let connected = Connected {
                         owner: owner.clone(),
@@ -254,11 +289,13 @@ where
         })
     };
     let watching = {
-        let users = Arc::clone(&users);
+        let (users, session) = (Arc::clone(&users), session.clone());
         tokio::spawn(async move {
             while let Ok(sample) = leaving.recv_async().await {
+                let key = sample.key_expr().as_str();
                 if sample.kind() == SampleKind::Delete
-                    && let Some(module) = sample.key_expr().as_str().rsplit('/').next()
+                    && !crate::watch::alive(&session, key).await
+                    && let Some(module) = key.rsplit('/').next()
                 {
                     users.gone(module);
                 }
@@ -304,11 +341,19 @@ where
     E: Forward<Req, Rep>,
 {
     let module = module_of(query)?;
-    let end = users.end(&module, claim, attach)?;
+    let (end, mut gone) = users.end(&module, claim, attach)?;
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
     let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
     // One request of a module at a time, as in one process: its next waits here.
-    let reply = end.lock().await.forward(request).await?;
+    let forwarding = async { end.lock().await.forward(request).await };
+    let reply = tokio::select! {
+        reply = forwarding => reply?,
+        // Its host is gone: nobody is there to read the reply, and the request's hold on
+        // the module's end must go with it.
+        _ = gone.wait_for(|gone| *gone) => {
+            return Err(format!("port {port}: module {module}'s host is gone"));
+        }
+    };
     encode(port, &reply).map_err(|e| e.to_string())
 }
 

@@ -16,12 +16,12 @@ use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
 use imrs_ports::{AnyUser, End, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage};
 use tokio::task::JoinHandle;
-use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
 use crate::key::{Keys, checked};
 use crate::message::{Message, decode, encode};
 use crate::take::Take;
+use crate::watch::Watch;
 use crate::{Host, ZenohError};
 
 /// How long the owner's host may take to be seen, and to answer a connection.
@@ -143,25 +143,11 @@ where
     checked("module", module)?;
     let session = &host.session;
     // The owner's token first: once it is seen, so is the owner's host's connect queryable.
-    let watch = session
-        .liveliness()
-        .declare_subscriber(&keys.live)
-        .history(true)
-        .await
-        .map_err(ZenohError::session)?;
-    let no_owner = || ZenohError::NoOwner {
-        port: port.to_owned(),
-    };
-    loop {
-        let seen = tokio::time::timeout(CONNECT_TIMEOUT, watch.recv_async()).await;
-        match seen
-            .map_err(|_| no_owner())?
-            .map_err(|_| no_owner())?
-            .kind()
-        {
-            SampleKind::Put => break,
-            SampleKind::Delete => {}
-        }
+    let watch = Watch::new(session, &keys.live).await?;
+    if !watch.seen_within(CONNECT_TIMEOUT).await {
+        return Err(ZenohError::NoOwner {
+            port: port.to_owned(),
+        });
     }
     let connected = connect(host, &keys, port, module).await?;
     if connected.owner != owner {
@@ -190,9 +176,16 @@ where
     };
     let owner: Arc<str> = owner.into();
     let bridged = local.clone();
+    let (host, port, module) = (host.clone(), port.to_owned(), module.to_owned());
     let bridge = tokio::spawn(async move {
         let mut live = true;
+        let mut back = false;
         loop {
+            // The owner's host is back: connect again, so that it drops what it still held
+            // of this module's requests asked before (they ended here with `NoReply`).
+            if live && back && connect(&host, &keys, &port, &module).await.is_err() {
+                live = false;
+            }
             if live {
                 let presence = Presence::new(&*owner);
                 let end = {
@@ -206,10 +199,10 @@ where
                 presence.set_gone();
             }
             // Gone: wait for the owner's host to come back.
-            match watch.recv_async().await {
-                Ok(sample) => live = sample.kind() == SampleKind::Put,
-                Err(_) => return,
+            if !watch.back().await {
+                return;
             }
+            (live, back) = (true, true);
         }
     });
     Ok(Imported {
@@ -243,28 +236,12 @@ async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
             taken = end.next() => match taken {
                 Ok((request, reply)) => tokio::select! {
                     () = ask::<Req, Rep>(asking, request, reply) => {}
-                    live = gone(watch) => return live,
+                    live = watch.gone() => return live,
                 },
                 // Nobody can use the local port any more.
                 Err(_) => return false,
             },
-            live = gone(watch) => return live,
-        }
-    }
-}
-
-/// The owner's liveliness, as this host hears of it.
-pub(crate) type Watch =
-    zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
-
-/// Completes when the owner's token is gone (true), or when nothing more can be heard of
-/// it (false: the session is closed).
-pub(crate) async fn gone(watch: &Watch) -> bool {
-    loop {
-        match watch.recv_async().await {
-            Ok(sample) if sample.kind() == SampleKind::Delete => return true,
-            Ok(_) => {}
-            Err(_) => return false,
+            live = watch.gone() => return live,
         }
     }
 }

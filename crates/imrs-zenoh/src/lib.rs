@@ -82,6 +82,7 @@ mod key;
 mod message;
 mod relay;
 mod take;
+mod watch;
 
 pub use access::TlsFiles;
 pub use error::ZenohError;

@@ -22,10 +22,11 @@ use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
 use crate::export::{Claim, Exported, first_exporter, module_of, reply};
-use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, Watch, ask, connect, gone};
+use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, ask, connect};
 use crate::key::{Keys, checked};
 use crate::message::{Message, decode, encode};
 use crate::take::Take;
+use crate::watch::{Watch, alive};
 use crate::{Host, Imported, ZenohError};
 
 /// A remote module's relay, and what tells it to stop.
@@ -128,11 +129,13 @@ where
         })
     };
     let watching = {
-        let relays = Arc::clone(&relays);
+        let (relays, session) = (Arc::clone(&relays), session.clone());
         tokio::spawn(async move {
             while let Ok(sample) = leaving.recv_async().await {
+                let key = sample.key_expr().as_str();
                 if sample.kind() == SampleKind::Delete
-                    && let Some(module) = sample.key_expr().as_str().rsplit('/').next()
+                    && !alive(&session, key).await
+                    && let Some(module) = key.rsplit('/').next()
                 {
                     relays.gone(module);
                 }
@@ -235,13 +238,12 @@ where
     checked("module", owner)?;
     checked("module", module)?;
     let session = &host.session;
-    let watch = session
-        .liveliness()
-        .declare_subscriber(&keys.live)
-        .history(true)
-        .await
-        .map_err(ZenohError::session)?;
-    seen(&watch, port).await?;
+    let watch = Watch::new(session, &keys.live).await?;
+    if !watch.seen_within(CONNECT_TIMEOUT).await {
+        return Err(ZenohError::NoOwner {
+            port: port.to_owned(),
+        });
+    }
     let local =
         Port::<Req, Rep, U, AnyUser, 1>::new(PortSpec::new(port, owner).user_list([module]));
     let slot: Slot<Req, Rep, U> = Arc::default();
@@ -277,14 +279,14 @@ where
         );
         tokio::spawn(async move {
             loop {
-                if !gone(&watch).await {
+                if !watch.gone().await {
                     return;
                 }
                 presence.set_gone();
                 drop(slot.lock().await.take());
                 // Gone: wait for the owner's host to come back, then connect again, so
                 // that it attaches the module again.
-                if seen(&watch, &port).await.is_err() {
+                if !watch.back().await {
                     return;
                 }
                 let Ok(back) = attach_owner(&local, &owner, &slot).await else {
@@ -301,22 +303,6 @@ where
         token,
         Box::new(delivering),
     ))
-}
-
-/// Waits (at most [`CONNECT_TIMEOUT`]) until the owner's token is seen.
-async fn seen(watch: &Watch, port: &str) -> Result<(), ZenohError> {
-    let no_owner = || ZenohError::NoOwner {
-        port: port.to_owned(),
-    };
-    loop {
-        let sample = tokio::time::timeout(CONNECT_TIMEOUT, watch.recv_async())
-            .await
-            .map_err(|_| no_owner())?
-            .map_err(|_| no_owner())?;
-        if sample.kind() == SampleKind::Put {
-            return Ok(());
-        }
-    }
 }
 
 /// Attaches the local port's owner end under a presence of `owner`, into `slot`.

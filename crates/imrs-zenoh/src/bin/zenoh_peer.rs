@@ -1,11 +1,13 @@
 //! A host of its own for the tests across hosts: `zenoh_peer CELL ENDPOINT` listens on
 //! ENDPOINT and exports DOUBLE (owned by DOUBLER, a port of `u64`s), answering each `n`
 //! with `2n` — except 0, whose reply it holds for ever, so that a test can cut the host
-//! off mid-rendezvous. It prints `ready` once the port is exported, and runs until killed.
+//! off mid-rendezvous. When its user's host is gone, it drops the replies it held and serves
+//! the next user that comes. It
+//! prints `ready` once the port is exported, and runs until killed.
 
 use std::process::ExitCode;
 
-use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, usage};
 use imrs_zenoh::{Host, export};
 
 fn main() -> ExitCode {
@@ -43,11 +45,18 @@ async fn serve(cell: &str, endpoint: &str) -> Result<(), Box<dyn std::error::Err
     println!("ready");
     let mut held = Vec::new();
     loop {
-        let (n, reply) = doubler.receive().await?;
-        if n == 0 {
-            held.push(reply);
-        } else {
-            reply.reply(2 * n);
+        match doubler.receive().await {
+            Ok((0, reply)) => held.push(reply),
+            Ok((n, reply)) => {
+                let _ = reply.reply(2 * n);
+            }
+            // Its user's host is gone: it lets go of what it held (a user place is free
+            // only once its last request is answered) and serves the next user that comes.
+            Err(ReceiveError::PeerGone { .. }) => {
+                held.clear();
+                doubler.peer_attached().await;
+            }
+            Err(error) => return Err(error.into()),
         }
     }
 }

@@ -2,6 +2,8 @@
 
 #![allow(dead_code)]
 
+pub(crate) mod relay;
+
 use std::net::TcpListener;
 use std::time::Duration;
 

@@ -1,0 +1,82 @@
+//! A liveliness token watched: zenoh's events of it, checked against what is alive now.
+//!
+//! A host whose link came back declares its tokens anew, and the end of the old ones may be
+//! heard after the new ones: an event that says a token is gone is believed only once a
+//! liveliness query finds no token there.
+
+use std::time::Duration;
+
+use zenoh::sample::SampleKind;
+
+use crate::ZenohError;
+
+/// How long a liveliness query may take: it is answered from what this host knows.
+const LOOK: Duration = Duration::from_secs(1);
+
+/// Whether a token lives on `key` now, as far as this host knows.
+pub(crate) async fn alive(session: &zenoh::Session, key: &str) -> bool {
+    match session.liveliness().get(key).timeout(LOOK).await {
+        Ok(replies) => replies.recv_async().await.is_ok(),
+        Err(_) => false,
+    }
+}
+
+/// The token on one key, watched.
+pub(crate) struct Watch {
+    subscriber:
+        zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    session: zenoh::Session,
+    key: String,
+}
+
+impl Watch {
+    /// Watches `key`, hearing first of a token already there.
+    pub(crate) async fn new(session: &zenoh::Session, key: &str) -> Result<Self, ZenohError> {
+        let subscriber = session
+            .liveliness()
+            .declare_subscriber(key)
+            .history(true)
+            .await
+            .map_err(ZenohError::session)?;
+        Ok(Self {
+            subscriber,
+            session: session.clone(),
+            key: key.to_owned(),
+        })
+    }
+
+    /// Completes when the token is gone (true), or when nothing more can be heard of it
+    /// (false: the session is closed).
+    pub(crate) async fn gone(&self) -> bool {
+        loop {
+            match self.subscriber.recv_async().await {
+                Ok(sample) if sample.kind() == SampleKind::Delete => {
+                    if !alive(&self.session, &self.key).await {
+                        return true;
+                    }
+                }
+                Ok(_) => {}
+                Err(_) => return false,
+            }
+        }
+    }
+
+    /// Completes when the token is there (true), or when nothing more can be heard of it
+    /// (false).
+    pub(crate) async fn back(&self) -> bool {
+        loop {
+            match self.subscriber.recv_async().await {
+                Ok(sample) if sample.kind() == SampleKind::Put => return true,
+                Ok(_) => {}
+                Err(_) => return false,
+            }
+        }
+    }
+
+    /// Waits at most `bound` until the token is there; says whether it is.
+    pub(crate) async fn seen_within(&self, bound: Duration) -> bool {
+        tokio::time::timeout(bound, self.back())
+            .await
+            .unwrap_or(false)
+    }
+}
