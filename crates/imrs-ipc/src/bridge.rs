@@ -123,6 +123,20 @@ pub(crate) fn transport(port: &Name, what: &str, error: impl std::fmt::Debug) ->
 }
 
 /// A node of this process for port `port`'s services.
+/// Whether some process serves the service of `port`, a name given as text (from a peer):
+/// checked before the name is made, so that a claim whose relay cannot be connected leaves
+/// no name behind.
+pub(crate) fn is_served(remote: &Remote, port: &str) -> bool {
+    remote.service(port, "messages").is_ok_and(|name| {
+        <Svc as iceoryx2::service::Service>::does_exist(
+            &name,
+            iceoryx2::config::Config::global_config(),
+            MessagingPattern::RequestResponse,
+        )
+        .unwrap_or(false)
+    })
+}
+
 pub(crate) fn node(port: &Name) -> Result<Node<Svc>, IpcError> {
     // Defaults need no configuration file; iceoryx2 says so at every start unless told to
     // keep its warnings for what matters (`IOX2_LOG_LEVEL` still overrides).

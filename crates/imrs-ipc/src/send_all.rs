@@ -13,6 +13,7 @@ use imrs_ports::usage::{Plain, Usage};
 
 use std::sync::{Arc, Mutex};
 
+use crate::bridge::is_served;
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
 use crate::export::{Forward, Refusal, bridge, claim};
@@ -257,6 +258,11 @@ where
     let (exported, _) =
         bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, false, move |module: &str| {
             claim(&port, module)?;
+            // The relay back is the module's process's service: one that is not there is
+            // refused before any name of the claim is made.
+            if !is_served(&cell, &format!("{served}/to/{module}")) {
+                return Err(Refusal::Failed);
+            }
             // The module's own end of the real port: what it receives goes to its process.
             let end = user_end(&port, module)?;
             let _entered = runtime.enter();

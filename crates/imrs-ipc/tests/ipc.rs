@@ -1856,20 +1856,26 @@ async fn a_refused_claim_leaves_no_name_in_the_owners_process() {
             });
         }
     });
-    let claim = |module: &str| {
-        let mut claimer = user(&cell, module, "1");
+    // Each claim must be refused for the reason given, which the claimer prints.
+    let refused = |args: &[&str], why: &str| {
+        let mut claimer = peer(args);
         let status = claimer.0.wait().unwrap();
-        assert_eq!(status.code(), Some(2), "{module}'s claim was not refused");
+        let mut said = String::new();
+        std::io::Read::read_to_string(&mut claimer.0.stdout.take().unwrap(), &mut said).unwrap();
+        assert_eq!(status.code(), Some(2), "{args:?}: {said}");
+        assert!(said.contains(why), "{args:?} was refused otherwise: {said}");
     };
     // Off the list.
     let off_list: Vec<String> = (0..20)
         .map(|i| format!("ROGUE_{}_{i}", std::process::id()))
         .collect();
-    off_list.iter().for_each(|module| claim(module));
-    // On the list, but past the number of users: ASKER holds the one place.
-    let asker: Imported<Number, Number, usage::Receive> =
-        imrs_ipc::import(&remote, "DOUBLE", "DOUBLER", "ASKER").unwrap();
-    let _asking = asker.port().user_named("ASKER").unwrap();
+    for module in &off_list {
+        refused(
+            &["user", &cell, "DOUBLE", module, "1"],
+            "not on the user list",
+        );
+    }
+    // Past the number of users of a port with no list: FIRST holds its one place.
     let open =
         Port::<Number, Number, usage::Receive, AnyUser, 1>::new(PortSpec::new("OPEN", "OPENER"));
     let _open = export(&remote, &open).unwrap();
@@ -1878,10 +1884,22 @@ async fn a_refused_claim_leaves_no_name_in_the_owners_process() {
         .map(|i| format!("LATE_{}_{i}", std::process::id()))
         .collect();
     for module in &past {
-        let mut claimer = peer(&["user", &cell, "OPEN", module, "1"]);
-        assert_eq!(claimer.0.wait().unwrap().code(), Some(2), "{module}");
+        refused(&["user", &cell, "OPEN", module, "1"], "active user");
     }
-    for module in off_list.iter().chain(&past) {
+    // Off the list of a SENDALL port, whose remote users are relayed to.
+    let alarm: Port<Number, Number, usage::SendAll, AnyUser, 1> =
+        Port::new(PortSpec::new("ALARM", "BROADCASTER").user_list(["HEARER"]));
+    let _alarm = export(&remote, &alarm).unwrap();
+    let listeners: Vec<String> = (0..5)
+        .map(|i| format!("EAVESDROPPER_{}_{i}", std::process::id()))
+        .collect();
+    for module in &listeners {
+        refused(
+            &["listener", &cell, "ALARM", module, "1"],
+            "not on the user list",
+        );
+    }
+    for module in off_list.iter().chain(&past).chain(&listeners) {
         assert_eq!(Name::known(module), None, "{module} was kept");
     }
 }

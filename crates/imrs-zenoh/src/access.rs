@@ -32,7 +32,7 @@ pub(crate) struct Admitted {
 
 /// The session settings for mutual TLS with `files`.
 pub(crate) fn tls_settings(files: &TlsFiles) -> Vec<(&'static str, String)> {
-    let path = |p: &PathBuf| format!("{:?}", p.display().to_string());
+    let path = |p: &PathBuf| serde_json::Value::from(p.display().to_string()).to_string();
     vec![
         (
             "transport/link/tls/root_ca_certificate",
@@ -59,8 +59,9 @@ pub(crate) fn tls_settings(files: &TlsFiles) -> Vec<(&'static str, String)> {
 
 /// zenoh's access control for `cell`, in JSON5: nothing is allowed but what `admitted`
 /// allows. On each port's keys, its owner's host may do anything; its users' hosts may ask
-/// it (queries), watch its owner's token and hold tokens of their own modules, and are sent
-/// its replies and its owner's token; any other host is let do nothing.
+/// it (queries), watch its owner's token, hold tokens of their own modules and serve their
+/// modules' `deliver` keys, and are sent its replies, its owner's token and its broadcasts;
+/// any other host is let do nothing.
 pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String, ZenohError> {
     let (mut rules, mut subjects, mut policies) = (Vec::new(), Vec::new(), Vec::new());
     for (i, port) in admitted.iter().enumerate() {
@@ -68,10 +69,11 @@ pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String
         let key = |kind: &str| format!("\"imrs/{cell}/{kind}/{}\"", port.port);
         let asked = [key("port"), key("connect"), key("live")].join(", ");
         let tokens = format!("\"imrs/{cell}/user/{}/**\"", port.port);
+        let deliver = format!("\"imrs/{cell}/deliver/{}/**\"", port.port);
         let names = |hosts: &[String]| {
             hosts
                 .iter()
-                .map(|h| format!("{h:?}"))
+                .map(|h| serde_json::Value::from(h.as_str()).to_string())
                 .collect::<Vec<_>>()
                 .join(", ")
         };
@@ -79,7 +81,7 @@ pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String
             "{{ id: \"owner{i}\", flows: [\"egress\", \"ingress\"], permission: \"allow\", \
              messages: [\"put\", \"delete\", \"declare_subscriber\", \"query\", \"reply\", \
              \"declare_queryable\", \"liveliness_token\", \"liveliness_query\", \
-             \"declare_liveliness_subscriber\"], key_exprs: [{asked}, {tokens}] }}"
+             \"declare_liveliness_subscriber\"], key_exprs: [{asked}, {tokens}, {deliver}] }}"
         ));
         rules.push(format!(
             "{{ id: \"ask{i}\", flows: [\"ingress\"], permission: \"allow\", \
@@ -95,6 +97,16 @@ pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String
              messages: [\"reply\", \"declare_queryable\", \"liveliness_token\", \"declare_liveliness_subscriber\"], \
              key_exprs: [{asked}, {tokens}] }}"
         ));
+        // For a port whose owner starts each rendezvous: each user's host serves its
+        // modules' `deliver` keys, which the owner's host asks.
+        rules.push(format!(
+            "{{ id: \"serve{i}\", flows: [\"ingress\"], permission: \"allow\", \
+             messages: [\"declare_queryable\", \"reply\"], key_exprs: [{deliver}] }}"
+        ));
+        rules.push(format!(
+            "{{ id: \"reach{i}\", flows: [\"egress\"], permission: \"allow\", \
+             messages: [\"query\", \"liveliness_query\"], key_exprs: [{deliver}, {tokens}] }}"
+        ));
         subjects.push(format!(
             "{{ id: \"owner{i}\", cert_common_names: [{}] }}",
             names(std::slice::from_ref(&port.owner))
@@ -108,7 +120,8 @@ pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String
                 names(&port.users)
             ));
             policies.push(format!(
-                "{{ rules: [\"ask{i}\", \"hold{i}\", \"told{i}\"], subjects: [\"users{i}\"] }}"
+                "{{ rules: [\"ask{i}\", \"hold{i}\", \"told{i}\", \"serve{i}\", \"reach{i}\"], \
+                 subjects: [\"users{i}\"] }}"
             ));
         }
     }

@@ -45,8 +45,8 @@ impl fmt::Display for ZenohError {
         match self {
             Self::BadName { what, name } => write!(
                 f,
-                "{what} name {name:?} cannot cross hosts: it must be non-empty and hold none \
-                 of / * $ ? # @ or whitespace"
+                "{what} name {name:?} cannot cross hosts: it must be non-empty, not start with \
+                 @, and hold none of / * $ ? # \" \\ or whitespace"
             ),
             Self::Session { reason } => write!(f, "zenoh session: {reason}"),
             Self::NoOwner { port } => {

@@ -121,7 +121,8 @@ impl<E> Users<E> {
             return Ok((Arc::clone(&attached.end), attached.gone.subscribe()));
         }
         // Refused by its text alone, before its name is made (names are kept for the life
-        // of the process): a peer that claims names without end grows nothing here.
+        // of the process): a refused claim grows nothing here. An accepted name is kept,
+        // so a port open to any user is open to that too.
         claim(module)?;
         let presence = Presence::new(module);
         // The end is held by the remote module's presence, so that its peers see it gone

@@ -128,12 +128,11 @@ impl HostBuilder {
             });
         }
         let mut config = zenoh::Config::default();
-        let json = |value: &Vec<String>| serde_json_list(value);
         let settings = [
             ("mode", "\"peer\"".to_owned()),
             ("scouting/multicast/enabled", "false".to_owned()),
-            ("listen/endpoints", json(&self.listen)),
-            ("connect/endpoints", json(&self.connect)),
+            ("listen/endpoints", json_list(&self.listen)),
+            ("connect/endpoints", json_list(&self.connect)),
             (
                 "transport/link/tx/lease",
                 self.lease.as_millis().max(1).to_string(),
@@ -169,8 +168,7 @@ impl HostBuilder {
     }
 }
 
-/// `["a", "b"]`, each endpoint quoted as a JSON string.
-fn serde_json_list(items: &[String]) -> String {
-    let quoted: Vec<String> = items.iter().map(|item| format!("{item:?}")).collect();
-    format!("[{}]", quoted.join(", "))
+/// `["a", "b"]`: the endpoints as a JSON list of strings.
+fn json_list(items: &[String]) -> String {
+    serde_json::Value::from(items.to_vec()).to_string()
 }

@@ -149,6 +149,13 @@ where
             port: port.to_owned(),
         });
     }
+    // The module's token before its connection: the owner's host lets go of the module's
+    // end when the token goes, which it must hold for that (a failed import drops it).
+    let token = session
+        .liveliness()
+        .declare_token(keys.user(module))
+        .await
+        .map_err(ZenohError::session)?;
     let connected = connect(host, &keys, port, module).await?;
     if connected.owner != owner {
         return Err(ZenohError::Refused {
@@ -162,11 +169,6 @@ where
         spec = spec.user_timeout(timeout);
     }
     let local = Port::<Req, Rep, U, AnyUser, 1>::new(spec);
-    let token = session
-        .liveliness()
-        .declare_token(keys.user(module))
-        .await
-        .map_err(ZenohError::session)?;
     let asking = Asking {
         session: session.clone(),
         key: keys.request.clone(),
@@ -178,15 +180,14 @@ where
     let bridged = local.clone();
     let (host, port, module) = (host.clone(), port.to_owned(), module.to_owned());
     let bridge = tokio::spawn(async move {
-        let mut live = true;
         let mut back = false;
         loop {
             // The owner's host is back: connect again, so that it drops what it still held
             // of this module's requests asked before (they ended here with `NoReply`).
-            if live && back && connect(&host, &keys, &port, &module).await.is_err() {
-                live = false;
+            if back && !reconnect(&host, &keys, &port, &module, &watch).await {
+                return;
             }
-            if live {
+            {
                 let presence = Presence::new(&*owner);
                 let end = {
                     let _held = Presence::enter(Some(Arc::clone(&presence)));
@@ -202,7 +203,7 @@ where
             if !watch.back().await {
                 return;
             }
-            (live, back) = (true, true);
+            back = true;
         }
     });
     Ok(Imported {
@@ -211,6 +212,29 @@ where
         _token: token,
         _held: None,
     })
+}
+
+/// Connects `module` again to a port whose owner's host is back, trying again, a little
+/// later each time, while it refuses (a user place not free yet) and the owner stays; false
+/// once nothing more can be heard of the owner.
+pub(crate) async fn reconnect(
+    host: &Host,
+    keys: &Keys,
+    port: &str,
+    module: &str,
+    watch: &Watch,
+) -> bool {
+    let mut pause = Duration::from_millis(50);
+    loop {
+        if connect(host, keys, port, module).await.is_ok() {
+            return true;
+        }
+        tokio::select! {
+            () = tokio::time::sleep(pause) => {}
+            live = watch.gone() => if !live { return false },
+        }
+        pause = (pause * 2).min(host.lease);
+    }
 }
 
 /// What the bridge needs to ask the owner's host.

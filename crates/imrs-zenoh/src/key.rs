@@ -17,9 +17,11 @@ use crate::ZenohError;
 pub(crate) fn checked<'a>(what: &'static str, name: &'a str) -> Result<&'a str, ZenohError> {
     let bad = name.is_empty()
         || name.starts_with('@')
-        || name
-            .chars()
-            .any(|c| matches!(c, '/' | '*' | '$' | '?' | '#') || c.is_whitespace());
+        || name.chars().any(|c| {
+            matches!(c, '/' | '*' | '$' | '?' | '#' | '"' | '\\')
+                || c.is_control()
+                || c.is_whitespace()
+        });
     if bad {
         Err(ZenohError::BadName {
             what,
@@ -75,7 +77,19 @@ mod tests {
 
     #[test]
     fn a_name_that_would_widen_a_key_expression_is_refused_by_name() {
-        for name in ["", "A/B", "*", "A**", "$x", "Q?", "#", "@live", "TWO WORDS"] {
+        for name in [
+            "",
+            "A/B",
+            "*",
+            "A**",
+            "$x",
+            "Q?",
+            "#",
+            "@live",
+            "TWO WORDS",
+            "A\"B",
+            "A\\B",
+        ] {
             let error = checked("module", name).unwrap_err();
             assert!(error.to_string().contains(&format!("{name:?}")), "{error}");
         }

@@ -50,8 +50,8 @@
 //! is seen gone through zenoh's liveliness tokens: waits on its ports end with `PeerGone`,
 //! and a request it had taken and not answered ends with `NoReply` (its reply is lost).
 //! When the host comes back and exports again, the same import is served again. A request
-//! is asked once, with one zenoh query: it is never served twice, and its reply reaches
-//! only its own sender.
+//! is asked once, with one zenoh query: while one host exports the port it is never
+//! served twice, and its reply reaches only its own sender.
 //!
 //! # On the wire
 //!
@@ -69,7 +69,7 @@
 //! Messages are [`Message`]s, any `serde` type, in little-endian CDR after the four-byte
 //! encapsulation header `00 01 00 00`, as ROS 2 encodes them: a `u64` is that header and
 //! its eight bytes. A message is refused, naming the port, if it does not decode, or would
-//! take more than [`MAX_MESSAGE`] bytes.
+//! be read past [`MAX_MESSAGE`] bytes.
 
 mod access;
 mod connected;

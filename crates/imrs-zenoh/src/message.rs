@@ -10,8 +10,8 @@ use serde::de::DeserializeOwned;
 
 use crate::ZenohError;
 
-/// The most bytes a peer's message may take when decoded: what a hostile peer can make
-/// this host allocate for one message.
+/// The most bytes of a peer's message that are read when it is decoded. What it decodes
+/// into may take more (a list of short strings takes a few times its encoding).
 pub const MAX_MESSAGE: u64 = 1 << 20;
 
 /// A message that can cross hosts: any `serde` type, encoded in CDR.

@@ -16,13 +16,13 @@ use std::sync::{Arc, Mutex, PoisonError};
 
 use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
-use imrs_ports::{AnyUser, End, Port, PortSpec, WireError, usage};
+use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, WireError, usage};
 use tokio::task::JoinHandle;
 use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
 use crate::export::{Claim, Exported, first_exporter, module_of, reply};
-use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, ask, connect};
+use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, ask, connect, reconnect};
 use crate::key::{Keys, checked};
 use crate::message::{Message, decode, encode};
 use crate::take::Take;
@@ -96,8 +96,16 @@ where
         tokio::spawn(async move {
             while let Ok(query) = connects.recv_async().await {
                 let answer = module_of(&query).and_then(|module| {
-                    if let std::collections::hash_map::Entry::Vacant(vacant) =
-                        relays.lock().entry(module)
+                    let mut running = relays.lock();
+                    // A relay that has ended (its module gone, or its end closed) is made
+                    // anew for a module that connects again.
+                    if running
+                        .get(&module)
+                        .is_some_and(|(relay, _)| relay.is_finished())
+                    {
+                        running.remove(&module);
+                    }
+                    if let std::collections::hash_map::Entry::Vacant(vacant) = running.entry(module)
                     {
                         let module = vacant.key();
                         claim(module)?;
@@ -175,6 +183,8 @@ async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(
                         tokio::time::sleep(grace).await;
                     } => break,
                 },
+                // A quiet spell past the port's TIMEOUT: the module is still there.
+                Err(ReceiveError::Timeout { .. }) => {}
                 Err(_) => break,
             },
         }
@@ -293,7 +303,9 @@ where
                     return;
                 };
                 presence = back;
-                let _ = connect(&host, &keys, &port, &module).await;
+                if !reconnect(&host, &keys, &port, &module, &watch).await {
+                    return;
+                }
             }
         })
     };

@@ -27,6 +27,9 @@ pub(crate) struct Watch {
         zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
     session: zenoh::Session,
     key: String,
+    /// A token's end taken from the subscriber and not yet confirmed: kept, so that a wait
+    /// dropped while it confirms loses no event.
+    unconfirmed: std::sync::atomic::AtomicBool,
 }
 
 impl Watch {
@@ -42,18 +45,25 @@ impl Watch {
             subscriber,
             session: session.clone(),
             key: key.to_owned(),
+            unconfirmed: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
     /// Completes when the token is gone (true), or when nothing more can be heard of it
     /// (false: the session is closed).
     pub(crate) async fn gone(&self) -> bool {
+        use std::sync::atomic::Ordering;
         loop {
+            if self.unconfirmed.load(Ordering::SeqCst) {
+                let gone = !alive(&self.session, &self.key).await;
+                self.unconfirmed.store(false, Ordering::SeqCst);
+                if gone {
+                    return true;
+                }
+            }
             match self.subscriber.recv_async().await {
                 Ok(sample) if sample.kind() == SampleKind::Delete => {
-                    if !alive(&self.session, &self.key).await {
-                        return true;
-                    }
+                    self.unconfirmed.store(true, Ordering::SeqCst);
                 }
                 Ok(_) => {}
                 Err(_) => return false,
@@ -64,6 +74,8 @@ impl Watch {
     /// Completes when the token is there (true), or when nothing more can be heard of it
     /// (false).
     pub(crate) async fn back(&self) -> bool {
+        self.unconfirmed
+            .store(false, std::sync::atomic::Ordering::SeqCst);
         loop {
             match self.subscriber.recv_async().await {
                 Ok(sample) if sample.kind() == SampleKind::Put => return true,

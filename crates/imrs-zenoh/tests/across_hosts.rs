@@ -180,7 +180,13 @@ async fn a_closed_owner_host_ends_waits_with_peer_gone_and_its_return_is_served(
         let lost = asker.send(7).await;
         (asker, lost)
     });
-    tokio::task::yield_now().await;
+    // Once the send has reached the owner's port (its owner never takes it), the host goes.
+    within(PROMPTLY, "the send at the owner", async {
+        while holder.waiting() == 0 {
+            tokio::task::yield_now().await;
+        }
+    })
+    .await;
     drop(exported);
     owner_host.close().await.unwrap();
     drop(holder);

@@ -105,10 +105,7 @@ async fn through_delays_and_stalls_each_request_is_served_once_and_timeouts_hold
             matches!(late, Err(SendError::ReplyTimeout { .. })),
             "{late:?}"
         );
-        assert!(
-            took >= Duration::from_millis(300) && took < Duration::from_millis(300) + PROMPTLY,
-            "{took:?}"
-        );
+        assert!(took >= Duration::from_millis(300), "{took:?}");
     }
 }
 

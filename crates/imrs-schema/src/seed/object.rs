@@ -98,8 +98,9 @@ type Trigger = Box<dyn FnMut(&Cx, u32) -> Result<(), SchemaError> + Send>;
 
 /// `Object?`: `FORALL SEF_i DO Objtest_i …` — one `Objtest` per SEF, all searching in
 /// parallel, their judgements fanned in on `result`; on a match it starts `Tj` for the
-/// matching SEF and stops. It numbers each `Objtest` after its SEF, so that it never runs
-/// two tests of one SEF at once.
+/// matching SEF and stops. It numbers each `Objtest` after its SEF, so that no two live
+/// tests are of one SEF (the judge of a test stopped mid-judge still finishes on its
+/// thread).
 pub struct ObjectQ<J = Desired> {
     desired: J,
     trigger: Trigger,
@@ -277,7 +278,8 @@ impl Schema for ObjectQOnce {
 ///
 /// The test runs on tokio's blocking pool, a thread of its own, so that the tests of every
 /// SEF run at once however long each takes, while the processor goes on with the other
-/// instances. On a paused runtime the clock stands still until it is done.
+/// instances. On a paused runtime the clock stands still until it is done; a test stopped
+/// meanwhile drops the handle, and the judge still runs to its end.
 async fn judge<J: Judge>(desired: &J, p: &ObjtestPorts, cx: &Cx) -> Result<bool, SchemaError> {
     let features = Features {
         position: p.f1.read().await?,

@@ -2,8 +2,8 @@
 //! ENDPOINT and exports DOUBLE (owned by DOUBLER, a port of `u64`s), answering each `n`
 //! with `2n` — except 0, whose reply it holds for ever, so that a test can cut the host
 //! off mid-rendezvous. When its user's host is gone, it drops the replies it held and serves
-//! the next user that comes. It
-//! prints `ready` once the port is exported, and runs until killed.
+//! the next user that comes. It prints `ready` once the port is exported, and runs until
+//! killed.
 
 use std::process::ExitCode;
 
