@@ -125,7 +125,16 @@ async fn only_admitted_hosts_reach_a_port_and_none_passes_for_its_owner() {
     drop(fake_export);
 
     // The gripper's host comes up: the robot is served by it, and by it alone.
-    let gripper_host = host(authority.host("gripper-host"), &endpoint, false).await;
+    // The gripper's host connects to the robot's, and listens for hosts of its own.
+    let gripper_endpoint = tls_endpoint();
+    let gripper_host = Host::builder("tls_cell")
+        .tls(authority.host("gripper-host"))
+        .admit("GRIP", "gripper-host", ["robot-host"])
+        .connect(&endpoint)
+        .listen(&gripper_endpoint)
+        .open()
+        .await
+        .unwrap();
     let grip: Port<f32, bool, usage::Receive, AnyUser, 2> =
         Port::new(PortSpec::new("GRIP", "GRIPPER").user_list(["ROBOT"]));
     let _exported = export(&gripper_host, &grip).await.unwrap();
@@ -145,10 +154,16 @@ async fn only_admitted_hosts_reach_a_port_and_none_passes_for_its_owner() {
         assert!(closed.unwrap(), "an answer that was not the gripper's");
     }
 
-    // Neither the intruder, claiming ROBOT's name, nor a host with no certificate at all,
-    // reaches the gripper's GRIP.
+    // Neither the intruder, claiming ROBOT's name from a link straight to the gripper's host,
+    // nor a host with no certificate at all, reaches the gripper's GRIP.
+    let intruder_host = Host::builder("tls_cell")
+        .tls(authority.host("intruder-host"))
+        .connect(&gripper_endpoint)
+        .open()
+        .await
+        .unwrap();
     let plain_host = Host::builder("tls_cell")
-        .connect(&endpoint)
+        .connect(&gripper_endpoint)
         .open()
         .await
         .unwrap();
