@@ -11,17 +11,18 @@
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
+use std::time::Duration;
 
 use imrs_ports::transport::Presence;
 use imrs_ports::{Port, UserList, WireError, usage};
 use tokio::task::JoinHandle;
 use zenoh::query::Query;
-use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
 use crate::forward::Forward;
-use crate::key::{Keys, checked};
+use crate::key::checked;
 use crate::message::{Message, decode, encode};
+use crate::opening::{Opening, live, watch_users};
 use crate::{Host, ZenohError};
 
 /// A port exported to other hosts: served while this is held, withdrawn when dropped.
@@ -96,15 +97,21 @@ struct Users<E> {
 
 struct Attached<E> {
     end: Arc<tokio::sync::Mutex<E>>,
+    /// The port's TIMEOUT for the module, as declared, which its host waits for.
+    timeout: Option<Duration>,
     presence: Arc<Presence>,
     /// Set when the module's host is gone: its requests still waiting are dropped, so that
     /// the last hold on its end goes and its user place is free again.
     gone: tokio::sync::watch::Sender<bool>,
 }
 
-/// A remote module's end, and the word that its host is gone.
+/// Attaches a remote module: its end, and the port's TIMEOUT for it as declared.
+type Attach<E> = dyn Fn(&str) -> Result<(E, Option<Duration>), WireError> + Send + Sync;
+
+/// A remote module's end, the port's TIMEOUT for it, and the word that its host is gone.
 type Held<E> = (
     Arc<tokio::sync::Mutex<E>>,
+    Option<Duration>,
     tokio::sync::watch::Receiver<bool>,
 );
 
@@ -114,11 +121,12 @@ impl<E> Users<E> {
         &self,
         module: &str,
         claim: &Claim,
-        attach: impl FnOnce(&str) -> Result<E, WireError>,
+        attach: impl FnOnce(&str) -> Result<(E, Option<Duration>), WireError>,
     ) -> Result<Held<E>, String> {
         let mut ends = self.ends.lock().unwrap_or_else(PoisonError::into_inner);
         if let Some(attached) = ends.get(module) {
-            return Ok((Arc::clone(&attached.end), attached.gone.subscribe()));
+            let end = Arc::clone(&attached.end);
+            return Ok((end, attached.timeout, attached.gone.subscribe()));
         }
         // Refused by its text alone, before its name is made (names are kept for the life
         // of the process): a refused claim grows nothing here. An accepted name is kept,
@@ -127,7 +135,7 @@ impl<E> Users<E> {
         let presence = Presence::new(module);
         // The end is held by the remote module's presence, so that its peers see it gone
         // when the module's host is.
-        let end = {
+        let (end, timeout) = {
             let _held = Presence::enter(Some(Arc::clone(&presence)));
             attach(module).map_err(|error| error.to_string())?
         };
@@ -135,11 +143,12 @@ impl<E> Users<E> {
         let (gone, told) = tokio::sync::watch::channel(false);
         let attached = Attached {
             end: Arc::clone(&end),
+            timeout,
             presence,
             gone,
         };
         ends.insert(module.to_owned(), attached);
-        Ok((end, told))
+        Ok((end, timeout, told))
     }
 
     /// `module` connects (again): its host has just imported the port, or has seen this host
@@ -220,22 +229,22 @@ where
     Rep: Message,
     E: Forward<Req, Rep>,
 {
-    let keys = Keys::new(&host.cell, port_name)?;
+    let Opening {
+        keys,
+        connects,
+        leaving,
+    } = Opening::new(host, port_name).await?;
     let session = &host.session;
-    first_exporter(host, &keys, port_name).await?;
-    let connects = session
-        .declare_queryable(&keys.connect)
-        .await
-        .map_err(ZenohError::session)?;
-    let leaving = session
-        .liveliness()
-        .declare_subscriber(format!("{}/*", keys.user_prefix()))
-        .await
-        .map_err(ZenohError::session)?;
     let users = Arc::new(Users::<E> {
         ends: Mutex::default(),
     });
-    let attach = Arc::new(attach);
+    let lease = host.lease;
+    let attach = Arc::new(move |module: &str| {
+        attach(module).map(|end| {
+            let declared = end.timeout();
+            (end.waiting_longer(lease), declared)
+        })
+    });
     let claim: Arc<Claim> = claim.into();
     let port: Arc<str> = port_name.into();
 
@@ -260,13 +269,7 @@ where
             .await
             .map_err(ZenohError::session)?
     };
-    // Declared last: a host that sees the token sees the queryables too, as zenoh carries
-    // one host's declarations to another in order.
-    let token = session
-        .liveliness()
-        .declare_token(&keys.live)
-        .await
-        .map_err(ZenohError::session)?;
+    let token = live(host, &keys).await?;
     let connecting = {
         let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
         let claim = Arc::clone(&claim);
@@ -277,8 +280,7 @@ where
                     users.renew(&module).await;
                 }
                 let answer = module_of(&query).and_then(|module| {
-                    let (end, _) = users.end(&module, &*claim, |m| attach(m))?;
-                    let timeout = end.try_lock().ok().and_then(|end| end.timeout());
+                    let (_, timeout, _) = users.end(&module, &*claim, |m| attach(m))?;
                     let connected = Connected {
                         owner: owner.clone(),
                         timeout_ms: timeout.map_or(0, |t| t.as_millis().max(1) as u64),
@@ -290,18 +292,8 @@ where
         })
     };
     let watching = {
-        let (users, session) = (Arc::clone(&users), session.clone());
-        tokio::spawn(async move {
-            while let Ok(sample) = leaving.recv_async().await {
-                let key = sample.key_expr().as_str();
-                if sample.kind() == SampleKind::Delete
-                    && !crate::watch::alive(&session, key).await
-                    && let Some(module) = key.rsplit('/').next()
-                {
-                    users.gone(module);
-                }
-            }
-        })
+        let users = Arc::clone(&users);
+        watch_users(host, leaving, move |module| users.gone(module))
     };
     Ok(Exported::new(
         port_name,
@@ -311,29 +303,12 @@ where
     ))
 }
 
-/// Refuses to export a port another host exports already, as far as this host has heard.
-pub(crate) async fn first_exporter(host: &Host, keys: &Keys, port: &str) -> Result<(), ZenohError> {
-    let others = host
-        .session
-        .liveliness()
-        .get(&keys.live)
-        .await
-        .map_err(ZenohError::session)?;
-    if others.recv_async().await.is_ok() {
-        return Err(ZenohError::Refused {
-            port: port.to_owned(),
-            reason: "another host exports it already".to_owned(),
-        });
-    }
-    Ok(())
-}
-
 /// One remote request, through its module's end: the reply in CDR, or why there is none.
 async fn forward<Req, Rep, E>(
     query: &Query,
     users: &Users<E>,
     claim: &Claim,
-    attach: &(dyn Fn(&str) -> Result<E, WireError> + Send + Sync),
+    attach: &Attach<E>,
     port: &str,
 ) -> Result<Vec<u8>, String>
 where
@@ -342,7 +317,7 @@ where
     E: Forward<Req, Rep>,
 {
     let module = module_of(query)?;
-    let (end, mut gone) = users.end(&module, claim, attach)?;
+    let (end, _, mut gone) = users.end(&module, claim, attach)?;
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
     let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
     // One request of a module at a time, as in one process: its next waits here.

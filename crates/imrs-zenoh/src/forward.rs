@@ -13,6 +13,11 @@ pub(crate) trait Forward<Req, Rep>: Send + 'static {
 
     /// The port's TIMEOUT for this module, if it has one.
     fn timeout(&self) -> Option<Duration>;
+
+    /// The same end, its TIMEOUT (if any) longer by `by`. The module's own host times its
+    /// wait to the port's TIMEOUT; this end's bound is a backstop, longer by a lease, so
+    /// that the module hears its own `ReplyTimeout` rather than a `NoReply` racing it.
+    fn waiting_longer(self, by: Duration) -> Self;
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
@@ -22,6 +27,13 @@ impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Re
 
     fn timeout(&self) -> Option<Duration> {
         End::timeout(self)
+    }
+
+    fn waiting_longer(self, by: Duration) -> Self {
+        match End::timeout(&self) {
+            Some(timeout) => self.with_timeout(timeout + by),
+            None => self,
+        }
     }
 }
 
@@ -33,5 +45,12 @@ impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Re
 
     fn timeout(&self) -> Option<Duration> {
         End::timeout(self)
+    }
+
+    fn waiting_longer(self, by: Duration) -> Self {
+        match End::timeout(&self) {
+            Some(timeout) => self.with_timeout(timeout + by),
+            None => self,
+        }
     }
 }

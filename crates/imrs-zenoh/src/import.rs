@@ -27,6 +27,9 @@ use crate::{Host, ZenohError};
 /// How long the owner's host may take to be seen, and to answer a connection.
 pub(crate) const CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
 
+/// How long past a port's TIMEOUT the bridge still waits for a reply.
+const AFTER_TIMEOUT: Duration = Duration::from_millis(50);
+
 /// How long a request with no TIMEOUT may wait for its reply across hosts: zenoh's
 /// queries end, and a port without a TIMEOUT waits as long as its owner takes.
 pub(crate) const NO_TIMEOUT: Duration = Duration::from_secs(24 * 3600);
@@ -143,12 +146,7 @@ where
     checked("module", module)?;
     let session = &host.session;
     // The owner's token first: once it is seen, so is the owner's host's connect queryable.
-    let watch = Watch::new(session, &keys.live).await?;
-    if !watch.seen_within(CONNECT_TIMEOUT).await {
-        return Err(ZenohError::NoOwner {
-            port: port.to_owned(),
-        });
-    }
+    let watch = Watch::owner(session, &keys.live, port, CONNECT_TIMEOUT).await?;
     // The module's token before its connection: the owner's host lets go of the module's
     // end when the token goes, which it must hold for that (a failed import drops it).
     let token = session
@@ -174,7 +172,9 @@ where
         key: keys.request.clone(),
         module: module.to_owned(),
         port: port.to_owned(),
-        wait: timeout.map_or(NO_TIMEOUT, |t| t + host.lease),
+        // A little past the TIMEOUT: the sender hears its own `ReplyTimeout` first, and the
+        // bridge, free again, takes its next send in time.
+        wait: timeout.map_or(NO_TIMEOUT, |t| t + AFTER_TIMEOUT),
     };
     let owner: Arc<str> = owner.into();
     let bridged = local.clone();
@@ -243,7 +243,7 @@ pub(crate) struct Asking {
     pub(crate) key: String,
     pub(crate) module: String,
     pub(crate) port: String,
-    /// How long a request waits for its reply: the port's TIMEOUT and a lease.
+    /// How long a request waits for its reply.
     pub(crate) wait: Duration,
 }
 

@@ -80,6 +80,7 @@ mod host;
 mod import;
 mod key;
 mod message;
+mod opening;
 mod relay;
 mod take;
 mod watch;

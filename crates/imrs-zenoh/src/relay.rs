@@ -18,15 +18,15 @@ use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
 use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, WireError, usage};
 use tokio::task::JoinHandle;
-use zenoh::sample::SampleKind;
 
 use crate::connected::Connected;
-use crate::export::{Claim, Exported, first_exporter, module_of, reply};
+use crate::export::{Claim, Exported, module_of, reply};
 use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, ask, connect, reconnect};
 use crate::key::{Keys, checked};
 use crate::message::{Message, decode, encode};
+use crate::opening::{Opening, live, watch_users};
 use crate::take::Take;
-use crate::watch::{Watch, alive};
+use crate::watch::Watch;
 use crate::{Host, Imported, ZenohError};
 
 /// A remote module's relay, and what tells it to stop.
@@ -72,23 +72,13 @@ where
     Rep: Message,
     T: Take<Req, Rep>,
 {
-    let keys = Keys::new(&host.cell, port_name)?;
+    let Opening {
+        keys,
+        connects,
+        leaving,
+    } = Opening::new(host, port_name).await?;
     let session = &host.session;
-    first_exporter(host, &keys, port_name).await?;
-    let connects = session
-        .declare_queryable(&keys.connect)
-        .await
-        .map_err(ZenohError::session)?;
-    let leaving = session
-        .liveliness()
-        .declare_subscriber(format!("{}/*", keys.user_prefix()))
-        .await
-        .map_err(ZenohError::session)?;
-    let token = session
-        .liveliness()
-        .declare_token(&keys.live)
-        .await
-        .map_err(ZenohError::session)?;
+    let token = live(host, &keys).await?;
     let relays = Arc::new(Relays::default());
     let lease = host.lease;
     let connecting = {
@@ -137,18 +127,8 @@ where
         })
     };
     let watching = {
-        let (relays, session) = (Arc::clone(&relays), session.clone());
-        tokio::spawn(async move {
-            while let Ok(sample) = leaving.recv_async().await {
-                let key = sample.key_expr().as_str();
-                if sample.kind() == SampleKind::Delete
-                    && !alive(&session, key).await
-                    && let Some(module) = key.rsplit('/').next()
-                {
-                    relays.gone(module);
-                }
-            }
-        })
+        let relays = Arc::clone(&relays);
+        watch_users(host, leaving, move |module| relays.gone(module))
     };
     Ok(Exported::new(
         port_name,
@@ -248,12 +228,7 @@ where
     checked("module", owner)?;
     checked("module", module)?;
     let session = &host.session;
-    let watch = Watch::new(session, &keys.live).await?;
-    if !watch.seen_within(CONNECT_TIMEOUT).await {
-        return Err(ZenohError::NoOwner {
-            port: port.to_owned(),
-        });
-    }
+    let watch = Watch::owner(session, &keys.live, port, CONNECT_TIMEOUT).await?;
     let local =
         Port::<Req, Rep, U, AnyUser, 1>::new(PortSpec::new(port, owner).user_list([module]));
     let slot: Slot<Req, Rep, U> = Arc::default();

@@ -85,10 +85,20 @@ impl Watch {
         }
     }
 
-    /// Waits at most `bound` until the token is there; says whether it is.
-    pub(crate) async fn seen_within(&self, bound: Duration) -> bool {
-        tokio::time::timeout(bound, self.back())
-            .await
-            .unwrap_or(false)
+    /// Watches port `port`'s owner's token at `key`, and waits at most `bound` until it is
+    /// there; refused with [`ZenohError::NoOwner`] if it is not.
+    pub(crate) async fn owner(
+        session: &zenoh::Session,
+        key: &str,
+        port: &str,
+        bound: Duration,
+    ) -> Result<Self, ZenohError> {
+        let watch = Self::new(session, key).await?;
+        match tokio::time::timeout(bound, watch.back()).await {
+            Ok(true) => Ok(watch),
+            _ => Err(ZenohError::NoOwner {
+                port: port.to_owned(),
+            }),
+        }
     }
 }

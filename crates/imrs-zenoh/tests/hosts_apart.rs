@@ -84,13 +84,15 @@ async fn served_again(asker: &mut imrs_ports::End<u64, u64, usage::Send>, bound:
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_process_killed_ends_waits_and_its_restart_is_served() {
+    killed_and_restarted("kill_cell").await;
+}
+
+/// The owner's host, a process of its own on loopback, killed with SIGKILL while a send
+/// waits for its reply, then started again.
+async fn killed_and_restarted(cell: &str) {
     let endpoint = free_endpoint();
-    let mut owner = peer("kill_cell", &endpoint, None).await;
-    let host = Host::builder("kill_cell")
-        .connect(&endpoint)
-        .open()
-        .await
-        .unwrap();
+    let mut owner = peer(cell, &endpoint, None).await;
+    let host = Host::builder(cell).connect(&endpoint).open().await.unwrap();
     let imported: Imported<u64, u64, usage::Receive> =
         import(&host, "DOUBLE", "DOUBLER", "ASKER").await.unwrap();
     let mut asker = imported.port().user_named("ASKER").unwrap();
@@ -108,7 +110,7 @@ async fn an_owner_process_killed_ends_waits_and_its_restart_is_served() {
     let lease = host.lease();
     held_send_ends_with_no_reply(&mut asker, kill, 2 * lease + PROMPTLY).await;
     seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
-    let _restarted = peer("kill_cell", &endpoint, None).await;
+    let _restarted = peer(cell, &endpoint, None).await;
     served_again(&mut asker, PROMPTLY).await;
 }
 
@@ -212,8 +214,7 @@ async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
                 "\n!!! NETWORK NAMESPACES UNAVAILABLE ({why}): this test runs over loopback, \
                  its link cut by killing the owner's host !!!\n"
             );
-            return an_owner_process_killed_ends_waits_and_its_restart_is_served_over_loopback()
-                .await;
+            return killed_and_restarted("loopback_cell").await;
         }
     };
     let endpoint = format!("tcp/{}:7447", netns.inside_address);
@@ -242,27 +243,4 @@ async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
     seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
     netns.set_link("up");
     served_again(&mut asker, PROMPTLY + 2 * lease).await;
-}
-
-/// The namespace test's fallback: the same cut, made by killing the owner's host.
-async fn an_owner_process_killed_ends_waits_and_its_restart_is_served_over_loopback() {
-    let endpoint = free_endpoint();
-    let mut owner = peer("loopback_cell", &endpoint, None).await;
-    let host = Host::builder("loopback_cell")
-        .connect(&endpoint)
-        .open()
-        .await
-        .unwrap();
-    let imported: Imported<u64, u64, usage::Receive> =
-        import(&host, "DOUBLE", "DOUBLER", "ASKER").await.unwrap();
-    let mut asker = imported.port().user_named("ASKER").unwrap();
-    let lease = host.lease();
-    let kill = async {
-        owner.start_kill().expect("SIGKILL");
-        owner.wait().await.expect("the peer reaped");
-    };
-    held_send_ends_with_no_reply(&mut asker, kill, 2 * lease + PROMPTLY).await;
-    seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
-    let _restarted = peer("loopback_cell", &endpoint, None).await;
-    served_again(&mut asker, PROMPTLY).await;
 }
