@@ -188,16 +188,18 @@ where
                 return;
             }
             {
-                let presence = Presence::new(&*owner);
+                // Marked gone on every way out of this block, the bridge aborted with its
+                // import included, once the end is let go: the local module's waits end
+                // with `PeerGone` rather than hang.
+                let presence = GoneOnDrop(Presence::new(&*owner));
                 let end = {
-                    let _held = Presence::enter(Some(Arc::clone(&presence)));
+                    let _held = Presence::enter(Some(Arc::clone(&presence.0)));
                     T::attach_to(&bridged)
                 };
                 let Ok(end) = end else { return };
                 if !serve_while_live::<Req, Rep, T>(end, &watch, &asking).await {
                     return;
                 }
-                presence.set_gone();
             }
             // Gone: wait for the owner's host to come back.
             if !watch.back().await {
@@ -234,6 +236,15 @@ pub(crate) async fn reconnect(
             live = watch.gone() => if !live { return false },
         }
         pause = (pause * 2).min(host.lease);
+    }
+}
+
+/// A presence marked gone when dropped.
+struct GoneOnDrop(Arc<Presence>);
+
+impl Drop for GoneOnDrop {
+    fn drop(&mut self) {
+        self.0.set_gone();
     }
 }
 

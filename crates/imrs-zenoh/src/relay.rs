@@ -264,11 +264,14 @@ where
         );
         tokio::spawn(async move {
             loop {
-                if !watch.gone().await {
+                // The owner's host gone, or this host's session closed: either way the
+                // local module's waits end with `PeerGone` rather than hang.
+                let live = watch.gone().await;
+                drop(slot.lock().await.take());
+                presence.set_gone();
+                if !live {
                     return;
                 }
-                presence.set_gone();
-                drop(slot.lock().await.take());
                 // Gone: wait for the owner's host to come back, then connect again, so
                 // that it attaches the module again.
                 if !watch.back().await {

@@ -307,3 +307,26 @@ async fn a_refused_claim_is_answered_by_name_and_leaves_no_name_behind() {
         assert_eq!(imrs_ports::Name::known(module), None, "{module} was kept");
     }
 }
+
+/// A host whose own session closes: its modules' waits on imported ports end with
+/// `PeerGone`, even on a port with no TIMEOUT, rather than hang.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_closed_session_ends_its_own_modules_waits() {
+    let (owner_host, user_host) = two_hosts("closing_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("WAIT", "WAITER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "WAIT", "WAITER", "ASKER").await.unwrap();
+    let mut asker = imported.port().user_named("ASKER").unwrap();
+    user_host.close().await.unwrap();
+    let ended = within(PROMPTLY, "a send on a closed host", async {
+        loop {
+            match asker.send(1).await {
+                Err(SendError::PeerGone { module, .. }) => break module,
+                _ => tokio::task::yield_now().await,
+            }
+        }
+    })
+    .await;
+    assert_eq!(ended.as_str(), "WAITER");
+}
