@@ -16,7 +16,7 @@ use std::thread::JoinHandle;
 
 use iceoryx2::port::notifier::Notifier;
 use imrs_ports::usage::{Plain, Usage};
-use imrs_ports::{End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
+use imrs_ports::{ClaimRefused, End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
 
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Active, Carry, Held, Server, lock};
@@ -65,26 +65,12 @@ pub(crate) enum Refusal {
     Failed,
 }
 
-/// Refuses remote module `module`'s claim on `port` by its text alone, before its name is
-/// made: a name is kept for the life of the process, so a peer that claimed names without
-/// end would otherwise grow this process without bound. Only a module that may attach
-/// gets a name.
-pub(crate) fn claim<M, R, U, L, const N: usize>(
-    port: &Port<M, R, U, L, N>,
-    module: &str,
-) -> Result<(), Refusal>
-where
-    M: Send + 'static,
-    R: Send + 'static,
-    U: Usage,
-    L: UserList,
-{
-    if !port.admits(module) {
-        Err(Refusal::NotOnUserList)
-    } else if port.is_full() {
-        Err(Refusal::Full { capacity: N })
-    } else {
-        Ok(())
+impl From<ClaimRefused> for Refusal {
+    fn from(refused: ClaimRefused) -> Self {
+        match refused {
+            ClaimRefused::NotOnUserList { .. } => Self::NotOnUserList,
+            ClaimRefused::Full { capacity, .. } => Self::Full { capacity },
+        }
     }
 }
 
@@ -243,7 +229,8 @@ where
         false,
         tight,
         move |module: &str| {
-            claim(&attached, module)?;
+            // Refused by its name's text before the name is made: see `Port::claim`.
+            attached.claim(module)?;
             // The remote module's end waits in the bridge's task, which a spinning wait
             // would keep off its worker: it parks, whatever the port's process type.
             let mut end = attached.user_named(module)?;

@@ -16,7 +16,7 @@ use std::sync::{Arc, Mutex};
 use crate::bridge::is_served;
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
-use crate::export::{Forward, Refusal, bridge, claim};
+use crate::export::{Forward, Refusal, bridge};
 use crate::import::{Relay, SharedAsker, Take, connect, keep_attached, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
@@ -257,7 +257,7 @@ where
     // kept off tokio's workers.
     let (exported, _) =
         bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, false, move |module: &str| {
-            claim(&port, module)?;
+            port.claim(module)?;
             // The relay back is the module's process's service: one that is not there is
             // refused before any name of the claim is made.
             if !is_served(&cell, &format!("{served}/to/{module}")) {

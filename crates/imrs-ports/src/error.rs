@@ -416,6 +416,50 @@ impl fmt::Display for ReceiveError {
     }
 }
 
+/// Why a remote module's claim on a port was refused ([`Port::claim`]): the module's name
+/// is kept as text, so that a refused name is never made.
+///
+/// [`Port::claim`]: crate::Port::claim
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ClaimRefused {
+    /// The module is not on the port's user list.
+    NotOnUserList {
+        /// The port.
+        port: Name,
+        /// The module refused, as claimed.
+        module: String,
+    },
+    /// Every user place of the port is taken.
+    Full {
+        /// The port.
+        port: Name,
+        /// The module refused, as claimed.
+        module: String,
+        /// The declared number of users.
+        capacity: usize,
+    },
+}
+
+impl fmt::Display for ClaimRefused {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NotOnUserList { port, module } => {
+                write!(f, "module {module} is not on the user list of port {port}")
+            }
+            Self::Full {
+                port,
+                module,
+                capacity,
+            } => write!(
+                f,
+                "module {module} cannot use port {port}: it allows {capacity} active user(s) and all are attached"
+            ),
+        }
+    }
+}
+
+impl Error for ClaimRefused {}
+
 impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -79,7 +79,7 @@ mod wiring;
 pub use broadcast::{Broadcast, Broadcasting};
 pub use clock::{Clock, Instant, RealClock, SharedClock, VirtualClock};
 pub use end::End;
-pub use error::{BroadcastError, QueryError, ReceiveError, SendError, WireError};
+pub use error::{BroadcastError, ClaimRefused, QueryError, ReceiveError, SendError, WireError};
 pub use filter::{BoundedBuffer, BoundedBufferPort, FilterEnds, FilteredPort};
 pub use meta::{Name, Named};
 pub use module_name::Module;

@@ -10,7 +10,7 @@ use crate::attachment::Attachment;
 use crate::clock::{RealClock, SharedClock};
 use crate::core::{Core, SlotId, hold};
 use crate::end::End;
-use crate::error::WireError;
+use crate::error::{ClaimRefused, WireError};
 use crate::meta::{Name, Named, PortMeta};
 use crate::presence::Presence;
 use crate::priority::Priority;
@@ -252,17 +252,26 @@ where
         self.core.users_attached()
     }
 
-    /// Whether module `module` may attach as a user as far as its name goes: it is on the
-    /// port's user list, or the port has none. Looks at the text only, so that a name a
-    /// peer claims is not kept (see [`Name`]) when it is refused: a transport checks this,
-    /// and [`Port::is_full`], before it attaches a remote module.
-    pub fn admits(&self, module: &str) -> bool {
-        self.core.meta.admits(module)
-    }
-
-    /// Whether every user place is taken: one more user would be refused.
-    pub fn is_full(&self) -> bool {
-        self.core.users_attached() >= self.core.capacity()
+    /// Checks a remote module's claim to attach as a user, by its name's text alone: refused
+    /// if it is not on the port's user list or every user place is taken. A transport
+    /// checks this before it attaches a module a peer names, so that a refused claim leaves
+    /// no name behind (names are kept for the life of the process, see [`Name`]).
+    pub fn claim(&self, module: &str) -> Result<(), ClaimRefused> {
+        let port = self.core.meta.name.clone();
+        if !self.core.meta.admits(module) {
+            Err(ClaimRefused::NotOnUserList {
+                port,
+                module: module.to_owned(),
+            })
+        } else if self.core.users_attached() >= self.core.capacity() {
+            Err(ClaimRefused::Full {
+                port,
+                module: module.to_owned(),
+                capacity: self.core.capacity(),
+            })
+        } else {
+            Ok(())
+        }
     }
 
     /// Attaches the owner end. One owner end at a time; after it is dropped (its module

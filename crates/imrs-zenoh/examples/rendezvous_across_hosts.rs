@@ -9,9 +9,12 @@
 //! a module's `send` on the imported port and a raw `get` of the queryable, each awaited on
 //! the same multi-thread tokio runtime, and prints p50 and p99 of each and their ratios.
 
-use std::process::Stdio;
-use std::time::{Duration, Instant};
+mod common;
 
+use std::process::Stdio;
+use std::time::Instant;
+
+use common::{cdr, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
@@ -19,7 +22,6 @@ use tokio::io::{AsyncBufReadExt, BufReader};
 const CELL: &str = "bench_cell";
 const RAW: &str = "bench/raw/DOUBLE";
 const BLOCK: usize = 1_000;
-const HEADER: [u8; 4] = [0, 1, 0, 0];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -32,11 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     {
         return runtime.block_on(serve(endpoint));
     }
-    let rounds = args
-        .iter()
-        .position(|a| a == "--rounds")
-        .and_then(|i| args.get(i + 1))
-        .map_or(Ok(20_000), |n| n.parse::<usize>())?;
+    let rounds = rounds(&args, 20_000)?;
     let netns = args.iter().any(|a| a == "--netns");
     runtime.block_on(measure(rounds, netns))
 }
@@ -67,19 +65,6 @@ async fn serve(endpoint: &str) -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|e| e.to_string())?;
     }
     Ok(())
-}
-
-fn cdr(n: u64) -> Vec<u8> {
-    let mut bytes = HEADER.to_vec();
-    bytes.extend_from_slice(&n.to_le_bytes());
-    bytes
-}
-
-fn read(bytes: &[u8]) -> u64 {
-    bytes
-        .get(4..12)
-        .and_then(|b| b.try_into().ok())
-        .map_or(0, u64::from_le_bytes)
 }
 
 async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::Error>> {
@@ -153,24 +138,14 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
         "two processes, loopback"
     };
     println!("{} round trips each, {where_}:\n", imrs.len());
-    println!("| case | p50 | p99 |");
-    println!("|---|---:|---:|");
-    let (a50, a99) = (percentile(&mut imrs, 0.50), percentile(&mut imrs, 0.99));
-    let (b50, b99) = (percentile(&mut zenoh, 0.50), percentile(&mut zenoh, 0.99));
-    println!("| IMRS `send` on an imported port | {a50:.1?} | {a99:.1?} |");
-    println!("| raw zenoh `get` of a queryable | {b50:.1?} | {b99:.1?} |");
-    println!(
-        "| ratio | {:.2}× | {:.2}× |",
-        a50.as_secs_f64() / b50.as_secs_f64(),
-        a99.as_secs_f64() / b99.as_secs_f64()
+    table(
+        "IMRS `send` on an imported port",
+        &mut imrs,
+        "raw zenoh `get` of a queryable",
+        &mut zenoh,
     );
     owner.start_kill()?;
     Ok(())
-}
-
-fn percentile(samples: &mut [Duration], q: f64) -> Duration {
-    samples.sort_unstable();
-    samples[((samples.len() - 1) as f64 * q).round() as usize]
 }
 
 /// A network namespace joined to this one by a veth link, removed when dropped.

@@ -10,9 +10,12 @@
 //! queryables until all three replies are in, and prints p50 and p99 of each and their
 //! ratios.
 
-use std::process::Stdio;
-use std::time::{Duration, Instant};
+mod common;
 
+use std::process::Stdio;
+use std::time::Instant;
+
+use common::{cdr, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
@@ -21,7 +24,6 @@ use zenoh::query::{ConsolidationMode, QueryTarget};
 const CELL: &str = "sendall_bench_cell";
 const MODULES: [&str; 3] = ["PANEL_1", "PANEL_2", "PANEL_3"];
 const BLOCK: usize = 500;
-const HEADER: [u8; 4] = [0, 1, 0, 0];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -34,25 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     {
         return runtime.block_on(listen(endpoint, module));
     }
-    let rounds = args
-        .iter()
-        .position(|a| a == "--rounds")
-        .and_then(|i| args.get(i + 1))
-        .map_or(Ok(5_000), |n| n.parse::<usize>())?;
+    let rounds = rounds(&args, 5_000)?;
     runtime.block_on(measure(rounds))
-}
-
-fn cdr(n: u64) -> Vec<u8> {
-    let mut bytes = HEADER.to_vec();
-    bytes.extend_from_slice(&n.to_le_bytes());
-    bytes
-}
-
-fn read(bytes: &[u8]) -> u64 {
-    bytes
-        .get(4..12)
-        .and_then(|b| b.try_into().ok())
-        .map_or(0, u64::from_le_bytes)
 }
 
 /// A listener's host: ALARM imported for `module`, and the raw queryable beside it.
@@ -150,23 +135,11 @@ async fn measure(rounds: usize) -> Result<(), Box<dyn std::error::Error>> {
         "{} broadcasts each, to three hosts (processes, loopback):\n",
         imrs.len()
     );
-    println!("| case | p50 | p99 |");
-    println!("|---|---:|---:|");
-    let (a50, a99) = (percentile(&mut imrs, 0.50), percentile(&mut imrs, 0.99));
-    let (b50, b99) = (percentile(&mut zenoh, 0.50), percentile(&mut zenoh, 0.99));
-    println!("| IMRS `send_all`, until the three replies | {a50:.1?} | {a99:.1?} |");
-    println!(
-        "| raw zenoh `get` of three queryables, until the three replies | {b50:.1?} | {b99:.1?} |"
-    );
-    println!(
-        "| ratio | {:.2}× | {:.2}× |",
-        a50.as_secs_f64() / b50.as_secs_f64(),
-        a99.as_secs_f64() / b99.as_secs_f64()
+    table(
+        "IMRS `send_all`, until the three replies",
+        &mut imrs,
+        "raw zenoh `get` of three queryables, until the three replies",
+        &mut zenoh,
     );
     Ok(())
-}
-
-fn percentile(samples: &mut [Duration], q: f64) -> Duration {
-    samples.sort_unstable();
-    samples[((samples.len() - 1) as f64 * q).round() as usize]
 }

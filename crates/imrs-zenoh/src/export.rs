@@ -9,6 +9,7 @@
 //! end is dropped and its presence marked gone, so the owner's waits on it end as they
 //! would for a module that ended.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -188,33 +189,6 @@ impl<E> Users<E> {
 /// Whether a remote module may attach, by its name's text: why not, naming the port.
 pub(crate) type Claim = dyn Fn(&str) -> Result<(), String> + Send + Sync;
 
-/// `port`'s answer to a remote module's claim: refused, in the words of its wiring error,
-/// if the module is off its user list or every user place is taken.
-pub(crate) fn claim<Req, Rep, U, L, const N: usize>(
-    port: &Port<Req, Rep, U, L, N>,
-    module: &str,
-) -> Result<(), String>
-where
-    Req: Send + 'static,
-    Rep: Send + 'static,
-    U: imrs_ports::usage::Usage,
-    L: UserList,
-{
-    let name = port.name();
-    if !port.admits(module) {
-        Err(format!(
-            "module {module} is not on the user list of port {name}"
-        ))
-    } else if port.is_full() {
-        Err(format!(
-            "module {module} cannot use port {name}: it allows {N} active user(s) and all are \
-             attached"
-        ))
-    } else {
-        Ok(())
-    }
-}
-
 /// Serves `port_name` for the remote modules, each claimed with `claim` and attached with
 /// `attach`.
 async fn serve<Req, Rep, E>(
@@ -276,10 +250,11 @@ where
         tokio::spawn(async move {
             let owner = owner;
             while let Ok(query) = connects.recv_async().await {
-                if let Ok(module) = module_of(&query) {
-                    users.renew(&module).await;
+                let module = module_of(&query);
+                if let Ok(module) = &module {
+                    users.renew(module).await;
                 }
-                let answer = module_of(&query).and_then(|module| {
+                let answer = module.and_then(|module| {
                     let (_, timeout, _) = users.end(&module, &*claim, |m| attach(m))?;
                     let connected = Connected {
                         owner: owner.clone(),
@@ -334,12 +309,18 @@ where
 }
 
 /// The module a query comes from: its attachment, the module's name in UTF-8.
-pub(crate) fn module_of(query: &Query) -> Result<String, String> {
+/// Read where it lies when the attachment is one slice, as it is for a name.
+pub(crate) fn module_of(query: &Query) -> Result<Cow<'_, str>, String> {
     let attachment = query
         .attachment()
         .ok_or("a request names no module: its attachment must be the module's name")?;
-    let module = String::from_utf8(attachment.to_bytes().into_owned())
-        .map_err(|_| "a request's module name is not UTF-8".to_owned())?;
+    let not_utf8 = |_| "a request's module name is not UTF-8".to_owned();
+    let module = match attachment.to_bytes() {
+        Cow::Borrowed(bytes) => Cow::Borrowed(std::str::from_utf8(bytes).map_err(not_utf8)?),
+        Cow::Owned(bytes) => {
+            Cow::Owned(String::from_utf8(bytes).map_err(|e| not_utf8(e.utf8_error()))?)
+        }
+    };
     checked("module", &module).map_err(|e| e.to_string())?;
     Ok(module)
 }
@@ -364,36 +345,48 @@ mod sealed {
             host: &Host,
         ) -> impl Future<Output = Result<Exported, ZenohError>> + Send;
     }
+}
 
-    impl<Req: Message, Rep: Message, L: UserList, const N: usize> Exports
-        for Port<Req, Rep, usage::Receive, L, N>
-    {
-        async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
-            let port = self.clone();
-            let owner = self.owner_module().to_string();
-            let claims = self.clone();
-            let claim = Box::new(move |module: &str| claim(&claims, module));
-            serve::<Req, Rep, _>(host, self.name().as_str(), owner, claim, move |module| {
-                port.user_named(module)
-            })
-            .await
+/// Exports with [`serve`], for a port whose users start each rendezvous.
+macro_rules! asked {
+    ($usage:ty) => {
+        impl<Req: Message, Rep: Message, L: UserList, const N: usize> sealed::Exports
+            for Port<Req, Rep, $usage, L, N>
+        {
+            async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
+                let port = self.clone();
+                let owner = self.owner_module().to_string();
+                serve::<Req, Rep, _>(
+                    host,
+                    self.name().as_str(),
+                    owner,
+                    claim_of(self),
+                    move |module| port.user_named(module),
+                )
+                .await
+            }
         }
-    }
 
-    impl<Req: Message, Rep: Message, L: UserList, const N: usize> Exports
-        for Port<Req, Rep, usage::Response, L, N>
-    {
-        async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
-            let port = self.clone();
-            let owner = self.owner_module().to_string();
-            let claims = self.clone();
-            let claim = Box::new(move |module: &str| claim(&claims, module));
-            serve::<Req, Rep, _>(host, self.name().as_str(), owner, claim, move |module| {
-                port.user_named(module)
-            })
-            .await
+        impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export
+            for Port<Req, Rep, $usage, L, N>
+        {
         }
-    }
+    };
+}
+
+asked!(usage::Receive);
+asked!(usage::Response);
+
+/// `port`'s check of a remote module's claim, refused in words that name the port.
+fn claim_of<Req, Rep, U, L, const N: usize>(port: &Port<Req, Rep, U, L, N>) -> Box<Claim>
+where
+    Req: Send + 'static,
+    Rep: Send + 'static,
+    U: imrs_ports::usage::Usage,
+    L: UserList,
+{
+    let port = port.clone();
+    Box::new(move |module: &str| port.claim(module).map_err(|refused| refused.to_string()))
 }
 
 /// Exports with [`crate::relay`], for a port whose owner starts each rendezvous.
@@ -404,13 +397,12 @@ macro_rules! relayed {
         {
             async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
                 let owner = self.owner_module().to_string();
-                let (claims, port) = (self.clone(), self.clone());
-                let claim = Box::new(move |module: &str| claim(&claims, module));
+                let port = self.clone();
                 crate::relay::export_relayed::<Req, Rep, _>(
                     host,
                     self.name().as_str(),
                     owner,
-                    claim,
+                    claim_of(self),
                     move |module| port.attach_relayed(module),
                 )
                 .await
@@ -467,14 +459,4 @@ impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> Atta
 /// answers it with the module's host's answer.
 fn never_handled<Req, Rep>(_: &(), _: Req) -> Rep {
     unreachable!("a relayed port's queries are taken, never handled here")
-}
-
-impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export
-    for Port<Req, Rep, usage::Receive, L, N>
-{
-}
-
-impl<Req: Message, Rep: Message, L: UserList, const N: usize> Export
-    for Port<Req, Rep, usage::Response, L, N>
-{
 }

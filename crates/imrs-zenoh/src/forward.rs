@@ -20,37 +20,30 @@ pub(crate) trait Forward<Req, Rep>: Send + 'static {
     fn waiting_longer(self, by: Duration) -> Self;
 }
 
-impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
-    async fn forward(&mut self, request: Req) -> Result<Rep, String> {
-        self.send(request).await.map_err(|error| error.to_string())
-    }
+/// The module's end, whose primitive is `$primitive` (a send; a query, answered by the
+/// owner's response handler when the owner's order says).
+macro_rules! forwards {
+    ($usage:ty, $primitive:ident) => {
+        impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, $usage> {
+            async fn forward(&mut self, request: Req) -> Result<Rep, String> {
+                self.$primitive(request)
+                    .await
+                    .map_err(|error| error.to_string())
+            }
 
-    fn timeout(&self) -> Option<Duration> {
-        End::timeout(self)
-    }
+            fn timeout(&self) -> Option<Duration> {
+                End::timeout(self)
+            }
 
-    fn waiting_longer(self, by: Duration) -> Self {
-        match End::timeout(&self) {
-            Some(timeout) => self.with_timeout(timeout + by),
-            None => self,
+            fn waiting_longer(self, by: Duration) -> Self {
+                match End::timeout(&self) {
+                    Some(timeout) => self.with_timeout(timeout + by),
+                    None => self,
+                }
+            }
         }
-    }
+    };
 }
 
-/// A query to the owner's response handler, which runs when the owner's order says.
-impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
-    async fn forward(&mut self, request: Req) -> Result<Rep, String> {
-        self.query(request).await.map_err(|error| error.to_string())
-    }
-
-    fn timeout(&self) -> Option<Duration> {
-        End::timeout(self)
-    }
-
-    fn waiting_longer(self, by: Duration) -> Self {
-        match End::timeout(&self) {
-            Some(timeout) => self.with_timeout(timeout + by),
-            None => self,
-        }
-    }
-}
+forwards!(usage::Send, send);
+forwards!(usage::Query, query);

@@ -128,6 +128,40 @@ impl<Req: Send + 'static, Rep: Message> Attach<Req, Rep, usage::Response>
     }
 }
 
+/// How every import begins: `port`'s keys, its names checked, and its owner's token
+/// watched, once seen (then so is the owner's host's connect queryable).
+pub(crate) async fn begin(
+    host: &Host,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<(Keys, Watch), ZenohError> {
+    let keys = Keys::new(&host.cell, port)?;
+    checked("module", owner)?;
+    checked("module", module)?;
+    let watch = Watch::owner(&host.session, &keys.live, port, CONNECT_TIMEOUT).await?;
+    Ok((keys, watch))
+}
+
+/// `module`'s connection to `port`, refused if another module than `owner` owns it.
+pub(crate) async fn connect_to(
+    host: &Host,
+    keys: &Keys,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Connected, ZenohError> {
+    let connected = connect(host, keys, port, module).await?;
+    if connected.owner == owner {
+        Ok(connected)
+    } else {
+        Err(ZenohError::Refused {
+            port: port.to_owned(),
+            reason: format!("{owner} does not own it; {} does", connected.owner),
+        })
+    }
+}
+
 /// Connects `module` to `port` and starts the bridge of its local side, `T`.
 async fn bridge<Req, Rep, U, T>(
     host: &Host,
@@ -141,12 +175,8 @@ where
     U: Usage,
     T: Take<Req, Rep> + Attach<Req, Rep, U>,
 {
-    let keys = Keys::new(&host.cell, port)?;
-    checked("module", owner)?;
-    checked("module", module)?;
+    let (keys, watch) = begin(host, port, owner, module).await?;
     let session = &host.session;
-    // The owner's token first: once it is seen, so is the owner's host's connect queryable.
-    let watch = Watch::owner(session, &keys.live, port, CONNECT_TIMEOUT).await?;
     // The module's token before its connection: the owner's host lets go of the module's
     // end when the token goes, which it must hold for that (a failed import drops it).
     let token = session
@@ -154,13 +184,7 @@ where
         .declare_token(keys.user(module))
         .await
         .map_err(ZenohError::session)?;
-    let connected = connect(host, &keys, port, module).await?;
-    if connected.owner != owner {
-        return Err(ZenohError::Refused {
-            port: port.to_owned(),
-            reason: format!("{owner} does not own it; {} does", connected.owner),
-        });
-    }
+    let connected = connect_to(host, &keys, port, owner, module).await?;
     let mut spec = PortSpec::new(port, owner);
     let timeout = (connected.timeout_ms > 0).then(|| Duration::from_millis(connected.timeout_ms));
     if let Some(timeout) = timeout {
@@ -170,7 +194,7 @@ where
     let asking = Asking {
         session: session.clone(),
         key: keys.request.clone(),
-        module: module.to_owned(),
+        name: module.into(),
         port: port.to_owned(),
         // A little past the TIMEOUT: the sender hears its own `ReplyTimeout` first, and the
         // bridge, free again, takes its next send in time.
@@ -252,7 +276,8 @@ impl Drop for GoneOnDrop {
 pub(crate) struct Asking {
     pub(crate) session: zenoh::Session,
     pub(crate) key: String,
-    pub(crate) module: String,
+    /// The asking module's name, the attachment of every request: made once, shared.
+    pub(crate) name: zenoh::bytes::ZBytes,
     pub(crate) port: String,
     /// How long a request waits for its reply.
     pub(crate) wait: Duration,
@@ -296,7 +321,7 @@ pub(crate) async fn ask<Req: Message, Rep: Message>(
             .session
             .get(&asking.key)
             .payload(bytes?)
-            .attachment(asking.module.as_bytes())
+            .attachment(asking.name.clone())
             .timeout(asking.wait)
             .await
             .map_err(|e| e.to_string())?;
@@ -359,35 +384,28 @@ mod sealed {
             module: &str,
         ) -> impl Future<Output = Result<Self, ZenohError>> + Send;
     }
-
-    impl<Req: Message, Rep: Message> Imports for Imported<Req, Rep, usage::Receive> {
-        async fn import_from(
-            host: &Host,
-            port: &str,
-            owner: &str,
-            module: &str,
-        ) -> Result<Self, ZenohError> {
-            bridge::<Req, Rep, usage::Receive, End<Req, Rep, usage::Receive>>(
-                host, port, owner, module,
-            )
-            .await
-        }
-    }
-
-    impl<Req: Message, Rep: Message> Imports for Imported<Req, Rep, usage::Response> {
-        async fn import_from(
-            host: &Host,
-            port: &str,
-            owner: &str,
-            module: &str,
-        ) -> Result<Self, ZenohError> {
-            bridge::<Req, Rep, usage::Response, ResponseEnd<Req, Rep, ()>>(
-                host, port, owner, module,
-            )
-            .await
-        }
-    }
 }
+
+/// Imports with [`bridge`], whose local owner side `$side` takes what the module asks.
+macro_rules! asked {
+    ($usage:ty, $side:ty) => {
+        impl<Req: Message, Rep: Message> sealed::Imports for Imported<Req, Rep, $usage> {
+            async fn import_from(
+                host: &Host,
+                port: &str,
+                owner: &str,
+                module: &str,
+            ) -> Result<Self, ZenohError> {
+                bridge::<Req, Rep, $usage, $side>(host, port, owner, module).await
+            }
+        }
+
+        impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, $usage> {}
+    };
+}
+
+asked!(usage::Receive, End<Req, Rep, usage::Receive>);
+asked!(usage::Response, ResponseEnd<Req, Rep, ()>);
 
 /// Imports with [`crate::relay`], for a port whose owner starts each rendezvous.
 macro_rules! relayed {
@@ -415,7 +433,3 @@ macro_rules! relayed {
 relayed!(usage::SendAll, Clone);
 relayed!(usage::CallAll, Clone);
 relayed!(usage::Query, Send);
-
-impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, usage::Receive> {}
-
-impl<Req: Message, Rep: Message> Import for Imported<Req, Rep, usage::Response> {}

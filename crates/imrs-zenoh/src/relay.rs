@@ -21,12 +21,10 @@ use tokio::task::JoinHandle;
 
 use crate::connected::Connected;
 use crate::export::{Claim, Exported, module_of, reply};
-use crate::import::{Asking, CONNECT_TIMEOUT, NO_TIMEOUT, ask, connect, reconnect};
-use crate::key::{Keys, checked};
+use crate::import::{Asking, NO_TIMEOUT, ask, begin, connect_to, reconnect};
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
 use crate::take::Take;
-use crate::watch::Watch;
 use crate::{Host, Imported, ZenohError};
 
 /// A remote module's relay, and what tells it to stop.
@@ -89,6 +87,7 @@ where
                     let mut running = relays.lock();
                     // A relay that has ended (its module gone, or its end closed) is made
                     // anew for a module that connects again.
+                    let module = module.into_owned();
                     if running
                         .get(&module)
                         .is_some_and(|(relay, _)| relay.is_finished())
@@ -107,7 +106,7 @@ where
                         let asking = Asking {
                             session: session.clone(),
                             key: keys.deliver(module),
-                            module: owner.clone(),
+                            name: owner.as_str().into(),
                             port: port.clone(),
                             wait: NO_TIMEOUT,
                         };
@@ -224,11 +223,8 @@ where
     U: Usage + imrs_ports::usage::Plain,
     End<Req, Rep, U>: Deliver<Req, Rep>,
 {
-    let keys = Keys::new(&host.cell, port)?;
-    checked("module", owner)?;
-    checked("module", module)?;
+    let (keys, watch) = begin(host, port, owner, module).await?;
     let session = &host.session;
-    let watch = Watch::owner(session, &keys.live, port, CONNECT_TIMEOUT).await?;
     let local =
         Port::<Req, Rep, U, AnyUser, 1>::new(PortSpec::new(port, owner).user_list([module]));
     let slot: Slot<Req, Rep, U> = Arc::default();
@@ -253,7 +249,7 @@ where
         .declare_token(keys.user(module))
         .await
         .map_err(ZenohError::session)?;
-    check_owner(connect(host, &keys, port, module).await?, port, owner)?;
+    connect_to(host, &keys, port, owner, module).await?;
     let bridge = {
         let (host, local, owner, port, module) = (
             host.clone(),
@@ -317,18 +313,6 @@ where
     })?;
     *slot.lock().await = Some(end);
     Ok(presence)
-}
-
-/// Refuses a connection whose port another module than `owner` owns.
-fn check_owner(connected: Connected, port: &str, owner: &str) -> Result<(), ZenohError> {
-    if connected.owner == owner {
-        Ok(())
-    } else {
-        Err(ZenohError::Refused {
-            port: port.to_owned(),
-            reason: format!("{owner} does not own it; {} does", connected.owner),
-        })
-    }
 }
 
 /// One broadcast or query from the owner's host, handed to the local module: its reply in
