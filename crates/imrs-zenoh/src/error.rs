@@ -31,6 +31,12 @@ pub enum ZenohError {
         /// The owner's host's reason, naming the port.
         reason: String,
     },
+    /// A port this host does not admit, on a host that admits ports: every port that crosses
+    /// to or from it must be ([`HostBuilder::admit`](crate::HostBuilder::admit)).
+    NotAdmitted {
+        /// The port.
+        port: String,
+    },
     /// A message that could not be encoded, or bytes that are not the port's message.
     Encoding {
         /// The port.
@@ -59,6 +65,11 @@ impl fmt::Display for ZenohError {
             Self::Refused { port, reason } => {
                 write!(f, "port {port}: its owner's host refused: {reason}")
             }
+            Self::NotAdmitted { port } => write!(
+                f,
+                "port {port} is not admitted on this host, which admits ports: admit it \
+                 (HostBuilder::admit) on its owner's host and on each of its users'"
+            ),
             Self::Encoding { port, reason } => write!(f, "port {port}: {reason}"),
         }
     }

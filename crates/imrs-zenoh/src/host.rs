@@ -16,6 +16,8 @@ pub struct Host {
     pub(crate) session: zenoh::Session,
     pub(crate) cell: String,
     pub(crate) lease: Duration,
+    /// The ports admitted, if this host admits ports: no other can cross.
+    admitted: Option<Vec<String>>,
 }
 
 /// How to open a [`Host`]: its endpoints and lease.
@@ -59,6 +61,19 @@ impl Host {
     /// The zenoh session, for what this crate does not wrap.
     pub fn session(&self) -> &zenoh::Session {
         &self.session
+    }
+
+    /// Refuses, naming it, a port this host cannot carry: one it does not admit, when it
+    /// admits ports. Without the check such a port would only ever time out.
+    pub(crate) fn carries(&self, port: &str) -> Result<(), ZenohError> {
+        match &self.admitted {
+            Some(ports) if !ports.iter().any(|admitted| admitted == port) => {
+                Err(ZenohError::NotAdmitted {
+                    port: port.to_owned(),
+                })
+            }
+            _ => Ok(()),
+        }
     }
 
     /// Closes the session: every port it exports is withdrawn, and its peers see it gone.
@@ -160,10 +175,13 @@ impl HostBuilder {
                 .map_err(|error| ZenohError::session(format!("{key} = {value}: {error}")))?;
         }
         let session = zenoh::open(config).await.map_err(ZenohError::session)?;
+        let admitted = (!self.admitted.is_empty())
+            .then(|| self.admitted.iter().map(|a| a.port.clone()).collect());
         Ok(Host {
             session,
             cell: self.cell,
             lease: self.lease,
+            admitted,
         })
     }
 }

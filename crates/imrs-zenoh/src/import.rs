@@ -137,6 +137,7 @@ pub(crate) async fn begin(
     module: &str,
 ) -> Result<(Keys, Watch), ZenohError> {
     let keys = Keys::new(&host.cell, port)?;
+    host.carries(port)?;
     checked("module", owner)?;
     checked("module", module)?;
     let watch = Watch::owner(&host.session, &keys.live, port, CONNECT_TIMEOUT).await?;

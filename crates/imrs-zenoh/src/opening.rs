@@ -27,6 +27,7 @@ impl Opening {
     /// host has heard.
     pub(crate) async fn new(host: &Host, port: &str) -> Result<Self, ZenohError> {
         let keys = Keys::new(&host.cell, port)?;
+        host.carries(port)?;
         let session = &host.session;
         let others = session
             .liveliness()

@@ -233,3 +233,20 @@ async fn an_admitted_broadcast_reaches_its_listener() {
     .await;
     assert_eq!(answered.unwrap(), 42);
 }
+
+/// A port misspelt, or forgotten, in a host's admissions would only ever time out: it is
+/// refused at once, by name, when the host exports or imports it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_port_the_host_does_not_admit_is_refused_at_once_by_name() {
+    let authority = Authority::new("unadmitted");
+    let host = host(authority.host("gripper-host"), &tls_endpoint(), true).await;
+    let misspelt: Port<f32, bool, usage::Receive> = Port::new(PortSpec::new("GIRP", "GRIPPER"));
+    let not_admitted = ZenohError::NotAdmitted {
+        port: "GIRP".into(),
+    };
+    assert_eq!(export(&host, &misspelt).await.unwrap_err(), not_admitted);
+    let imported =
+        import::<Imported<f32, bool, usage::Receive>>(&host, "GIRP", "GRIPPER", "ROBOT").await;
+    assert_eq!(imported.unwrap_err(), not_admitted);
+    assert!(not_admitted.to_string().contains("HostBuilder::admit"));
+}
