@@ -26,7 +26,7 @@ use crate::export::InFlight;
 use crate::sweep::sweep_dead;
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
-    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -615,26 +615,34 @@ fn handshake<Req: Wire, Rep: Wire>(
     let deadline = Instant::now() + CONNECT_TIMEOUT;
     while Instant::now() < deadline {
         if let Ok(Some(response)) = pending.receive() {
-            let meta = *response.user_header();
-            let (port, module) = (port.clone(), Name::from(module));
-            return match meta.status {
-                OK => Ok(meta.detail == TIGHT),
-                NOT_ON_USER_LIST => {
-                    Err(IpcError::Refused(WireError::NotOnUserList { port, module }))
-                }
-                TOO_MANY_USERS => Err(IpcError::Refused(WireError::TooManyUsers {
-                    port,
-                    module,
-                    capacity: meta.detail as usize,
-                })),
-                REFUSED => Err(transport(format!("the owner refused {module}"))),
-                status => Err(transport(format!("the owner answered status {status}"))),
-            };
+            return answered(*response.user_header(), port, module);
         }
         let _ = listener.timed_wait(|_| {}, TICK);
         let _ = wake_owner.notify();
     }
     Err(IpcError::NoOwner { port: port.clone() })
+}
+
+/// What the owner's answer to a connection says, as its header reads: whether the port is
+/// TIGHT, or why the module was refused. A status the owner should not have written is a
+/// transport error that names it.
+pub(crate) fn answered(meta: ReplyMeta, port: &Name, module: &str) -> Result<bool, IpcError> {
+    let transport = |detail: String| IpcError::Transport {
+        port: port.clone(),
+        detail,
+    };
+    let (port, module) = (port.clone(), Name::from(module));
+    match meta.status {
+        OK => Ok(meta.detail == TIGHT),
+        NOT_ON_USER_LIST => Err(IpcError::Refused(WireError::NotOnUserList { port, module })),
+        TOO_MANY_USERS => Err(IpcError::Refused(WireError::TooManyUsers {
+            port,
+            module,
+            capacity: meta.detail as usize,
+        })),
+        REFUSED => Err(transport(format!("the owner refused {module}"))),
+        status => Err(transport(format!("the owner answered status {status}"))),
+    }
 }
 
 /// The bridge's task: does the bridge's work where a wake-up could not be served where it

@@ -158,6 +158,10 @@ mod dispatch;
 mod entry;
 mod error;
 mod export;
+// What reads a peer's bytes, for the fuzz targets in `fuzz/` (`cargo fuzz` sets the cfg).
+#[cfg(fuzzing)]
+#[doc(hidden)]
+pub mod fuzzing;
 mod import;
 mod send_all;
 mod sweep;

@@ -26,8 +26,9 @@ pub(crate) struct Admitted {
     pub(crate) port: String,
     /// The host of the port's owner: it alone may serve the port.
     pub(crate) owner: String,
-    /// The hosts of the modules on the port's user list: they may ask it.
-    pub(crate) users: Vec<String>,
+    /// The modules on the port's user list, each with its host: a host may ask the port
+    /// for its own modules only.
+    pub(crate) users: Vec<(String, String)>,
 }
 
 /// The session settings for mutual TLS with `files`.
@@ -58,70 +59,133 @@ pub(crate) fn tls_settings(files: &TlsFiles) -> Vec<(&'static str, String)> {
 }
 
 /// zenoh's access control for `cell`, in JSON5: nothing is allowed but what `admitted`
-/// allows. On each port's keys, its owner's host may do anything; its users' hosts may ask
-/// it (queries), watch its owner's token, hold tokens of their own modules and serve their
-/// modules' `deliver` keys, and are sent its replies, its owner's token and its broadcasts;
-/// any other host is let do nothing.
+/// allows. On each port's keys, its owner's host may do anything; each user's host may ask
+/// it for its own modules (connections and requests on keys that end with the module's
+/// name), watch its owner's token, hold its own modules' tokens and serve their `deliver`
+/// keys, and is sent the port's replies, its owner's token and its broadcasts; any other
+/// host is let do nothing.
 pub(crate) fn access_control(cell: &str, admitted: &[Admitted]) -> Result<String, ZenohError> {
+    let quoted = |text: &str| serde_json::Value::from(text).to_string();
+    let list = |keys: &[String]| {
+        keys.iter()
+            .map(|k| quoted(k))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let (mut rules, mut subjects, mut policies) = (Vec::new(), Vec::new(), Vec::new());
+    let mut rule = |id: &str, flow: &str, messages: &[&str], keys: &[String]| {
+        let messages = messages.iter().map(|m| quoted(m)).collect::<Vec<_>>();
+        rules.push(format!(
+            "{{ id: {}, flows: [{flow}], permission: \"allow\", messages: [{}], \
+             key_exprs: [{}] }}",
+            quoted(id),
+            messages.join(", "),
+            list(keys)
+        ));
+    };
+    const BOTH: &str = "\"egress\", \"ingress\"";
+    const IN: &str = "\"ingress\"";
+    const OUT: &str = "\"egress\"";
     for (i, port) in admitted.iter().enumerate() {
-        checked("port", &port.port)?;
-        let key = |kind: &str| format!("\"imrs/{cell}/{kind}/{}\"", port.port);
-        let asked = [key("port"), key("connect"), key("live")].join(", ");
-        let tokens = format!("\"imrs/{cell}/user/{}/**\"", port.port);
-        let deliver = format!("\"imrs/{cell}/deliver/{}/**\"", port.port);
-        let names = |hosts: &[String]| {
-            hosts
-                .iter()
-                .map(|h| serde_json::Value::from(h.as_str()).to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        rules.push(format!(
-            "{{ id: \"owner{i}\", flows: [\"egress\", \"ingress\"], permission: \"allow\", \
-             messages: [\"put\", \"delete\", \"declare_subscriber\", \"query\", \"reply\", \
-             \"declare_queryable\", \"liveliness_token\", \"liveliness_query\", \
-             \"declare_liveliness_subscriber\"], key_exprs: [{asked}, {tokens}, {deliver}] }}"
-        ));
-        rules.push(format!(
-            "{{ id: \"ask{i}\", flows: [\"ingress\"], permission: \"allow\", \
-             messages: [\"query\", \"liveliness_query\", \"declare_liveliness_subscriber\"], \
-             key_exprs: [{asked}] }}"
-        ));
-        rules.push(format!(
-            "{{ id: \"hold{i}\", flows: [\"ingress\"], permission: \"allow\", \
-             messages: [\"liveliness_token\"], key_exprs: [{tokens}] }}"
-        ));
-        rules.push(format!(
-            "{{ id: \"told{i}\", flows: [\"egress\"], permission: \"allow\", \
-             messages: [\"reply\", \"declare_queryable\", \"liveliness_token\", \"declare_liveliness_subscriber\"], \
-             key_exprs: [{asked}, {tokens}] }}"
-        ));
-        // For a port whose owner starts each rendezvous: each user's host serves its
-        // modules' `deliver` keys, which the owner's host asks.
-        rules.push(format!(
-            "{{ id: \"serve{i}\", flows: [\"ingress\"], permission: \"allow\", \
-             messages: [\"declare_queryable\", \"reply\"], key_exprs: [{deliver}] }}"
-        ));
-        rules.push(format!(
-            "{{ id: \"reach{i}\", flows: [\"egress\"], permission: \"allow\", \
-             messages: [\"query\", \"liveliness_query\"], key_exprs: [{deliver}, {tokens}] }}"
-        ));
+        let p = checked("port", &port.port)?;
+        let key = |kind: &str, rest: &str| format!("imrs/{cell}/{kind}/{p}{rest}");
+        let live = key("live", "");
+        let (requests, connects) = (key("port", "/*"), key("connect", "/*"));
+        let (tokens, deliver) = (key("user", "/**"), key("deliver", "/**"));
+        rule(
+            &format!("owner{i}"),
+            BOTH,
+            &[
+                "put",
+                "delete",
+                "declare_subscriber",
+                "query",
+                "reply",
+                "declare_queryable",
+                "liveliness_token",
+                "liveliness_query",
+                "declare_liveliness_subscriber",
+            ],
+            &[
+                requests.clone(),
+                connects.clone(),
+                live.clone(),
+                tokens.clone(),
+                deliver.clone(),
+            ],
+        );
         subjects.push(format!(
             "{{ id: \"owner{i}\", cert_common_names: [{}] }}",
-            names(std::slice::from_ref(&port.owner))
+            quoted(&port.owner)
         ));
         policies.push(format!(
             "{{ rules: [\"owner{i}\"], subjects: [\"owner{i}\"] }}"
         ));
-        if !port.users.is_empty() {
+        if port.users.is_empty() {
+            continue;
+        }
+        // To every user's host: the owner's replies, declarations and token, its
+        // broadcasts and queries on the `deliver` keys, and its looks at the users' tokens.
+        rule(
+            &format!("told{i}"),
+            OUT,
+            &[
+                "reply",
+                "declare_queryable",
+                "liveliness_token",
+                "declare_liveliness_subscriber",
+            ],
+            &[requests, connects, live.clone(), tokens.clone()],
+        );
+        rule(
+            &format!("reach{i}"),
+            OUT,
+            &["query", "liveliness_query"],
+            &[deliver, tokens],
+        );
+        // From each user's host: what its own modules do, on keys named for them.
+        let mut hosts: std::collections::BTreeMap<&str, Vec<&str>> = Default::default();
+        for (module, host) in &port.users {
+            hosts
+                .entry(host)
+                .or_default()
+                .push(checked("module", module)?);
+        }
+        for (j, (host, modules)) in hosts.into_iter().enumerate() {
+            let each = |kind: &str| -> Vec<String> {
+                modules
+                    .iter()
+                    .map(|m| key(kind, &format!("/{m}")))
+                    .collect()
+            };
+            let mut asked = each("port");
+            asked.extend(each("connect"));
+            asked.push(live.clone());
+            rule(
+                &format!("ask{i}_{j}"),
+                IN,
+                &["query", "liveliness_query", "declare_liveliness_subscriber"],
+                &asked,
+            );
+            rule(
+                &format!("hold{i}_{j}"),
+                IN,
+                &["liveliness_token"],
+                &each("user"),
+            );
+            rule(
+                &format!("serve{i}_{j}"),
+                IN,
+                &["declare_queryable", "reply"],
+                &each("deliver"),
+            );
             subjects.push(format!(
-                "{{ id: \"users{i}\", cert_common_names: [{}] }}",
-                names(&port.users)
+                "{{ id: \"user{i}_{j}\", cert_common_names: [{}] }}",
+                quoted(host)
             ));
             policies.push(format!(
-                "{{ rules: [\"ask{i}\", \"hold{i}\", \"told{i}\", \"serve{i}\", \"reach{i}\"], \
-                 subjects: [\"users{i}\"] }}"
+                "{{ rules: [\"told{i}\", \"reach{i}\", \"ask{i}_{j}\", \"hold{i}_{j}\", \
+                 \"serve{i}_{j}\"], subjects: [\"user{i}_{j}\"] }}"
             ));
         }
     }

@@ -37,6 +37,14 @@ pub enum ZenohError {
         /// The port.
         port: String,
     },
+    /// A module this host does not admit to a port it admits
+    /// ([`HostBuilder::admit`](crate::HostBuilder::admit)).
+    ModuleNotAdmitted {
+        /// The port.
+        port: String,
+        /// The module.
+        module: String,
+    },
     /// A message that could not be encoded, or bytes that are not the port's message.
     Encoding {
         /// The port.
@@ -69,6 +77,11 @@ impl fmt::Display for ZenohError {
                 f,
                 "port {port} is not admitted on this host, which admits ports: admit it \
                  (HostBuilder::admit) on its owner's host and on each of its users'"
+            ),
+            Self::ModuleNotAdmitted { port, module } => write!(
+                f,
+                "module {module} is not admitted to port {port} on this host: admit it with \
+                 its host (HostBuilder::admit) on the port's owner's host and on its own"
             ),
             Self::Encoding { port, reason } => write!(f, "port {port}: {reason}"),
         }

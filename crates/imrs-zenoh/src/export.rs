@@ -229,7 +229,7 @@ where
         let (users, attach, port) = (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
         let claim = Arc::clone(&claim);
         session
-            .declare_queryable(&keys.request)
+            .declare_queryable(keys.requests())
             .callback(move |query| {
                 let (users, attach, port) =
                     (Arc::clone(&users), Arc::clone(&attach), Arc::clone(&port));
@@ -255,7 +255,7 @@ where
                     users.renew(module).await;
                 }
                 let answer = module.and_then(|module| {
-                    let (_, timeout, _) = users.end(&module, &*claim, |m| attach(m))?;
+                    let (_, timeout, _) = users.end(module, &*claim, |m| attach(m))?;
                     let connected = Connected {
                         owner: owner.clone(),
                         timeout_ms: timeout.map_or(0, |t| t.as_millis().max(1) as u64),
@@ -292,7 +292,7 @@ where
     E: Forward<Req, Rep>,
 {
     let module = module_of(query)?;
-    let (end, _, mut gone) = users.end(&module, claim, attach)?;
+    let (end, _, mut gone) = users.end(module, claim, attach)?;
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
     let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
     // One request of a module at a time, as in one process: its next waits here.
@@ -308,14 +308,32 @@ where
     encode(port, &reply).map_err(|e| e.to_string())
 }
 
-/// The module a query comes from: its attachment, the module's name in UTF-8.
-/// Read where it lies when the attachment is one slice, as it is for a name.
-pub(crate) fn module_of(query: &Query) -> Result<Cow<'_, str>, String> {
+/// The module a request or a connection comes from: the last chunk of its key, which
+/// access control lets only the module's own host ask.
+pub(crate) fn module_of(query: &Query) -> Result<&str, String> {
+    module_in(query.key_expr().as_str())
+}
+
+/// The module a key of a request or a connection names, checked as part of a key
+/// expression (a query for a wildcard names none).
+pub(crate) fn module_in(key: &str) -> Result<&str, String> {
+    let module = key.rsplit('/').next().unwrap_or_default();
+    checked("module", module).map_err(|e| e.to_string())
+}
+
+/// The module that asks a `deliver` key: the attachment, its name in UTF-8.
+pub(crate) fn sender_of(query: &Query) -> Result<Cow<'_, str>, String> {
     let attachment = query
         .attachment()
-        .ok_or("a request names no module: its attachment must be the module's name")?;
+        .ok_or("a delivery names no sender: its attachment must be the owner's name")?;
+    module_from(attachment.to_bytes())
+}
+
+/// The module's name an attachment holds, checked as part of a key expression. Read where
+/// it lies when the attachment is one slice, as it is for a name.
+pub(crate) fn module_from(attachment: Cow<'_, [u8]>) -> Result<Cow<'_, str>, String> {
     let not_utf8 = |_| "a request's module name is not UTF-8".to_owned();
-    let module = match attachment.to_bytes() {
+    let module = match attachment {
         Cow::Borrowed(bytes) => Cow::Borrowed(std::str::from_utf8(bytes).map_err(not_utf8)?),
         Cow::Owned(bytes) => {
             Cow::Owned(String::from_utf8(bytes).map_err(|e| not_utf8(e.utf8_error()))?)

@@ -16,8 +16,9 @@ pub struct Host {
     pub(crate) session: zenoh::Session,
     pub(crate) cell: String,
     pub(crate) lease: Duration,
-    /// The ports admitted, if this host admits ports: no other can cross.
-    admitted: Option<Vec<String>>,
+    /// The ports admitted and their users' modules, if this host admits ports: no other
+    /// port can cross, and no other module use one.
+    admitted: Option<Vec<(String, Vec<String>)>>,
 }
 
 /// How to open a [`Host`]: its endpoints and lease.
@@ -66,13 +67,34 @@ impl Host {
     /// Refuses, naming it, a port this host cannot carry: one it does not admit, when it
     /// admits ports. Without the check such a port would only ever time out.
     pub(crate) fn carries(&self, port: &str) -> Result<(), ZenohError> {
-        match &self.admitted {
-            Some(ports) if !ports.iter().any(|admitted| admitted == port) => {
-                Err(ZenohError::NotAdmitted {
+        self.admitted_users(port).map(drop)
+    }
+
+    /// Refuses, naming them, a port this host cannot carry, or a module it does not admit to
+    /// the port as one of its users, when it admits ports.
+    pub(crate) fn carries_for(&self, port: &str, module: &str) -> Result<(), ZenohError> {
+        match self.admitted_users(port)? {
+            Some(users) if !users.iter().any(|user| user == module) => {
+                Err(ZenohError::ModuleNotAdmitted {
                     port: port.to_owned(),
+                    module: module.to_owned(),
                 })
             }
             _ => Ok(()),
+        }
+    }
+
+    /// The modules admitted to use `port`, if this host admits ports; refused if it admits
+    /// ports but not this one.
+    fn admitted_users(&self, port: &str) -> Result<Option<&[String]>, ZenohError> {
+        let Some(ports) = &self.admitted else {
+            return Ok(None);
+        };
+        match ports.iter().find(|(admitted, _)| admitted == port) {
+            Some((_, users)) => Ok(Some(users)),
+            None => Err(ZenohError::NotAdmitted {
+                port: port.to_owned(),
+            }),
         }
     }
 
@@ -111,21 +133,32 @@ impl HostBuilder {
     }
 
     /// Admits to port `port`'s keys on this host only `owner_host`, the host of its owner,
-    /// which alone may serve it, and `user_hosts`, the hosts of the modules on its user list,
-    /// which may ask it; each host is named by its certificate's common name. Once any port
-    /// is admitted, this host lets no other host do anything else: every port that crosses
-    /// to or from it must be admitted, on the owner's host and on each user's. Needs
-    /// [`tls`](Self::tls).
-    pub fn admit<S: Into<String>>(
+    /// which alone may serve it, and the `(module, host)` pairs of `users`: each module on
+    /// the port's user list with the host it runs on, which may ask the port for that module
+    /// and no other. Hosts are named by their certificates' common names. Once any port is
+    /// admitted, this host lets no other host do anything else: every port that crosses to
+    /// or from it must be admitted, on the owner's host and on each user's, and a module not
+    /// admitted to a port cannot import it. Needs [`tls`](Self::tls).
+    ///
+    /// ```
+    /// # let files = imrs_zenoh::TlsFiles { authority: "a".into(), certificate: "c".into(), key: "k".into() };
+    /// let builder = imrs_zenoh::Host::builder("my_cell")
+    ///     .tls(files)
+    ///     .admit("GRIP", "gripper-host", [("ROBOT_1", "robot-host"), ("ROBOT_2", "robot-host")]);
+    /// ```
+    pub fn admit<M: Into<String>, H: Into<String>>(
         mut self,
         port: &str,
         owner_host: &str,
-        user_hosts: impl IntoIterator<Item = S>,
+        users: impl IntoIterator<Item = (M, H)>,
     ) -> Self {
         self.admitted.push(Admitted {
             port: port.to_owned(),
             owner: owner_host.to_owned(),
-            users: user_hosts.into_iter().map(Into::into).collect(),
+            users: users
+                .into_iter()
+                .map(|(module, host)| (module.into(), host.into()))
+                .collect(),
         });
         self
     }
@@ -175,8 +208,15 @@ impl HostBuilder {
                 .map_err(|error| ZenohError::session(format!("{key} = {value}: {error}")))?;
         }
         let session = zenoh::open(config).await.map_err(ZenohError::session)?;
-        let admitted = (!self.admitted.is_empty())
-            .then(|| self.admitted.iter().map(|a| a.port.clone()).collect());
+        let admitted = (!self.admitted.is_empty()).then(|| {
+            self.admitted
+                .iter()
+                .map(|a| {
+                    let users = a.users.iter().map(|(module, _)| module.clone()).collect();
+                    (a.port.clone(), users)
+                })
+                .collect()
+        });
         Ok(Host {
             session,
             cell: self.cell,

@@ -137,7 +137,7 @@ pub(crate) async fn begin(
     module: &str,
 ) -> Result<(Keys, Watch), ZenohError> {
     let keys = Keys::new(&host.cell, port)?;
-    host.carries(port)?;
+    host.carries_for(port, module)?;
     checked("module", owner)?;
     checked("module", module)?;
     let watch = Watch::owner(&host.session, &keys.live, port, CONNECT_TIMEOUT).await?;
@@ -161,6 +161,16 @@ pub(crate) async fn connect_to(
             reason: format!("{owner} does not own it; {} does", connected.owner),
         })
     }
+}
+
+/// The port's TIMEOUT for the module, as the owner's host answered it, and how long each of
+/// the module's requests waits for its reply: a little past the TIMEOUT, so that the sender
+/// hears its own `ReplyTimeout` first, and the bridge, free again, takes its next send in
+/// time.
+pub(crate) fn waits(connected: &Connected) -> (Option<Duration>, Duration) {
+    let timeout = (connected.timeout_ms > 0).then(|| Duration::from_millis(connected.timeout_ms));
+    let wait = timeout.map_or(NO_TIMEOUT, |t| t.saturating_add(AFTER_TIMEOUT));
+    (timeout, wait)
 }
 
 /// Connects `module` to `port` and starts the bridge of its local side, `T`.
@@ -187,19 +197,17 @@ where
         .map_err(ZenohError::session)?;
     let connected = connect_to(host, &keys, port, owner, module).await?;
     let mut spec = PortSpec::new(port, owner);
-    let timeout = (connected.timeout_ms > 0).then(|| Duration::from_millis(connected.timeout_ms));
+    let (timeout, wait) = waits(&connected);
     if let Some(timeout) = timeout {
         spec = spec.user_timeout(timeout);
     }
     let local = Port::<Req, Rep, U, AnyUser, 1>::new(spec);
     let asking = Asking {
         session: session.clone(),
-        key: keys.request.clone(),
-        name: module.into(),
+        key: keys.request(module),
+        name: None,
         port: port.to_owned(),
-        // A little past the TIMEOUT: the sender hears its own `ReplyTimeout` first, and the
-        // bridge, free again, takes its next send in time.
-        wait: timeout.map_or(NO_TIMEOUT, |t| t + AFTER_TIMEOUT),
+        wait,
     };
     let owner: Arc<str> = owner.into();
     let bridged = local.clone();
@@ -277,8 +285,9 @@ impl Drop for GoneOnDrop {
 pub(crate) struct Asking {
     pub(crate) session: zenoh::Session,
     pub(crate) key: String,
-    /// The asking module's name, the attachment of every request: made once, shared.
-    pub(crate) name: zenoh::bytes::ZBytes,
+    /// The owner's name, the attachment of what it delivers to a module: made once, shared.
+    /// A module's own requests are named by their key, and carry none.
+    pub(crate) name: Option<zenoh::bytes::ZBytes>,
     pub(crate) port: String,
     /// How long a request waits for its reply.
     pub(crate) wait: Duration,
@@ -354,8 +363,7 @@ pub(crate) async fn connect(
 ) -> Result<Connected, ZenohError> {
     let replies = host
         .session
-        .get(&keys.connect)
-        .attachment(module.as_bytes())
+        .get(keys.connect(module))
         .timeout(CONNECT_TIMEOUT)
         .await
         .map_err(ZenohError::session)?;

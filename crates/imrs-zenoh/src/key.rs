@@ -1,8 +1,10 @@
 //! The key expressions a cell's ports use on zenoh, and the names allowed in them.
 //!
-//! - `imrs/<cell>/port/<PORT>`: a module's request (a send, a query) to the port's owner.
-//! - `imrs/<cell>/connect/<PORT>`: a module's connection, checked against the port's
-//!   restrictions before any request.
+//! - `imrs/<cell>/port/<PORT>/<MODULE>`: a module's request (a send, a query) to the port's
+//!   owner. The module is named by the key, so that access control can bind a module's
+//!   name to its host.
+//! - `imrs/<cell>/connect/<PORT>/<MODULE>`: a module's connection, checked against the
+//!   port's restrictions before any request.
 //! - `imrs/<cell>/live/<PORT>`: a liveliness token, held by the owner's host while it
 //!   exports the port.
 //! - `imrs/<cell>/user/<PORT>/<MODULE>`: a liveliness token, held by a user's host while
@@ -35,8 +37,8 @@ pub(crate) fn checked<'a>(what: &'static str, name: &'a str) -> Result<&'a str, 
 /// The keys of one port of one cell.
 #[derive(Debug, Clone)]
 pub(crate) struct Keys {
-    pub(crate) request: String,
-    pub(crate) connect: String,
+    request: String,
+    connect: String,
     pub(crate) live: String,
     user: String,
     deliver: String,
@@ -52,6 +54,26 @@ impl Keys {
             user: format!("imrs/{cell}/user/{port}"),
             deliver: format!("imrs/{cell}/deliver/{port}"),
         })
+    }
+
+    /// Where `module`'s requests go.
+    pub(crate) fn request(&self, module: &str) -> String {
+        format!("{}/{module}", self.request)
+    }
+
+    /// Where `module` connects.
+    pub(crate) fn connect(&self, module: &str) -> String {
+        format!("{}/{module}", self.connect)
+    }
+
+    /// Where the owner's host takes every module's requests.
+    pub(crate) fn requests(&self) -> String {
+        format!("{}/*", self.request)
+    }
+
+    /// Where the owner's host takes every module's connections.
+    pub(crate) fn connects(&self) -> String {
+        format!("{}/*", self.connect)
     }
 
     /// The key under which the importing hosts' tokens for the port's users lie.
@@ -94,9 +116,8 @@ mod tests {
             assert!(error.to_string().contains(&format!("{name:?}")), "{error}");
         }
         assert_eq!(checked("module", "ROBOT_1").unwrap(), "ROBOT_1");
-        assert_eq!(
-            Keys::new("cell", "DOUBLE").unwrap().request,
-            "imrs/cell/port/DOUBLE"
-        );
+        let keys = Keys::new("cell", "DOUBLE").unwrap();
+        assert_eq!(keys.request("ROBOT_1"), "imrs/cell/port/DOUBLE/ROBOT_1");
+        assert_eq!(keys.requests(), "imrs/cell/port/DOUBLE/*");
     }
 }

@@ -60,8 +60,8 @@
 //!
 //! | key | what |
 //! |---|---|
-//! | `imrs/<cell>/port/<PORT>` | a request: a zenoh query whose payload is the message in CDR (below) and whose attachment is the asking module's name in UTF-8; the reply's payload is the answer in CDR, or an error reply whose payload is the reason in UTF-8, naming the port |
-//! | `imrs/<cell>/connect/<PORT>` | a module's connection: a query with the module's name as attachment; answered with the owner's name and the port's TIMEOUT in milliseconds (a CDR struct of a string and a `u64`, 0 for none), or an error reply naming the port and the restriction refused |
+//! | `imrs/<cell>/port/<PORT>/<MODULE>` | module `MODULE`'s request: a zenoh query whose payload is the message in CDR (below); the reply's payload is the answer in CDR, or an error reply whose payload is the reason in UTF-8, naming the port |
+//! | `imrs/<cell>/connect/<PORT>/<MODULE>` | module `MODULE`'s connection: a query; answered with the owner's name and the port's TIMEOUT in milliseconds (a CDR struct of a string and a `u64`, 0 for none), or an error reply naming the port and the restriction refused |
 //! | `imrs/<cell>/live/<PORT>` | a liveliness token, held by the owner's host while it exports the port |
 //! | `imrs/<cell>/user/<PORT>/<MODULE>` | a liveliness token, held by a user's host while it imports the port for the module |
 //! | `imrs/<cell>/deliver/<PORT>/<MODULE>` | for `SENDALL`, `CALLALL` and `QUERY` ports: the user's host's queryable, where the owner's broadcasts and queries reach the module (attachment: the owner's name), answered with the module's reply in CDR |
@@ -76,6 +76,10 @@ mod connected;
 mod error;
 mod export;
 mod forward;
+// What reads a peer's bytes, for the fuzz targets in `fuzz/` (`cargo fuzz` sets the cfg).
+#[cfg(fuzzing)]
+#[doc(hidden)]
+pub mod fuzzing;
 mod host;
 mod import;
 mod key;

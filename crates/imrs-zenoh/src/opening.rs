@@ -41,7 +41,7 @@ impl Opening {
             });
         }
         let connects = session
-            .declare_queryable(&keys.connect)
+            .declare_queryable(keys.connects())
             .await
             .map_err(ZenohError::session)?;
         let leaving = session

@@ -20,7 +20,7 @@ use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, WireError, usage};
 use tokio::task::JoinHandle;
 
 use crate::connected::Connected;
-use crate::export::{Claim, Exported, module_of, reply};
+use crate::export::{Claim, Exported, module_of, reply, sender_of};
 use crate::import::{Asking, NO_TIMEOUT, ask, begin, connect_to, reconnect};
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
@@ -87,7 +87,7 @@ where
                     let mut running = relays.lock();
                     // A relay that has ended (its module gone, or its end closed) is made
                     // anew for a module that connects again.
-                    let module = module.into_owned();
+                    let module = module.to_owned();
                     if running
                         .get(&module)
                         .is_some_and(|(relay, _)| relay.is_finished())
@@ -106,7 +106,7 @@ where
                         let asking = Asking {
                             session: session.clone(),
                             key: keys.deliver(module),
-                            name: owner.as_str().into(),
+                            name: Some(owner.as_str().into()),
                             port: port.clone(),
                             wait: NO_TIMEOUT,
                         };
@@ -329,7 +329,7 @@ where
     U: Usage,
     End<Req, Rep, U>: Deliver<Req, Rep>,
 {
-    if module_of(query)? != owner {
+    if sender_of(query)? != owner {
         return Err(format!("only {owner} broadcasts on port {port}"));
     }
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();

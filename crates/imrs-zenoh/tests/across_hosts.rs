@@ -288,9 +288,8 @@ async fn a_refused_claim_is_answered_by_name_and_leaves_no_name_behind() {
     for module in &claims {
         let replies = peer_host
             .session()
-            .get("imrs/claim_cell/port/GATE")
+            .get(format!("imrs/claim_cell/port/GATE/{module}"))
             .payload(vec![0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0])
-            .attachment(module.as_bytes())
             .await
             .unwrap();
         let reply = within(PROMPTLY, "a claim's answer", replies.recv_async())

@@ -40,7 +40,9 @@ def read_string(payload):
 
 
 def ask(session, key, payload, module):
-    replies = list(session.get(key, payload=payload, attachment=module.encode(), timeout=10.0))
+    # The asking module is the key's last chunk.
+    key = f"{key}/{module}"
+    replies = list(session.get(key, payload=payload, timeout=10.0))
     assert len(replies) == 1, f"{key}: {len(replies)} replies"
     reply = replies[0]
     if reply.ok is not None:

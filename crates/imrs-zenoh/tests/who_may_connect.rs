@@ -2,7 +2,8 @@
 //! cell's authority, over mutual TLS; on each port's keys, zenoh's access control lets in
 //! only the host of its owner and the hosts of the modules on its user list. A host without
 //! a certificate, and one with a valid certificate that is not admitted, get nothing — not
-//! even under a module name on the list — and cannot pass for the owner.
+//! even under a module name on the list — and cannot pass for the owner; an admitted host
+//! cannot pass for another host's module.
 
 mod common;
 
@@ -73,13 +74,15 @@ fn tls_endpoint() -> String {
     common::free_endpoint().replacen("tcp/", "tls/", 1)
 }
 
+/// GRIP's users, each with its host.
+const GRIP_USERS: [(&str, &str); 2] = [("ROBOT", "robot-host"), ("PANEL", "panel-host")];
+
 /// A host of the cell with `files`, admitting GRIP as the wiring says, listening or
 /// connecting on `endpoint`.
 async fn host(files: TlsFiles, endpoint: &str, listens: bool) -> Host {
-    let builder =
-        Host::builder("tls_cell")
-            .tls(files)
-            .admit("GRIP", "gripper-host", ["robot-host"]);
+    let builder = Host::builder("tls_cell")
+        .tls(files)
+        .admit("GRIP", "gripper-host", GRIP_USERS);
     let builder = if listens {
         builder.listen(endpoint)
     } else {
@@ -129,7 +132,7 @@ async fn only_admitted_hosts_reach_a_port_and_none_passes_for_its_owner() {
     let gripper_endpoint = tls_endpoint();
     let gripper_host = Host::builder("tls_cell")
         .tls(authority.host("gripper-host"))
-        .admit("GRIP", "gripper-host", ["robot-host"])
+        .admit("GRIP", "gripper-host", GRIP_USERS)
         .connect(&endpoint)
         .listen(&gripper_endpoint)
         .open()
@@ -182,7 +185,7 @@ async fn only_admitted_hosts_reach_a_port_and_none_passes_for_its_owner() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn admitting_ports_without_tls_is_refused_by_name() {
     let refused = Host::builder("tls_cell")
-        .admit("GRIP", "gripper-host", ["robot-host"])
+        .admit("GRIP", "gripper-host", GRIP_USERS)
         .open()
         .await
         .err()
@@ -202,7 +205,7 @@ async fn an_admitted_broadcast_reaches_its_listener() {
     let open = |name: &str, listens: bool| {
         let builder = Host::builder("tls_alarm_cell")
             .tls(authority.host(name))
-            .admit("ALARM", "line-host", ["panel-host"]);
+            .admit("ALARM", "line-host", [("PANEL", "panel-host")]);
         let builder = if listens {
             builder.listen(&endpoint)
         } else {
@@ -249,4 +252,67 @@ async fn a_port_the_host_does_not_admit_is_refused_at_once_by_name() {
         import::<Imported<f32, bool, usage::Receive>>(&host, "GIRP", "GRIPPER", "ROBOT").await;
     assert_eq!(imported.unwrap_err(), not_admitted);
     assert!(not_admitted.to_string().contains("HostBuilder::admit"));
+}
+
+/// Module names are bound to hosts: a host admitted for one of a port's modules, that claims
+/// another module's name on the port, is refused by the owner's host, though it is served
+/// under its own module's name.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_admitted_host_cannot_claim_another_hosts_module() {
+    let authority = Authority::new("bound");
+    let endpoint = tls_endpoint();
+    let gripper_host = host(authority.host("gripper-host"), &endpoint, true).await;
+    let grip: Port<f32, bool, usage::Receive, AnyUser, 2> =
+        Port::new(PortSpec::new("GRIP", "GRIPPER").user_list(["ROBOT", "PANEL"]));
+    let _exported = export(&gripper_host, &grip).await.unwrap();
+    let mut gripper = grip.owner().unwrap();
+    tokio::spawn(async move {
+        while let Ok((width, reply)) = gripper.receive().await {
+            reply.reply(width < 0.05);
+        }
+    });
+    // The panel's host, admitted for PANEL, its own admissions left out so that nothing on
+    // its side stops it: served as PANEL, refused as ROBOT, whose host is robot-host.
+    let panel_host = Host::builder("tls_cell")
+        .tls(authority.host("panel-host"))
+        .connect(&endpoint)
+        .open()
+        .await
+        .unwrap();
+    let panel: Imported<f32, bool, usage::Receive> =
+        import(&panel_host, "GRIP", "GRIPPER", "PANEL")
+            .await
+            .unwrap();
+    let mut panel = panel.port().user_named("PANEL").unwrap();
+    let closed = within(PROMPTLY, "the panel's own request", panel.send(0.01)).await;
+    assert!(closed.unwrap());
+    let claimed =
+        import::<Imported<f32, bool, usage::Receive>>(&panel_host, "GRIP", "GRIPPER", "ROBOT")
+            .await
+            .unwrap_err();
+    assert_eq!(
+        claimed,
+        ZenohError::NoOwner {
+            port: "GRIP".into()
+        }
+    );
+    assert_eq!(grip.users_attached(), 1, "ROBOT's place was taken");
+
+    // A host that admits GRIP refuses at once, by name, a module it does not admit.
+    let robot_host = host(authority.host("robot-host"), &endpoint, false).await;
+    let stranger =
+        import::<Imported<f32, bool, usage::Receive>>(&robot_host, "GRIP", "GRIPPER", "STRANGER")
+            .await
+            .unwrap_err();
+    assert_eq!(
+        stranger,
+        ZenohError::ModuleNotAdmitted {
+            port: "GRIP".into(),
+            module: "STRANGER".into()
+        }
+    );
+    assert!(
+        stranger.to_string().contains("module STRANGER"),
+        "{stranger}"
+    );
 }
