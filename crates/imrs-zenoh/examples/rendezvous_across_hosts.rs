@@ -14,7 +14,7 @@ mod common;
 use std::process::Stdio;
 use std::time::Instant;
 
-use common::{cdr, read, rounds, table};
+use common::{Namespace, cdr, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
@@ -68,7 +68,7 @@ async fn serve(endpoint: &str) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::Error>> {
-    let namespace = netns.then(Namespace::make).transpose()?;
+    let namespace = netns.then(|| Namespace::make(0)).transpose()?;
     let endpoint = match &namespace {
         Some(ns) => format!("tcp/{}:7447", ns.inside),
         None => {
@@ -78,11 +78,7 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
     };
     let me = std::env::current_exe()?;
     let mut command = match &namespace {
-        Some(ns) => {
-            let mut c = tokio::process::Command::new("ip");
-            c.args(["netns", "exec", &ns.name]).arg(&me);
-            c
-        }
+        Some(ns) => ns.command(&me),
         None => tokio::process::Command::new(&me),
     };
     let mut owner = command
@@ -146,66 +142,4 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
     );
     owner.start_kill()?;
     Ok(())
-}
-
-/// A network namespace joined to this one by a veth link, removed when dropped.
-struct Namespace {
-    name: String,
-    inside: String,
-}
-
-impl Namespace {
-    fn make() -> Result<Self, Box<dyn std::error::Error>> {
-        let id = std::process::id() % 100_000;
-        let name = format!("imrsb-{id}");
-        let (outside, inside_dev) = (format!("imrsbo{id}"), format!("imrsbi{id}"));
-        let subnet = format!("10.{}.{}", 200 + id % 50, id / 100 % 250);
-        let ns = Self {
-            name: name.clone(),
-            inside: format!("{subnet}.2"),
-        };
-        let steps: [&[&str]; 7] = [
-            &["netns", "add", &name],
-            &[
-                "link",
-                "add",
-                &outside,
-                "type",
-                "veth",
-                "peer",
-                "name",
-                &inside_dev,
-                "netns",
-                &name,
-            ],
-            &["addr", "add", &format!("{subnet}.1/30"), "dev", &outside],
-            &["link", "set", &outside, "up"],
-            &[
-                "-n",
-                &name,
-                "addr",
-                "add",
-                &format!("{subnet}.2/30"),
-                "dev",
-                &inside_dev,
-            ],
-            &["-n", &name, "link", "set", &inside_dev, "up"],
-            &["-n", &name, "link", "set", "lo", "up"],
-        ];
-        for step in steps {
-            let status = std::process::Command::new("ip").args(step).status()?;
-            if !status.success() {
-                return Err(format!("ip {} failed (root is needed)", step.join(" ")).into());
-            }
-        }
-        Ok(ns)
-    }
-}
-
-impl Drop for Namespace {
-    fn drop(&mut self) {
-        let _ = std::process::Command::new("ip")
-            .args(["netns", "del", &self.name])
-            .status();
-    }
 }

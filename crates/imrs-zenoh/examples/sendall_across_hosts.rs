@@ -1,9 +1,10 @@
 //! A broadcast to three hosts, beside raw zenoh in the same run.
 //!
-//! `cargo run --release -p imrs-zenoh --example sendall_across_hosts -- [--rounds N]`
+//! `cargo run --release -p imrs-zenoh --example sendall_across_hosts -- [--rounds N] [--netns]`
 //!
 //! This process is the owner's host: it exports ALARM, a `SENDALL` port of `u64`s, and
-//! starts three copies of itself as hosts of their own, each importing ALARM for a module
+//! starts three copies of itself as hosts of their own (each in a network namespace of its
+//! own, joined to this one by a veth link, with `--netns`, as root), each importing ALARM for a module
 //! that answers every broadcast `n` with `n`, and declaring beside it a raw zenoh queryable
 //! that does the same work (decode the CDR `u64`, answer it). It then times, in alternating
 //! blocks of 500, a `send_all` until all three replies are in, and a raw `get` of the three
@@ -15,7 +16,7 @@ mod common;
 use std::process::Stdio;
 use std::time::Instant;
 
-use common::{cdr, read, rounds, table};
+use common::{Namespace, cdr, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
@@ -37,7 +38,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return runtime.block_on(listen(endpoint, module));
     }
     let rounds = rounds(&args, 5_000)?;
-    runtime.block_on(measure(rounds))
+    let netns = args.iter().any(|a| a == "--netns");
+    runtime.block_on(measure(rounds, netns))
 }
 
 /// A listener's host: ALARM imported for `module`, and the raw queryable beside it.
@@ -65,18 +67,34 @@ async fn listen(endpoint: &str, module: &str) -> Result<(), Box<dyn std::error::
     Ok(())
 }
 
-async fn measure(rounds: usize) -> Result<(), Box<dyn std::error::Error>> {
-    let probe = std::net::TcpListener::bind("127.0.0.1:0")?;
-    let endpoint = format!("tcp/127.0.0.1:{}", probe.local_addr()?.port());
+async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::Error>> {
+    let namespaces = if netns {
+        (0..MODULES.len() as u32)
+            .map(Namespace::make)
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        Vec::new()
+    };
+    let probe = std::net::TcpListener::bind("0.0.0.0:0")?;
+    let port = probe.local_addr()?.port();
     drop(probe);
-    let host = Host::builder(CELL).listen(&endpoint).open().await?;
+    let host = Host::builder(CELL)
+        .listen(format!("tcp/0.0.0.0:{port}"))
+        .open()
+        .await?;
     let alarm: Port<u64, u64, usage::SendAll, AnyUser, 3> =
         Port::new(PortSpec::new("ALARM", "LINE").user_list(MODULES));
     let _exported = export(&host, &alarm).await?;
     let me = std::env::current_exe()?;
     let mut listeners = Vec::new();
-    for module in MODULES {
-        let mut child = tokio::process::Command::new(&me)
+    for (i, module) in MODULES.into_iter().enumerate() {
+        // Each listener reaches this host over its own link, or over loopback.
+        let (mut command, address) = match namespaces.get(i) {
+            Some(ns) => (ns.command(&me), ns.outside.as_str()),
+            None => (tokio::process::Command::new(&me), "127.0.0.1"),
+        };
+        let endpoint = format!("tcp/{address}:{port}");
+        let mut child = command
             .args(["--listen", &endpoint, module])
             .stdout(Stdio::piped())
             .kill_on_drop(true)
@@ -131,8 +149,13 @@ async fn measure(rounds: usize) -> Result<(), Box<dyn std::error::Error>> {
         // The first block of each warms the paths and is not counted.
         block += 1;
     }
+    let where_ = if netns {
+        "three network namespaces, a veth link each"
+    } else {
+        "processes, loopback"
+    };
     println!(
-        "{} broadcasts each, to three hosts (processes, loopback):\n",
+        "{} broadcasts each, to three hosts ({where_}):\n",
         imrs.len()
     );
     table(

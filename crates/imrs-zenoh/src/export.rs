@@ -16,6 +16,7 @@ use std::time::Duration;
 
 use imrs_ports::transport::Presence;
 use imrs_ports::{Port, UserList, WireError, usage};
+use tokio::sync::Semaphore;
 use tokio::task::JoinHandle;
 use zenoh::query::Query;
 
@@ -104,16 +105,25 @@ struct Attached<E> {
     /// Set when the module's host is gone: its requests still waiting are dropped, so that
     /// the last hold on its end goes and its user place is free again.
     gone: tokio::sync::watch::Sender<bool>,
+    /// Room for the module's requests waiting here at once.
+    room: Arc<Semaphore>,
 }
+
+/// The most requests of one module that wait here at once. A module's host asks one at a
+/// time; past this a peer that floods the port under a module's name is refused at once,
+/// so what it costs this host is bounded by the port's users times this.
+pub(crate) const MAX_WAITING: usize = 16;
 
 /// Attaches a remote module: its end, and the port's TIMEOUT for it as declared.
 type Attach<E> = dyn Fn(&str) -> Result<(E, Option<Duration>), WireError> + Send + Sync;
 
-/// A remote module's end, the port's TIMEOUT for it, and the word that its host is gone.
+/// A remote module's end, the port's TIMEOUT for it, the word that its host is gone, and
+/// the room for its requests.
 type Held<E> = (
     Arc<tokio::sync::Mutex<E>>,
     Option<Duration>,
     tokio::sync::watch::Receiver<bool>,
+    Arc<Semaphore>,
 );
 
 impl<E> Users<E> {
@@ -127,7 +137,8 @@ impl<E> Users<E> {
         let mut ends = self.ends.lock().unwrap_or_else(PoisonError::into_inner);
         if let Some(attached) = ends.get(module) {
             let end = Arc::clone(&attached.end);
-            return Ok((end, attached.timeout, attached.gone.subscribe()));
+            let room = Arc::clone(&attached.room);
+            return Ok((end, attached.timeout, attached.gone.subscribe(), room));
         }
         // Refused by its text alone, before its name is made (names are kept for the life
         // of the process): a refused claim grows nothing here. An accepted name is kept,
@@ -142,14 +153,16 @@ impl<E> Users<E> {
         };
         let end = Arc::new(tokio::sync::Mutex::new(end));
         let (gone, told) = tokio::sync::watch::channel(false);
+        let room = Arc::new(Semaphore::new(MAX_WAITING));
         let attached = Attached {
             end: Arc::clone(&end),
             timeout,
             presence,
             gone,
+            room: Arc::clone(&room),
         };
         ends.insert(module.to_owned(), attached);
-        Ok((end, timeout, told))
+        Ok((end, timeout, told, room))
     }
 
     /// `module` connects (again): its host has just imported the port, or has seen this host
@@ -255,7 +268,7 @@ where
                     users.renew(module).await;
                 }
                 let answer = module.and_then(|module| {
-                    let (_, timeout, _) = users.end(module, &*claim, |m| attach(m))?;
+                    let (_, timeout, _, _) = users.end(module, &*claim, |m| attach(m))?;
                     let connected = Connected {
                         owner: owner.clone(),
                         timeout_ms: timeout.map_or(0, |t| t.as_millis().max(1) as u64),
@@ -292,7 +305,12 @@ where
     E: Forward<Req, Rep>,
 {
     let module = module_of(query)?;
-    let (end, _, mut gone) = users.end(module, claim, attach)?;
+    let (end, _, mut gone, room) = users.end(module, claim, attach)?;
+    let Ok(_room) = room.try_acquire() else {
+        return Err(format!(
+            "port {port}: module {module} has {MAX_WAITING} requests waiting already"
+        ));
+    };
     let bytes = query.payload().map(|p| p.to_bytes()).unwrap_or_default();
     let request: Req = decode(port, &bytes).map_err(|e| e.to_string())?;
     // One request of a module at a time, as in one process: its next waits here.

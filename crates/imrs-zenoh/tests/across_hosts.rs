@@ -329,3 +329,53 @@ async fn a_closed_session_ends_its_own_modules_waits() {
     .await;
     assert_eq!(ended.as_str(), "WAITER");
 }
+
+/// A peer that floods a port under one module's name holds at most a bounded number of
+/// requests waiting on the owner's host: the rest are refused at once, naming the port and
+/// the module, and the owner's host keeps no task for them.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_flood_under_one_name_is_refused_past_its_room() {
+    let (owner_host, user_host) = two_hosts("flood_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive> =
+        Port::new(PortSpec::new("SLOW", "SLOWPOKE").user_list(["FLOODER"]));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    // The owner never receives: every request that is let in waits.
+    let _slowpoke = port.owner().unwrap();
+    let _seen: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "SLOW", "SLOWPOKE", "FLOODER")
+            .await
+            .unwrap();
+    let mut flood = tokio::task::JoinSet::new();
+    for n in 0..100_u64 {
+        let session = user_host.session().clone();
+        flood.spawn(async move {
+            let mut payload = vec![0, 1, 0, 0];
+            payload.extend_from_slice(&n.to_le_bytes());
+            let replies = session
+                .get("imrs/flood_cell/port/SLOW/FLOODER")
+                .payload(payload)
+                .timeout(Duration::from_secs(3))
+                .await
+                .unwrap();
+            let reply = replies.recv_async().await.unwrap();
+            let reason = reply.into_result().unwrap_err();
+            let reason = String::from_utf8(reason.payload().to_bytes().into_owned()).unwrap();
+            // Let in, and never answered: zenoh's own timeout on this side.
+            (reason != "Timeout").then_some(reason)
+        });
+    }
+    let (mut refused, mut waited) = (0, 0);
+    while let Some(answer) = flood.join_next().await {
+        match answer.unwrap() {
+            Some(reason) => {
+                assert_eq!(
+                    reason,
+                    "port SLOW: module FLOODER has 16 requests waiting already"
+                );
+                refused += 1;
+            }
+            None => waited += 1,
+        }
+    }
+    assert_eq!((refused, waited), (84, 16));
+}
