@@ -229,6 +229,9 @@ where
         Port::<Req, Rep, U, AnyUser, 1>::new(PortSpec::new(port, owner).user_list([module]));
     let slot: Slot<Req, Rep, U> = Arc::default();
     let mut presence = attach_owner(&local, owner, &slot).await?;
+    // Told when the owner's host goes: a delivery that waits for the module's answer ends,
+    // and lets go of the slot.
+    let (owner_gone, gone) = tokio::sync::watch::channel(false);
     let runtime = tokio::runtime::Handle::current();
     let delivering = {
         let (slot, owner, port) = (Arc::clone(&slot), owner.to_owned(), port.to_owned());
@@ -236,8 +239,9 @@ where
             .declare_queryable(keys.deliver(module))
             .callback(move |query| {
                 let (slot, owner, port) = (Arc::clone(&slot), owner.clone(), port.clone());
+                let gone = gone.clone();
                 runtime.spawn(async move {
-                    let answer = deliver::<Req, Rep, U>(&query, &slot, &owner, &port).await;
+                    let answer = deliver::<Req, Rep, U>(&query, &slot, &owner, &port, gone).await;
                     reply(&query, answer).await;
                 });
             })
@@ -263,8 +267,10 @@ where
                 // The owner's host gone, or this host's session closed: either way the
                 // local module's waits end with `PeerGone` rather than hang.
                 let live = watch.gone().await;
-                drop(slot.lock().await.take());
+                // The module's waits end first; a delivery it holds the reply of ends too.
                 presence.set_gone();
+                owner_gone.send_replace(true);
+                drop(slot.lock().await.take());
                 if !live {
                     return;
                 }
@@ -273,6 +279,7 @@ where
                 if !watch.back().await {
                     return;
                 }
+                owner_gone.send_replace(false);
                 let Ok(back) = attach_owner(&local, &owner, &slot).await else {
                     return;
                 };
@@ -322,6 +329,7 @@ async fn deliver<Req, Rep, U>(
     slot: &Slot<Req, Rep, U>,
     owner: &str,
     port: &str,
+    mut gone: tokio::sync::watch::Receiver<bool>,
 ) -> Result<Vec<u8>, String>
 where
     Req: Message,
@@ -338,9 +346,14 @@ where
     let end = slot
         .as_mut()
         .ok_or_else(|| format!("port {port}: its owner is gone"))?;
-    let answer = end
-        .deliver(request)
-        .await
-        .ok_or_else(|| format!("port {port}: the module did not answer"))?;
+    let answer = tokio::select! {
+        answer = end.deliver(request) => {
+            answer.ok_or_else(|| format!("port {port}: the module did not answer"))?
+        }
+        // Nobody is there to read the answer; the slot must go to the bridge.
+        _ = gone.wait_for(|gone| *gone) => {
+            return Err(format!("port {port}: its owner's host is gone"));
+        }
+    };
     encode(port, &answer).map_err(|e| e.to_string())
 }

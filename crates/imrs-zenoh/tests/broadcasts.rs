@@ -199,3 +199,69 @@ async fn a_gone_listener_host_leaves_the_owners_broadcasts_to_the_others() {
         None
     );
 }
+
+/// The owner's host goes while its broadcast waits for a listener that holds its reply:
+/// the listener's next wait still ends with `PeerGone` (the delivery waiting on the reply
+/// no longer holds up the word that the owner is gone), and once the listener lets the old
+/// reply go, the owner's return reaches it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_gone_owner_is_seen_while_its_broadcasts_reply_is_held() {
+    let endpoint = free_endpoint();
+    let owner_host = listening("held_alarm_cell", &endpoint).await;
+    let alarm: Port<u32, u32, usage::SendAll, AnyUser, 1> =
+        Port::new(PortSpec::new("ALARM", "LINE"));
+    let exported = export(&owner_host, &alarm).await.unwrap();
+    let user_host = connecting("held_alarm_cell", &endpoint).await;
+    let imported: Imported<u32, u32, usage::SendAll> =
+        import(&user_host, "ALARM", "LINE", "PANEL").await.unwrap();
+    let mut panel = imported.port().user_named("PANEL").unwrap();
+    let mut line = alarm.owner().unwrap();
+    let broadcasting = tokio::spawn(async move {
+        while alarm.users_attached() < 1 {
+            tokio::task::yield_now().await;
+        }
+        let _ = line.send_all(7).await;
+    });
+    let (n, held) = within(PROMPTLY, "the first broadcast", panel.receive())
+        .await
+        .unwrap();
+    assert_eq!(n, 7);
+    // The owner's host goes while the panel holds the broadcast's reply.
+    broadcasting.abort();
+    drop(exported);
+    owner_host.close().await.unwrap();
+    let waited = within(PROMPTLY, "the panel's next wait", panel.receive()).await;
+    assert!(
+        matches!(&waited, Err(ReceiveError::PeerGone { module, .. }) if module.as_str() == "LINE"),
+        "{waited:?}"
+    );
+    // The panel lets the old reply go (one rendezvous at a time, as in one process), and the
+    // owner's host comes back: its broadcast reaches the panel, with no new import.
+    drop(held);
+    let back_host = listening("held_alarm_cell", &endpoint).await;
+    let back: Port<u32, u32, usage::SendAll, AnyUser, 1> =
+        Port::new(PortSpec::new("ALARM", "LINE"));
+    let _exported = export(&back_host, &back).await.unwrap();
+    let heard = tokio::spawn(async move {
+        loop {
+            match panel.receive().await {
+                Ok((n, reply)) => {
+                    reply.reply(n + 1);
+                    break n;
+                }
+                Err(ReceiveError::PeerGone { .. }) => tokio::task::yield_now().await,
+                Err(error) => panic!("{error}"),
+            }
+        }
+    });
+    let mut line = back.owner().unwrap();
+    let answer = within(PROMPTLY, "the returned owner's broadcast", async {
+        while back.users_attached() < 1 {
+            tokio::task::yield_now().await;
+        }
+        line.send_all(41).await.map(|broadcast| broadcast.first)
+    })
+    .await;
+    assert_eq!(answer.unwrap(), 42);
+    assert_eq!(within(PROMPTLY, "the panel", heard).await.unwrap(), 41);
+}
