@@ -14,12 +14,13 @@ use std::time::Duration;
 
 use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
-use imrs_ports::{AnyUser, End, Port, PortSpec, ReplyHandle, ResponseEnd, WireError, usage};
+use imrs_ports::{AnyUser, End, Port, PortSpec, ResponseEnd, WireError, usage};
 use tokio::task::JoinHandle;
 
+use crate::asking::{Asking, Pending};
 use crate::connected::Connected;
 use crate::key::{Keys, checked};
-use crate::message::{Message, decode, encode};
+use crate::message::{Message, decode};
 use crate::take::Take;
 use crate::watch::Watch;
 use crate::{Host, ZenohError};
@@ -202,13 +203,14 @@ where
         spec = spec.user_timeout(timeout);
     }
     let local = Port::<Req, Rep, U, AnyUser, 1>::new(spec);
-    let asking = Asking {
-        session: session.clone(),
-        key: keys.request(module),
-        name: None,
-        port: port.to_owned(),
+    let asking = Asking::new(
+        session.clone(),
+        keys.request(module),
+        None,
+        port.into(),
         wait,
-    };
+    )
+    .await?;
     let owner: Arc<str> = owner.into();
     let bridged = local.clone();
     let (host, port, module) = (host.clone(), port.to_owned(), module.to_owned());
@@ -281,18 +283,6 @@ impl Drop for GoneOnDrop {
     }
 }
 
-/// What the bridge needs to ask the owner's host.
-pub(crate) struct Asking {
-    pub(crate) session: zenoh::Session,
-    pub(crate) key: String,
-    /// The owner's name, the attachment of what it delivers to a module: made once, shared.
-    /// A module's own requests are named by their key, and carry none.
-    pub(crate) name: Option<zenoh::bytes::ZBytes>,
-    pub(crate) port: String,
-    /// How long a request waits for its reply.
-    pub(crate) wait: Duration,
-}
-
 /// Takes local requests through `end` and asks the owner's host, one at a time as its one
 /// local user sends them, until its token is gone (true: a request asked meanwhile is
 /// dropped unanswered) or the bridge must end (false).
@@ -301,57 +291,23 @@ async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
     watch: &Watch,
     asking: &Asking,
 ) -> bool {
-    loop {
+    // The request asked last: dropped unanswered if the owner's host goes. A module asks one
+    // at a time, so no other can be waiting.
+    let mut pending: Option<Pending<Rep>> = None;
+    let live = loop {
         tokio::select! {
             taken = end.next() => match taken {
-                Ok((request, reply)) => tokio::select! {
-                    () = ask::<Req, Rep>(asking, request, reply) => {}
-                    live = watch.gone() => return live,
-                },
+                Ok((request, reply)) => pending = Some(asking.ask(request, reply).await),
                 // Nobody can use the local port any more.
-                Err(_) => return false,
+                Err(_) => break false,
             },
-            live = watch.gone() => return live,
-        }
-    }
-}
-
-/// Asks the owner's host with `request`, and replies with its answer. Without one (an
-/// error reply, no reply in time, bytes that are no reply) the handle is dropped, and the
-/// local sender gets `NoReply`; the reason is logged.
-pub(crate) async fn ask<Req: Message, Rep: Message>(
-    asking: &Asking,
-    request: Req,
-    reply: ReplyHandle<Rep>,
-) {
-    let bytes = encode(&asking.port, &request).map_err(|e| e.to_string());
-    drop(request);
-    let answer = async {
-        let replies = asking
-            .session
-            .get(&asking.key)
-            .payload(bytes?)
-            .attachment(asking.name.clone())
-            .timeout(asking.wait)
-            .await
-            .map_err(|e| e.to_string())?;
-        let answer = replies
-            .recv_async()
-            .await
-            .map_err(|_| "no reply from the owner's host".to_owned())?;
-        match answer.into_result() {
-            Ok(sample) => {
-                decode::<Rep>(&asking.port, &sample.payload().to_bytes()).map_err(|e| e.to_string())
-            }
-            Err(error) => Err(String::from_utf8_lossy(&error.payload().to_bytes()).into_owned()),
+            live = watch.gone() => break live,
         }
     };
-    match answer.await {
-        Ok(answer) => drop(reply.reply(answer)),
-        Err(reason) => {
-            tracing::debug!(port = %asking.port, %reason, "a request across hosts got no reply");
-        }
+    if let Some(pending) = pending {
+        pending.give_up();
     }
+    live
 }
 
 /// `module`'s connection to `port`: the owner's host's answer, or why there is none.

@@ -72,6 +72,7 @@
 //! be read past [`MAX_MESSAGE`] bytes.
 
 mod access;
+mod asking;
 mod connected;
 mod error;
 mod export;

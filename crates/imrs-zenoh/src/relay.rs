@@ -19,9 +19,10 @@ use imrs_ports::usage::Usage;
 use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, WireError, usage};
 use tokio::task::JoinHandle;
 
+use crate::asking::{Asking, Pending};
 use crate::connected::Connected;
 use crate::export::{Claim, Exported, module_of, reply, sender_of};
-use crate::import::{Asking, NO_TIMEOUT, ask, begin, connect_to, reconnect};
+use crate::import::{NO_TIMEOUT, begin, connect_to, reconnect};
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
 use crate::take::Take;
@@ -103,13 +104,13 @@ where
                             let _held = Presence::enter(Some(Arc::clone(&presence)));
                             attach(module).map_err(|e| e.to_string())?
                         };
-                        let asking = Asking {
-                            session: session.clone(),
-                            key: keys.deliver(module),
-                            name: Some(owner.as_str().into()),
-                            port: port.clone(),
-                            wait: NO_TIMEOUT,
-                        };
+                        let asking = Asking::new(
+                            session.clone(),
+                            keys.deliver(module),
+                            Some(owner.as_str().into()),
+                            port.as_str().into(),
+                            NO_TIMEOUT,
+                        );
                         let stop = Arc::new(tokio::sync::Notify::new());
                         let relay =
                             relay::<Req, Rep, T>(end, asking, presence, Arc::clone(&stop), lease);
@@ -143,34 +144,42 @@ where
 /// waits on it end as for a module that ended.
 async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(
     mut end: T,
-    asking: Asking,
+    asking: impl Future<Output = Result<Asking, ZenohError>>,
     presence: Arc<Presence>,
     stop: Arc<tokio::sync::Notify>,
     grace: std::time::Duration,
 ) {
-    loop {
-        tokio::select! {
-            biased;
-            () = stop.notified() => break,
-            taken = end.next() => match taken {
-                // A host that is gone ends the query, with its answer if it gave one first;
-                // one cut off is given a lease to, then the reply is dropped (`NoReply`).
-                Ok((request, reply)) => tokio::select! {
-                    () = ask::<Req, Rep>(&asking, request, reply) => {}
-                    () = async {
-                        stop.notified().await;
-                        tokio::time::sleep(grace).await;
-                    } => break,
+    // The broadcast or query asked last: the owner asks one at a time.
+    let mut pending: Option<Pending<Rep>> = None;
+    if let Ok(asking) = asking.await {
+        loop {
+            tokio::select! {
+                biased;
+                () = stop.notified() => break,
+                taken = end.next() => match taken {
+                    Ok((request, reply)) => pending = Some(asking.ask(request, reply).await),
+                    // A quiet spell past the port's TIMEOUT: the module is still there.
+                    Err(ReceiveError::Timeout { .. }) => {}
+                    Err(_) => break,
                 },
-                // A quiet spell past the port's TIMEOUT: the module is still there.
-                Err(ReceiveError::Timeout { .. }) => {}
-                Err(_) => break,
-            },
+            }
         }
+    }
+    // A host that is gone ends the query, with its answer if it gave one first; one cut off
+    // is given a lease to answer, then the reply is dropped (`NoReply`).
+    if let Some(pending) = pending {
+        let deadline = tokio::time::Instant::now() + grace;
+        while pending.waits() && tokio::time::Instant::now() < deadline {
+            tokio::time::sleep(RECHECK.min(grace)).await;
+        }
+        pending.give_up();
     }
     drop(end);
     presence.set_gone();
 }
+
+/// How often a relay told its module is gone looks whether the last query was answered.
+const RECHECK: std::time::Duration = std::time::Duration::from_millis(10);
 
 /// The local port's owner end on a user's host: hands a broadcast or query from the
 /// owner's host to the one local module, and gives back its reply.
