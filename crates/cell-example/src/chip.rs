@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use imrs_coord::zones::Reservations;
 use imrs_core::prelude::*;
-use imrs_ports::{End, ReplyHandle, select, usage};
+use imrs_ports::{End, ReplyHandle, select, usage, when};
 use imrs_sim::layout::LINK_RADIUS;
 use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station, Target};
 
@@ -17,8 +17,9 @@ use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
 };
-use crate::ports::{CellPorts, ModuleName, ZoneLink};
+use crate::ports::{CellPorts, ModuleName};
 use crate::reservation::{MAX_POSES, Reservation};
+use crate::zone_asker::ZoneAsker;
 
 /// How the two chip robots share the feeder zone.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -135,8 +136,10 @@ pub struct ChipItState {
 enum Access {
     Appendix(End<(), i32, usage::Query>),
     Arbiter {
-        request: End<ModuleName, (), usage::Send>,
-        release: End<ModuleName, (), usage::Send>,
+        request: End<ZoneAsker, (), usage::Send>,
+        release: End<ZoneAsker, (), usage::Send>,
+        /// What the monitor is told: who asks, from which run of its line's process.
+        asker: ZoneAsker,
     },
     Coordinator {
         reserve: End<Reservation, (), usage::Send>,
@@ -159,10 +162,7 @@ impl Access {
             Access::Appendix(share_feeder) => {
                 matches!(ctx.query(share_feeder, ()).await, Ok(clear) if clear != 0)
             }
-            Access::Arbiter { request, .. } => ctx
-                .send(request, ModuleName::new(ctx.module().as_str()))
-                .await
-                .is_ok(),
+            Access::Arbiter { request, asker, .. } => ctx.send(request, *asker).await.is_ok(),
             // The coordinator is asked per step, with the step's trajectory: see `reserve`.
             Access::Coordinator { .. } => return true,
         };
@@ -216,24 +216,28 @@ impl Access {
 
     /// Says it has left the zone.
     async fn left(&mut self, ctx: &Ctx<ChipItState>) {
-        let release = match self {
-            Access::Arbiter { release, .. } => release,
-            Access::Coordinator { free, .. } => free,
-            Access::Appendix(_) => return,
-        };
-        while ctx
-            .send(release, ModuleName::new(ctx.module().as_str()))
-            .await
-            .is_err()
-        {
-            ctx.delay(Duration::from_secs(1)).await;
+        match self {
+            Access::Arbiter { release, asker, .. } => {
+                while ctx.send(release, *asker).await.is_err() {
+                    ctx.delay(Duration::from_secs(1)).await;
+                }
+            }
+            Access::Coordinator { free, .. } => {
+                let robot = ModuleName::new(ctx.module().as_str());
+                while ctx.send(free, robot).await.is_err() {
+                    ctx.delay(Duration::from_secs(1)).await;
+                }
+            }
+            Access::Appendix(_) => {}
         }
     }
 }
 
-/// The CHIP_IT module of `line` (CHIP_IT2 on line B).
+/// The CHIP_IT module of `line` (CHIP_IT2 on line B), in `run` of its line's process (0 in
+/// one process; see [`ZoneAsker`]).
 pub fn chip_it(
     line: Line,
+    run: u32,
     policy: FeederPolicy,
     ports: &CellPorts,
     devices: &Devices,
@@ -320,6 +324,7 @@ pub fn chip_it(
                 FeederPolicy::Arbiter => Access::Arbiter {
                     request: zone_request.user(&ctx)?,
                     release: zone_release.user(&ctx)?,
+                    asker: ZoneAsker::new(ctx.module().as_str(), line, run),
                 },
                 FeederPolicy::Coordinator => Access::Coordinator {
                     reserve: zone_reserve.user(&ctx)?,
@@ -502,19 +507,68 @@ pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
 const SWEEP_MARGIN: f32 = 0.03;
 
 /// FEEDER_MONITOR: hands the feeder zone to one chip robot at a time.
+///
+/// Across processes the world tells it, on LINE_DOWN, that a line's process has died and
+/// which run of it comes next, once the dead line's chip robot is out of the zone: the
+/// zone a dead run held is free again, and the word of a dead run is not heeded (a request
+/// it left waiting is dropped: nobody is there to enter). In one process nothing is said
+/// on LINE_DOWN, and every word is of run 0.
 pub fn feeder_monitor(ports: &CellPorts) -> ModuleSpec<()> {
-    let (request, release): (ZoneLink, ZoneLink) =
-        (ports.zone_request.clone(), ports.zone_release.clone());
-    ModuleSpec::new(FEEDER_MONITOR, ()).task(FEEDER_MONITOR, move |ctx| {
-        let (request, release) = (request.clone(), release.clone());
+    let (request, release, line_down) = (
+        ports.zone_request.clone(),
+        ports.zone_release.clone(),
+        ports.line_down.clone(),
+    );
+    ModuleSpec::new(FEEDER_MONITOR, ()).task(FEEDER_MONITOR, move |_ctx| {
+        let (request, release, line_down) = (request.clone(), release.clone(), line_down.clone());
         async move {
             let (mut request, mut release) = (request.owner()?, release.owner()?);
+            let mut line_down = line_down.owner()?;
+            // The run of each line's process whose word counts.
+            let mut runs = [0_u32; 2];
+            let mut holder: Option<ZoneAsker> = None;
             loop {
-                // Grant the zone to the first to ask; take no other request until it is back.
-                let (_, granted) = ctx.receive(&mut request).await?;
-                granted.reply(());
-                let (_, returned) = ctx.receive(&mut release).await?;
-                returned.reply(());
+                enum Event {
+                    Down(Line, u32, ReplyHandle<()>),
+                    Left(ZoneAsker, ReplyHandle<()>),
+                    Asked(ZoneAsker, ReplyHandle<()>),
+                }
+                let event = select()
+                    .or(&mut line_down, |((line, next), reply)| {
+                        Event::Down(line, next, reply)
+                    })
+                    .or(&mut release, |(asker, reply)| Event::Left(asker, reply))
+                    // Take no other request until the zone is back.
+                    .or(when(holder.is_none(), &mut request), |(asker, reply)| {
+                        Event::Asked(asker, reply)
+                    })
+                    .await?;
+                match event {
+                    Event::Down(line, next, reply) => {
+                        runs[line.index()] = next;
+                        if holder.is_some_and(|held| held.line() == Some(line)) {
+                            holder = None;
+                        }
+                        reply.reply(());
+                    }
+                    // A release from any but the holder (a dead run's, sent on its way
+                    // out) is answered, and changes nothing.
+                    Event::Left(asker, returned) => {
+                        returned.reply(());
+                        if holder == Some(asker) {
+                            holder = None;
+                        }
+                    }
+                    Event::Asked(asker, granted) => {
+                        let live = asker
+                            .line()
+                            .is_some_and(|line| runs[line.index()] == asker.run());
+                        if live {
+                            granted.reply(());
+                            holder = Some(asker);
+                        }
+                    }
+                }
             }
         }
     })

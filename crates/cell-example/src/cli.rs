@@ -74,6 +74,10 @@ struct Flags {
     /// since 1970.
     #[arg(long, hide = true, requires = "line_process")]
     epoch: Option<u64>,
+    /// Set by the world on a line's process: which run of the line's process it is (the
+    /// world restarts a line whose process died).
+    #[arg(long, hide = true, default_value_t = 0, requires = "line_process")]
+    run: u32,
 }
 
 fn speed(text: &str) -> Result<f64, String> {
@@ -155,6 +159,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
     let line_process = match (flags.line_process, flags.remote, flags.epoch) {
         (Some(line), Some(remote), Some(epoch)) => Some(LineProcess {
             line,
+            run: flags.run,
             remote,
             epoch: UNIX_EPOCH + Duration::from_nanos(epoch),
         }),

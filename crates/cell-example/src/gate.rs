@@ -50,6 +50,21 @@ impl CycleTimeHistory {
     /// How many recent changes are kept.
     pub const RECENT: usize = 8;
 
+    /// Folds in the history of a later run of the same GATE (its line's process started
+    /// again): its first value stays, the rest is the later run's, added to this one's.
+    pub fn follow(&mut self, later: CycleTimeHistory) {
+        self.first = self.first.or(later.first);
+        self.now = later.now.or(self.now);
+        self.range = match (self.range, later.range) {
+            (Some((low, high)), Some((l, h))) => Some((low.min(l), high.max(h))),
+            (range, None) | (None, range) => range,
+        };
+        self.changes += later.changes;
+        self.recent.extend(later.recent);
+        let surplus = self.recent.len().saturating_sub(Self::RECENT);
+        self.recent.drain(..surplus);
+    }
+
     fn set(&mut self, at: f64, value: f64) {
         self.first.get_or_insert(value);
         let (low, high) = self.range.unwrap_or((value, value));

@@ -25,12 +25,14 @@ pub mod help;
 pub mod lateness;
 pub mod load;
 pub mod names;
+pub mod outage;
 pub mod ports;
 pub mod processes;
 pub mod report;
 pub mod reservation;
 pub mod run;
 pub mod tally;
+pub mod zone_asker;
 
 pub use chip::FeederPolicy;
 pub use cli::{CliError, parse};

@@ -73,6 +73,10 @@ pub const FEEDER_MONITOR: &str = "FEEDER_MONITOR";
 pub const ZONE_REQUEST: &str = "ZONE_REQUEST";
 /// The arbiter's port for handing the zone back.
 pub const ZONE_RELEASE: &str = "ZONE_RELEASE";
+/// The arbiter's port where the world says a line's process has died.
+pub const LINE_DOWN: &str = "LINE_DOWN";
+/// Who says it: the world's supervision of the lines' processes.
+pub const LINE_SUPERVISOR: &str = "LINE_SUPERVISOR";
 
 /// The coordinator of the feeder zone (the `--feeder coordinator` policy).
 pub const FEEDER_COORDINATOR: &str = "FEEDER_COORDINATOR";

@@ -12,10 +12,11 @@ use imrs_sim::{Line, PalletId};
 
 use crate::chip::FeederPolicy;
 use crate::names::{
-    FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
-    ZONE_RESERVE,
+    FEEDER_COORDINATOR, FEEDER_MONITOR, LINE_DOWN, LineNames, ZONE_FREE, ZONE_RELEASE,
+    ZONE_REQUEST, ZONE_RESERVE,
 };
 use crate::reservation::Reservation;
+use crate::zone_asker::ZoneAsker;
 
 /// FREQUENCY(TASK_NUM: INTEGER; TIME_FOR_ONE: REAL), through the bounded buffer.
 pub type Frequency = BoundedBufferPort<(i32, f64), AnyUser, 2>;
@@ -36,6 +37,10 @@ pub type ShareFeeder = Port<(), i32, usage::Query>;
 /// The feeder zone's ports: a chip robot sends its name (or, to the coordinator, the space
 /// it will sweep) and waits until it may enter (or has left).
 pub type ZonePort<Req = ModuleName> = Port<Req, (), usage::Receive, AnyUser, 2>;
+
+/// LINE_DOWN: the world tells FEEDER_MONITOR that a line's process has died, and which run
+/// of it comes next (see [`ZoneAsker`]). It stays in the world's process.
+pub type LineDownPort = Port<(Line, u32), (), usage::Receive, AnyUser, 1>;
 
 /// The longest module name a [`ModuleName`] holds.
 const MODULE_NAME: usize = 32;
@@ -169,9 +174,11 @@ pub struct CellPorts {
     /// Per line, A then B.
     pub lines: [LinePorts; 2],
     /// The arbiter's request port.
-    pub zone_request: ZoneLink,
+    pub zone_request: ZoneLink<ZoneAsker>,
     /// The arbiter's release port.
-    pub zone_release: ZoneLink,
+    pub zone_release: ZoneLink<ZoneAsker>,
+    /// The arbiter's port where the world says a line's process died.
+    pub line_down: LineDownPort,
     /// The coordinator's reservation port.
     pub zone_reserve: ZoneLink<Reservation>,
     /// The coordinator's port for freeing a reservation.
@@ -263,6 +270,7 @@ impl CellPorts {
             zone_release: ZoneLink::Here(
                 ZonePort::new(spec(ZONE_RELEASE, FEEDER_MONITOR, clock)).shown(),
             ),
+            line_down: LineDownPort::new(spec(LINE_DOWN, FEEDER_MONITOR, clock)).shown(),
             zone_reserve: ZoneLink::Here(
                 ReservePort::new(spec(ZONE_RESERVE, FEEDER_COORDINATOR, clock)).shown(),
             ),
@@ -286,6 +294,7 @@ impl CellPorts {
                         cell.declare(port)?;
                     }
                 }
+                cell.declare(&ports.line_down)?;
             }
             FeederPolicy::Coordinator => {
                 if let Some(port) = ports.zone_reserve.here() {

@@ -20,10 +20,25 @@
 //! that a timeout a machine too loaded for `--speed` caused can be told from one the cell
 //! did.
 //!
-//! At the end each line writes its modules' figures (timeouts, alarms, restarts, deadlocks,
+//! Each line writes its modules' figures so far (timeouts, alarms, restarts, deadlocks,
 //! waits for the zone, GATE's cycle times, its lateness) as one JSON line on its standard
-//! output; the world folds them into its own and reports as a single process does. A line
-//! whose world dies sees its standard input close and exits.
+//! output every minute of the cell's time, and at the end; the world folds them into its
+//! own and reports as a single process does. A line whose world dies sees its standard
+//! input close and exits.
+//!
+//! The world supervises the lines' processes, as a module's supervisor does its tasks: a
+//! line's process that dies before the end (killed, crashed) is started again, at most
+//! [`RESTARTS`] times a line, and the other line goes on. Before the next run starts, the
+//! world takes off as scrap the pallets the dead line's stations held (in a state nobody
+//! knows), drives its chip robot home through the robot's own port, and tells
+//! FEEDER_MONITOR on LINE_DOWN, which then frees the zone if the dead line held it. Each
+//! run of a line's process is numbered, and its calls and words to the zone carry the
+//! number: a call the dead run left on its way, carried by iceoryx2 after the next run has
+//! started, is not carried out (see [`crate::zone_asker`]). The report shows each outage:
+//! when, how long, and the pallets scrapped. Only the arbiter's policy is supervised so:
+//! under the Appendix's the survivor would wait on its dead twin's SHARE_FEEDER, and under
+//! the coordinator's on reservations nobody frees, so there a line that dies still fails
+//! the run, by name.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -33,23 +48,25 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 use imrs_core::CellErrors;
 use imrs_core::prelude::*;
 use imrs_ipc::{Exported, Imported, IpcError, Remote, export, import};
-use imrs_ports::{Instant, RealClock, SharedClock, usage};
-use imrs_sim::{Line, Sim, SimConfig};
+use imrs_ports::{End, Instant, RealClock, SharedClock, usage};
+use imrs_sim::{Line, RobotId, Role, Sim, SimConfig, Target};
 use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::alarms::AlarmKind;
 use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_coordinator, feeder_monitor};
-use crate::devices::{DevicePorts, Devices, RemoteDevices, world};
-use crate::faults::CellFaultKind;
+use crate::devices::{
+    Answer, Device, DeviceAnswer, DeviceCall, DevicePorts, Devices, Op, RemoteDevices, world,
+};
+use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
 use crate::lateness::Lateness;
 use crate::names::{
-    FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
-    ZONE_RESERVE,
+    FEEDER_COORDINATOR, FEEDER_MONITOR, LINE_SUPERVISOR, LineNames, ZONE_FREE, ZONE_RELEASE,
+    ZONE_REQUEST, ZONE_RESERVE,
 };
-use crate::ports::{CellPorts, ModuleName, ZoneLink};
-use crate::reservation::Reservation;
+use crate::outage::Outage;
+use crate::ports::{CellPorts, ZoneLink};
 use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject, lock};
 use crate::tally::Tally;
 
@@ -63,12 +80,23 @@ const STARTUP: Duration = Duration::from_secs(2);
 /// figures once the run has ended.
 const PATIENCE: Duration = Duration::from_secs(30);
 
+/// How many times, in one run of the cell, the world starts a line's process again after
+/// it died, before it gives up and fails the run.
+pub const RESTARTS: u32 = 3;
+
+/// How often, in the cell's time, a line's process sends its figures so far: a line that
+/// dies loses at most this much of them.
+const SNAPSHOT_PERIOD: Duration = Duration::from_secs(60);
+
 /// What makes a process one line's part of a cell run across processes: the line, the
 /// cell's name on this host, and the moment its time starts.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineProcess {
     /// The line whose modules it runs.
     pub line: Line,
+    /// Which run of the line's process it is: 0 first, then one more each time the world
+    /// starts it again.
+    pub run: u32,
     /// The cell's name, from which every port's service name is derived.
     pub remote: String,
     /// When the cell's time is zero, on the system clock.
@@ -160,19 +188,26 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     let ports = CellPorts::new(&clock);
     // The arbiter, or the coordinator, runs here; under the Appendix's policy the lines ask
     // each other.
-    let coordinator = config.feeder == FeederPolicy::Coordinator;
-    let zone: Vec<_> = match config.feeder {
-        FeederPolicy::Arbiter => vec![&ports.zone_request, &ports.zone_release],
-        FeederPolicy::Coordinator => vec![&ports.zone_free],
-        FeederPolicy::Appendix => Vec::new(),
-    }
-    .into_iter()
-    .filter_map(ZoneLink::here)
-    .collect();
+    let (arbiter, coordinator) = (
+        config.feeder == FeederPolicy::Arbiter,
+        config.feeder == FeederPolicy::Coordinator,
+    );
+    let asked: Vec<_> = [&ports.zone_request, &ports.zone_release]
+        .into_iter()
+        .filter_map(ZoneLink::here)
+        .filter(|_| arbiter)
+        .collect();
+    let free = ports.zone_free.here().filter(|_| coordinator);
     let reserve = ports.zone_reserve.here().filter(|_| coordinator);
     let devices = DevicePorts::declare(&clock);
-    for port in &zone {
+    for port in &asked {
         cell.declare(*port).map_err(CellErrors::from)?;
+    }
+    if arbiter {
+        cell.declare(&ports.line_down).map_err(CellErrors::from)?;
+    }
+    if let Some(port) = free {
+        cell.declare(port).map_err(CellErrors::from)?;
     }
     if let Some(port) = reserve {
         cell.declare(port).map_err(CellErrors::from)?;
@@ -190,7 +225,10 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     cell.check(&declarations)?;
     // Exported before a line starts: a line imports them at once.
     let mut exported: Vec<Exported> = Vec::new();
-    for port in zone {
+    for port in asked {
+        exported.push(export(&remote, port).map_err(ipc("world"))?);
+    }
+    if let Some(port) = free {
         exported.push(export(&remote, port).map_err(ipc("world"))?);
     }
     if let Some(port) = reserve {
@@ -205,33 +243,45 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
         cell.start(keeper)?;
     }
 
-    let (said, mut hear) = unbounded_channel();
+    // The world's hands on a dead line: its chip robot's port, and FEEDER_MONITOR's ear.
+    let supervisor = match config.feeder {
+        FeederPolicy::Arbiter => Some(Supervisor::new(&devices, &ports)?),
+        FeederPolicy::Appendix | FeederPolicy::Coordinator => None,
+    };
+    let (tell, mut hear) = unbounded_channel();
     let mut lines = Lines(Vec::new());
     for line in Line::ALL {
-        lines
-            .0
-            .push(start_line(config, line, &remote, epoch, said.clone())?);
+        lines.0.push(start_line(
+            config,
+            line,
+            0,
+            &remote,
+            epoch,
+            &config.faults,
+            tell.clone(),
+        )?);
     }
-    drop(said);
     for _ in Line::ALL {
         match hear_from(&mut hear).await? {
-            (_, Said::Ready) => {}
-            (line, other) => return Err(other.refusal(line, "ready")),
+            (_, _, Said::Ready) => {}
+            (line, _, other) => return Err(other.refusal(line, "ready")),
         }
     }
 
     let total = Duration::from_secs_f64(config.hours * 3600.0);
-    let mut waits = [ZoneWaits::default(); 2];
-    let mut cycle_times: [CycleTimeHistory; 2] = Default::default();
-    let mut late = [Duration::ZERO; 2];
-    let mut heard = [false; 2];
-    // Until the end, a line that fails or dies fails the run at once; then each line's
-    // figures are due.
+    let mut runs = [0_u32; 2];
+    // Per line: the latest figures of its run now, and the last of each run that died.
+    let mut latest: [Option<Value>; 2] = Default::default();
+    let mut banked: [Vec<Value>; 2] = Default::default();
+    let mut finals: [Option<Value>; 2] = Default::default();
+    let mut outages: Vec<Outage> = Vec::new();
+    // Until the end, a line that dies is started again (or fails the run, past its
+    // restarts); then each line's figures are due.
     let end = clock.sleep_until(Instant::from_start(total));
     tokio::pin!(end);
     let mut ended = false;
-    while heard.contains(&false) {
-        let said = if ended {
+    while finals.iter().any(Option::is_none) {
+        let (line, run, said) = if ended {
             hear_from(&mut hear).await?
         } else {
             tokio::select! {
@@ -242,27 +292,91 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                 said = hear.recv() => said.ok_or_else(|| refused("world", "the lines' processes are gone"))?,
             }
         };
+        let i = line.index();
+        // The last words of a run that has died, heard late.
+        if run != runs[i] {
+            continue;
+        }
         match said {
-            (line, Said::Figures(figures)) if !heard[line.index()] => {
-                let i = line.index();
-                absorb(
-                    &mut lock(&tally),
-                    &mut waits[i],
-                    &mut cycle_times[i],
-                    &mut late[i],
-                    &figures,
-                )
-                .ok_or_else(|| refused(process_name(line), "its figures do not read"))?;
-                heard[i] = true;
+            Said::Ready => {
+                let now = clock.now().since_start().as_secs_f64();
+                if let Some(outage) = outages
+                    .iter_mut()
+                    .rev()
+                    .find(|outage| outage.line == line && outage.back.is_none())
+                {
+                    outage.back = Some(now);
+                }
             }
+            Said::Snapshot(figures) => latest[i] = Some(figures),
+            Said::Figures(figures) if finals[i].is_none() => finals[i] = Some(figures),
             // A line that sent its figures may end before the other sends its own.
-            (line, Said::Ended(_)) if heard[line.index()] => {}
-            (line, other) => return Err(other.refusal(line, "its figures")),
+            Said::Ended(_) if finals[i].is_some() => {}
+            Said::Ended(_) | Said::Failed(_) if !ended => {
+                let Some(supervisor) = &supervisor else {
+                    return Err(said.refusal_restartless(line, config.feeder));
+                };
+                if runs[i] >= RESTARTS {
+                    return Err(refused(
+                        process_name(line),
+                        format!(
+                            "died {} times: the world starts a line again at most {RESTARTS} times",
+                            runs[i] + 1
+                        ),
+                    ));
+                }
+                let died = clock.now();
+                let next = runs[i] + 1;
+                banked[i].extend(latest[i].take());
+                let scrapped = supervisor.take_over(line, next, &sim).await?;
+                runs[i] = next;
+                // Faults still to come; those past happened to the run that died.
+                let faults: Vec<CellFault> = config
+                    .faults
+                    .iter()
+                    .filter(|fault| Instant::from_start(fault.at) > clock.now())
+                    .cloned()
+                    .collect();
+                lines.0.push(start_line(
+                    config,
+                    line,
+                    next,
+                    &remote,
+                    epoch,
+                    &faults,
+                    tell.clone(),
+                )?);
+                outages.push(Outage {
+                    line,
+                    died: died.since_start().as_secs_f64(),
+                    back: None,
+                    run: next,
+                    scrapped: scrapped as u32,
+                });
+            }
+            other => return Err(other.refusal(line, "its figures")),
         }
     }
     lines.ended().await;
     drop(exported);
-    let tally = lock(&tally).clone();
+    let mut tally = lock(&tally).clone();
+    let mut waits = [ZoneWaits::default(); 2];
+    let mut cycle_times: [CycleTimeHistory; 2] = Default::default();
+    let mut late = [Duration::ZERO; 2];
+    for line in Line::ALL {
+        let i = line.index();
+        // The runs that died, in order, then the last.
+        for figures in banked[i].iter().chain(finals[i].iter()) {
+            absorb(
+                &mut tally,
+                &mut waits[i],
+                &mut cycle_times[i],
+                &mut late[i],
+                figures,
+            )
+            .ok_or_else(|| refused(process_name(line), "its figures do not read"))?;
+        }
+    }
     let mut record = RunRecord::measured(config, tally, &sim, &cell, waits, cycle_times, total);
     record.lateness = vec![("world".into(), lateness.worst())];
     record.lateness.extend(
@@ -270,7 +384,67 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             .into_iter()
             .map(|line| (process_name(line).into(), late[line.index()])),
     );
+    record.outages = outages;
     Ok(record)
+}
+
+/// The world's hands on a line whose process died: the chip robot's port, as
+/// [`LINE_SUPERVISOR`], and FEEDER_MONITOR's LINE_DOWN.
+struct Supervisor {
+    chip_robots: [tokio::sync::Mutex<End<DeviceCall, DeviceAnswer, usage::Send>>; 2],
+    line_down: tokio::sync::Mutex<End<(Line, u32), (), usage::Send>>,
+}
+
+impl Supervisor {
+    fn new(devices: &DevicePorts, ports: &CellPorts) -> Result<Self, RunError> {
+        let robot = |line: Line| {
+            let device = Device::Robot(RobotId::new(line, Role::ChipIt));
+            let port = devices
+                .of(device)
+                .ok_or_else(|| refused("world", format!("no port for {}", device.port())))?;
+            let end = port
+                .user_named(LINE_SUPERVISOR)
+                .map_err(|error| refused("world", error))?;
+            Ok::<_, RunError>(tokio::sync::Mutex::new(end))
+        };
+        let line_down = ports
+            .line_down
+            .user_named(LINE_SUPERVISOR)
+            .map_err(|error| refused("world", error))?;
+        Ok(Self {
+            chip_robots: [robot(Line::A)?, robot(Line::B)?],
+            line_down: tokio::sync::Mutex::new(line_down),
+        })
+    }
+
+    /// Makes `line`, whose process died, safe for its `next` run: scraps the pallets its
+    /// stations hold, drives its chip robot home (as `next`, so that WORLD carries out no
+    /// call the dead run left on its way), then tells FEEDER_MONITOR. Returns how many
+    /// pallets were scrapped.
+    async fn take_over(&self, line: Line, next: u32, sim: &Sim) -> Result<usize, RunError> {
+        let scrapped = sim.scrap_held(line).len();
+        let home = DeviceCall::new(Op::Move(Target::Home)).in_run(next);
+        let answer = self.chip_robots[line.index()]
+            .lock()
+            .await
+            .send(home)
+            .await
+            .map_err(|error| refused("world", format!("{line:?}'s chip robot: {error}")))?;
+        if let Some(Answer::Failed(error)) = answer.answer() {
+            // A robot that cannot go home stays where it is: the zone stays its line's.
+            return Err(refused(
+                process_name(line),
+                format!("its chip robot could not be driven home: {error}"),
+            ));
+        }
+        self.line_down
+            .lock()
+            .await
+            .send((line, next))
+            .await
+            .map_err(|error| refused("world", format!("LINE_DOWN: {error}")))?;
+        Ok(scrapped)
+    }
 }
 
 fn process_name(line: Line) -> &'static str {
@@ -285,6 +459,8 @@ fn process_name(line: Line) -> &'static str {
 enum Said {
     /// Its ports are imported and its modules started.
     Ready,
+    /// Its figures so far, once a minute of the cell's time.
+    Snapshot(Value),
     /// Its figures, at the end of the run.
     Figures(Value),
     /// It could not run, and why.
@@ -304,13 +480,34 @@ impl Said {
                 status.map_or("status unknown".into(), |status| status.to_string())
             ),
             Said::Garbled(text) => format!("said {text:?} where {expected} was due"),
-            Said::Ready | Said::Figures(_) => format!("answered out of turn, before {expected}"),
+            Said::Ready | Said::Snapshot(_) | Said::Figures(_) => {
+                format!("answered out of turn, before {expected}")
+            }
         };
         refused(process_name(line), why)
     }
+
+    /// Why a line that died before the end fails the run under `policy`, which the world
+    /// does not restart a line under.
+    fn refusal_restartless(self, line: Line, policy: FeederPolicy) -> RunError {
+        let RunError::Processes { process, why } = self.refusal(line, "its figures") else {
+            unreachable!("a refusal is a process's")
+        };
+        RunError::Processes {
+            process,
+            why: format!(
+                "{why} (a line is started again under the arbiter's policy only, not under \
+                 --feeder {})",
+                policy.name()
+            ),
+        }
+    }
 }
 
-async fn hear_from(hear: &mut UnboundedReceiver<(Line, Said)>) -> Result<(Line, Said), RunError> {
+/// What a line's process said, with its line and run.
+type Heard = (Line, u32, Said);
+
+async fn hear_from(hear: &mut UnboundedReceiver<Heard>) -> Result<Heard, RunError> {
     match tokio::time::timeout(PATIENCE, hear.recv()).await {
         Ok(Some(said)) => Ok(said),
         Ok(None) => Err(refused("world", "the lines' processes are gone")),
@@ -357,9 +554,11 @@ impl Drop for Lines {
 fn start_line(
     config: &CellConfig,
     line: Line,
+    run: u32,
     remote: &Remote,
     epoch: SystemTime,
-    said: UnboundedSender<(Line, Said)>,
+    faults: &[CellFault],
+    said: UnboundedSender<Heard>,
 ) -> Result<Child, RunError> {
     let name = process_name(line);
     let program = std::env::current_exe()
@@ -371,12 +570,13 @@ fn start_line(
     let mut command = Command::new(program);
     command
         .args(["--processes", "--line-process", &format!("{line:?}")])
+        .args(["--run", &run.to_string()])
         .args(["--remote", remote.cell(), "--epoch", &epoch_ns.to_string()])
         .args(["--speed", &config.speed.to_string()])
         .args(["--hours", &config.hours.to_string()])
         .args(["--seed", &config.seed.to_string()])
         .args(["--feeder", config.feeder.name()]);
-    for fault in &config.faults {
+    for fault in faults {
         command.arg(format!("--fault={fault}"));
     }
     let mut child = command
@@ -393,6 +593,10 @@ fn start_line(
             let Ok(text) = text else { break };
             let heard = match text.split_once(' ') {
                 _ if text == "ready" => Said::Ready,
+                Some(("snapshot", json)) => match serde_json::from_str(json) {
+                    Ok(figures) => Said::Snapshot(figures),
+                    Err(_) => Said::Garbled(text),
+                },
                 Some(("figures", json)) => match serde_json::from_str(json) {
                     Ok(figures) => Said::Figures(figures),
                     Err(_) => Said::Garbled(text),
@@ -400,11 +604,11 @@ fn start_line(
                 Some(("failed", why)) => Said::Failed(why.into()),
                 _ => Said::Garbled(text),
             };
-            if said.send((line, heard)).is_err() {
+            if said.send((line, run, heard)).is_err() {
                 return;
             }
         }
-        let _ = said.send((line, Said::Ended(None)));
+        let _ = said.send((line, run, Said::Ended(None)));
     });
     Ok(child)
 }
@@ -443,37 +647,26 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let (names, twin) = (LineNames::of(line), LineNames::of(line.other()));
     let mut ports = CellPorts::new(&clock);
     // The feeder zone's keeper runs in the world's process: its ports are imported.
-    let keeper_ports = match config.feeder {
-        FeederPolicy::Arbiter => vec![
-            (&mut ports.zone_request, ZONE_REQUEST, FEEDER_MONITOR),
-            (&mut ports.zone_release, ZONE_RELEASE, FEEDER_MONITOR),
-        ],
-        FeederPolicy::Coordinator => vec![(&mut ports.zone_free, ZONE_FREE, FEEDER_COORDINATOR)],
-        FeederPolicy::Appendix => Vec::new(),
+    let failed = |error: ZoneImport| match error {
+        ZoneImport::Ipc(error) => refused(name, error),
+        ZoneImport::Wiring(error) => RunError::from(CellErrors::from(error)),
     };
-    for (link, port, keeper) in keeper_ports {
-        let imported = import::<Imported<ModuleName, (), usage::Receive>, _>(
-            &remote,
-            port,
-            keeper,
-            &names.chip_it,
-        )
-        .map_err(ipc(name))?;
-        cell.declare_imported(imported.port())
-            .map_err(CellErrors::from)?;
-        *link = ZoneLink::Imported(Arc::new(imported));
-    }
-    if config.feeder == FeederPolicy::Coordinator {
-        let imported = import::<Imported<Reservation, (), usage::Receive>, _>(
-            &remote,
-            ZONE_RESERVE,
-            FEEDER_COORDINATOR,
-            &names.chip_it,
-        )
-        .map_err(ipc(name))?;
-        cell.declare_imported(imported.port())
-            .map_err(CellErrors::from)?;
-        ports.zone_reserve = ZoneLink::Imported(Arc::new(imported));
+    let chip_it = &names.chip_it;
+    match config.feeder {
+        FeederPolicy::Arbiter => {
+            ports.zone_request =
+                zone_link(&remote, &cell, ZONE_REQUEST, FEEDER_MONITOR, chip_it).map_err(failed)?;
+            ports.zone_release =
+                zone_link(&remote, &cell, ZONE_RELEASE, FEEDER_MONITOR, chip_it).map_err(failed)?;
+        }
+        FeederPolicy::Coordinator => {
+            ports.zone_free = zone_link(&remote, &cell, ZONE_FREE, FEEDER_COORDINATOR, chip_it)
+                .map_err(failed)?;
+            ports.zone_reserve =
+                zone_link(&remote, &cell, ZONE_RESERVE, FEEDER_COORDINATOR, chip_it)
+                    .map_err(failed)?;
+        }
+        FeederPolicy::Appendix => {}
     }
     ports.lines[line.index()]
         .declare_to(&cell)
@@ -493,7 +686,7 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     }
     cell.declare_imported(&ports.lines[line.other().index()].share_feeder)
         .map_err(CellErrors::from)?;
-    let devices = RemoteDevices::import(&remote, line).map_err(ipc(name))?;
+    let devices = RemoteDevices::import(&remote, line, process.run).map_err(ipc(name))?;
 
     let death: ReleaseDeath = Arc::default();
     for fault in &config.faults {
@@ -505,6 +698,7 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let waits: SharedWaits = Arc::default();
     let modules = LineModules {
         line,
+        run: process.run,
         feeder: config.feeder,
         ports,
         devices: Devices::Remote(Arc::new(devices)),
@@ -523,12 +717,43 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     });
 
     let total = Duration::from_secs_f64(config.hours * 3600.0);
+    let so_far = || {
+        let waits = lock(&waits)[line.index()];
+        let history = lock(&history).clone();
+        figures(&lock(&tally), &waits, &history, lateness.worst())
+    };
+    // The figures so far, once a minute: if this process dies, the world keeps them.
+    let mut next = clock.now() + SNAPSHOT_PERIOD;
+    while next < Instant::from_start(total) {
+        clock.sleep_until(next).await;
+        println!("snapshot {}", so_far());
+        let _ = std::io::stdout().flush();
+        next = next + SNAPSHOT_PERIOD;
+    }
     clock.sleep_until(Instant::from_start(total)).await;
     drop(shared);
-    let waits = lock(&waits)[line.index()];
-    let history = lock(&history).clone();
-    let figures = figures(&lock(&tally), &waits, &history, lateness.worst());
-    Ok(figures)
+    Ok(so_far())
+}
+
+/// Why a port of the feeder zone's keeper could not be imported.
+enum ZoneImport {
+    Ipc(IpcError),
+    Wiring(imrs_ports::WireError),
+}
+
+/// The keeper's port `port`, imported for `module` and made known to `cell`.
+fn zone_link<Req: imrs_ipc::Wire>(
+    remote: &Remote,
+    cell: &Cell,
+    port: &str,
+    keeper: &str,
+    module: &str,
+) -> Result<ZoneLink<Req>, ZoneImport> {
+    let imported = import::<Imported<Req, (), usage::Receive>, _>(remote, port, keeper, module)
+        .map_err(ZoneImport::Ipc)?;
+    cell.declare_imported(imported.port())
+        .map_err(ZoneImport::Wiring)?;
+    Ok(ZoneLink::Imported(Arc::new(imported)))
 }
 
 /// Imports the twin's SHARE_FEEDER for `module`, waiting (up to the world's patience) until
@@ -624,15 +849,14 @@ fn absorb(
         tally.last_deadlock = Some(tally.last_deadlock.map_or(last, |other| other.max(last)));
     }
     tally.deadlock_lost += figures["deadlock_lost"].as_f64()?;
+    // A line's runs, folded in order: the waits of each add up.
     let asked = &figures["waits"];
-    *waits = ZoneWaits {
-        asks: count(&asked[0])?,
-        refused: count(&asked[1])?,
-        waited: asked[2].as_f64()?,
-    };
+    waits.asks += count(&asked[0])?;
+    waits.refused += count(&asked[1])?;
+    waits.waited += asked[2].as_f64()?;
     let cycle = &figures["cycle_time"];
     let pair = |value: &Value| Some((value[0].as_f64()?, value[1].as_f64()?));
-    *history = CycleTimeHistory {
+    let run = CycleTimeHistory {
         first: float(&cycle["first"])?,
         now: float(&cycle["now"])?,
         range: match &cycle["range"] {
@@ -646,7 +870,8 @@ fn absorb(
             .map(pair)
             .collect::<Option<_>>()?,
     };
-    *lateness = Duration::from_micros(figures["lateness_us"].as_u64()?);
+    history.follow(run);
+    *lateness = (*lateness).max(Duration::from_micros(figures["lateness_us"].as_u64()?));
     Some(())
 }
 

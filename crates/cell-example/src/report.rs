@@ -9,6 +9,7 @@ use imrs_sim::{FeederId, PalletId, RobotId, Role};
 use crate::alarms::AlarmKind;
 use crate::chip::{FeederPolicy, ZoneWaits};
 use crate::gate::CycleTimeHistory;
+use crate::outage::Outage;
 use crate::run::RunRecord;
 use crate::tally::Cycles;
 
@@ -139,6 +140,8 @@ pub struct Report {
     pub processes: Option<f64>,
     /// Across processes: how late each process's timer woke at worst, in wall seconds.
     pub lateness: Vec<(String, f64)>,
+    /// Across processes: each line's process that died, and its return.
+    pub outages: Vec<Outage>,
 }
 
 impl Report {
@@ -292,6 +295,7 @@ impl Report {
             simulated: record.simulated.as_secs_f64(),
             wall: record.wall.as_secs_f64(),
             processes: record.config.processes.then_some(record.config.speed),
+            outages: record.outages.clone(),
             lateness: record
                 .lateness
                 .iter()
@@ -413,6 +417,12 @@ impl fmt::Display for Report {
                 "processes: world (simulation, WORLD{keeper}), line A, line B over iceoryx2, \
                  on the wall clock x {speed}"
             )?;
+            if self.outages.is_empty() {
+                writeln!(f, "outages: none")?;
+            }
+            for outage in &self.outages {
+                writeln!(f, "outage: {outage}")?;
+            }
         }
         writeln!(f)?;
         writeln!(f, "  {:<34}{:>12}{:>12}", "", "line A", "line B")?;
@@ -434,7 +444,7 @@ impl fmt::Display for Report {
         row(f, "pallets in progress", &|l| {
             self.lines[l].in_progress.to_string()
         })?;
-        row(f, "pallets scrapped (jammed)", &|l| {
+        row(f, "pallets scrapped", &|l| {
             self.lines[l].scrapped.to_string()
         })?;
         row(f, "cards per hour", &|l| {

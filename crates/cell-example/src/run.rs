@@ -21,6 +21,7 @@ use crate::devices::Devices;
 use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes, gate};
 use crate::load::{load_card, load_it, screw_in_card};
+use crate::outage::Outage;
 use crate::ports::CellPorts;
 use crate::processes::{self, DEFAULT_SPEED, LineProcess};
 use crate::tally::Tally;
@@ -122,6 +123,8 @@ pub struct RunRecord {
     /// Across processes: how late each process's timer woke at worst, in wall time (see
     /// [`crate::lateness`]). Empty in one process, on virtual time.
     pub lateness: Vec<(String, Duration)>,
+    /// Across processes: each line's process that died, and its return.
+    pub outages: Vec<Outage>,
 }
 
 /// The longest run: a year of shifts.
@@ -293,6 +296,7 @@ async fn simulate(
     let mut declarations = Vec::new();
     let line_modules = |line: Line| LineModules {
         line,
+        run: 0,
         feeder: config.feeder,
         ports: ports.clone(),
         devices: devices.clone(),
@@ -396,6 +400,7 @@ impl RunRecord {
             simulated,
             wall: Duration::ZERO,
             lateness: Vec::new(),
+            outages: Vec::new(),
         }
     }
 }
@@ -404,6 +409,9 @@ impl RunRecord {
 /// declare them for the wiring check and to start them, in one process or in a line's own.
 pub(crate) struct LineModules {
     pub(crate) line: Line,
+    /// Which run of the line's process this is: 0 in one process, counted by the world
+    /// across processes.
+    pub(crate) run: u32,
     pub(crate) feeder: FeederPolicy,
     pub(crate) ports: CellPorts,
     pub(crate) devices: Devices,
@@ -423,7 +431,15 @@ impl LineModules {
             load_it(line, lines, &self.devices).declaration(),
             load_card(line, lines, &self.devices).declaration(),
             screw_in_card(line, lines, &self.devices).declaration(),
-            chip_it(line, self.feeder, &self.ports, &self.devices, waits).declaration(),
+            chip_it(
+                line,
+                self.run,
+                self.feeder,
+                &self.ports,
+                &self.devices,
+                waits,
+            )
+            .declaration(),
         ]
     }
 
@@ -445,8 +461,9 @@ impl LineModules {
         })?;
         cell.start(load_it(line, &lines, &self.devices))?;
         let (ports, devices, waits, feeder) = (self.ports, self.devices, self.waits, self.feeder);
+        let run = self.run;
         cell.supervise(policy, move || {
-            chip_it(line, feeder, &ports, &devices, Arc::clone(&waits))
+            chip_it(line, run, feeder, &ports, &devices, Arc::clone(&waits))
         })?;
         Ok(())
     }

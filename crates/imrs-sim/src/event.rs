@@ -65,7 +65,8 @@ pub enum SimEventKind {
         /// The pallet.
         pallet: PalletId,
     },
-    /// A jammed pallet was taken off the line.
+    /// A pallet was taken off the line: jammed, or held by a station of a line whose
+    /// controller died.
     PalletScrapped {
         /// The line.
         line: Line,

@@ -11,7 +11,7 @@ use tokio::sync::Notify;
 use tokio::sync::futures::Notified;
 
 use crate::device::{Gate, Relay, Robot};
-use crate::event::{SimEvent, SimLog};
+use crate::event::{SimEvent, SimEventKind, SimLog};
 use crate::fault::Fault;
 use crate::ids::{FeederId, Line, PalletId, RobotId, Station};
 use crate::layout::STEP;
@@ -52,6 +52,8 @@ struct Shared {
     watchers: Mutex<Vec<Watcher>>,
     /// Whether anyone watches: read at every step, so that an unwatched world takes no lock.
     watched: AtomicBool,
+    /// Each robot's turn: a robot does one thing at a time, whoever drives it.
+    turns: [tokio::sync::Mutex<()>; 6],
 }
 
 /// Someone who draws the scene, at most once per `period` of the clock.
@@ -73,6 +75,7 @@ impl Sim {
                 log: SimLog::default(),
                 watchers: Mutex::new(Vec::new()),
                 watched: AtomicBool::new(false),
+                turns: Default::default(),
             }),
         }
     }
@@ -221,6 +224,26 @@ impl Sim {
             .into_iter()
             .for_each(|event| self.shared.log.record(event));
         result
+    }
+
+    /// Waits for `robot`'s turn: until what it is doing is done.
+    pub(crate) async fn turn(&self, robot: RobotId) -> tokio::sync::MutexGuard<'_, ()> {
+        self.shared.turns[robot.index()].lock().await
+    }
+
+    /// Takes off `line` every pallet its stations hold, as scrap: a line whose controller
+    /// died left them in a state nobody knows. Returns them.
+    pub fn scrap_held(&self, line: Line) -> Vec<PalletId> {
+        let scrapped = self.with(|world, _| world.scrap_held(line));
+        let at = self.now();
+        for &pallet in &scrapped {
+            self.record(SimEvent {
+                at,
+                kind: SimEventKind::PalletScrapped { line, pallet },
+            });
+        }
+        self.wake_stepper();
+        scrapped
     }
 
     pub(crate) fn record(&self, event: SimEvent) {

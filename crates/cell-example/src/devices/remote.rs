@@ -58,7 +58,8 @@ impl Device {
         }
     }
 
-    /// The module that drives it: the only user of its port.
+    /// The module that drives it, the user of its port beside the world's
+    /// [`LINE_SUPERVISOR`](crate::names::LINE_SUPERVISOR).
     pub fn user(self) -> String {
         match self {
             Device::Gate(line) => LineNames::of(line).gate,
@@ -78,9 +79,10 @@ impl Device {
 
 type DeviceEnd = End<DeviceCall, DeviceAnswer, usage::Send>;
 
-/// The end a device's proxies send on; `None` for a device this process did not import.
+/// The end a device's proxies send on, and the run of this line's process its calls are
+/// sent from; `None` for a device this process did not import.
 #[derive(Clone)]
-pub struct Link(Option<Arc<Mutex<DeviceEnd>>>);
+pub struct Link(Option<(Arc<Mutex<DeviceEnd>>, u32)>);
 
 impl fmt::Debug for Link {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -96,11 +98,11 @@ impl Link {
     /// Calls the device and waits for its answer; `None` if the world's process could not
     /// be reached or answered with a record that does not decode.
     pub async fn call(&self, op: Op) -> Option<Answer> {
-        let end = self.0.as_ref()?;
+        let (end, run) = self.0.as_ref()?;
         // One call at a time per device, as a device does one thing at a time; a call
         // dropped halfway (its module killed) frees the end with it.
         let mut end = end.lock().await;
-        let answer = end.send(DeviceCall::new(op)).await.ok()?;
+        let answer = end.send(DeviceCall::new(op).in_run(*run)).await.ok()?;
         answer.answer()
     }
 
@@ -111,7 +113,7 @@ impl Link {
             Some(Answer::Done) => Ok(0),
             Some(Answer::Value(value)) => Ok(value),
             Some(Answer::Failed(error)) => Err(error),
-            Some(Answer::Malformed | Answer::Sweep(_)) | None => {
+            Some(Answer::Malformed | Answer::Stale | Answer::Sweep(_)) | None => {
                 Err(DeviceError::RobotFault { robot })
             }
         }
@@ -141,7 +143,7 @@ impl Link {
         match self.call(op).await {
             Some(Answer::Value(pallet)) => Ok(pallet),
             Some(Answer::Failed(error)) => Err(error),
-            Some(Answer::Done | Answer::Malformed | Answer::Sweep(_)) | None => {
+            Some(Answer::Done | Answer::Malformed | Answer::Stale | Answer::Sweep(_)) | None => {
                 Err(DeviceError::NoPallet { line, station })
             }
         }
@@ -165,8 +167,9 @@ impl fmt::Debug for RemoteDevices {
 
 impl RemoteDevices {
     /// Imports every device of `line` from the world's process of `remote`'s cell, each for
-    /// the module that drives it. Call it within the tokio runtime the line runs on.
-    pub fn import(remote: &Remote, line: Line) -> Result<Self, IpcError> {
+    /// the module that drives it, whose calls are sent from `run` of the line's process.
+    /// Call it within the tokio runtime the line runs on.
+    pub fn import(remote: &Remote, line: Line, run: u32) -> Result<Self, IpcError> {
         let mut links = BTreeMap::new();
         let mut imported = Vec::new();
         for device in Device::of_line(line) {
@@ -177,7 +180,7 @@ impl RemoteDevices {
                 .port()
                 .user_named(user.as_str())
                 .map_err(IpcError::Local)?;
-            links.insert(device, Link(Some(Arc::new(Mutex::new(end)))));
+            links.insert(device, Link(Some((Arc::new(Mutex::new(end)), run))));
             imported.push(port);
         }
         Ok(Self {

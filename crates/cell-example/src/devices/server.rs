@@ -5,6 +5,8 @@ use imrs_core::prelude::*;
 use imrs_ports::{AnyUser, Port, PortSpec, SharedClock, usage};
 use imrs_sim::{Line, Sim};
 
+use crate::names::LINE_SUPERVISOR;
+
 use super::remote::Device;
 use super::wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op};
 use super::{Devices, GateDevice, RelayDevice, RobotDevice};
@@ -12,8 +14,9 @@ use super::{Devices, GateDevice, RelayDevice, RobotDevice};
 /// The module of the world's process that serves the devices.
 pub const WORLD: &str = "WORLD";
 
-/// A device's port: the world receives calls from the one module that drives it.
-pub type DevicePort = Port<DeviceCall, DeviceAnswer, usage::Receive, AnyUser, 1>;
+/// A device's port: the world receives calls from the one module that drives it, and from
+/// the world's supervision of the lines, which drives a dead line's chip robot home.
+pub type DevicePort = Port<DeviceCall, DeviceAnswer, usage::Receive, AnyUser, 2>;
 
 /// The ports of every device of the cell, owned by [`WORLD`].
 #[derive(Debug, Clone)]
@@ -31,7 +34,7 @@ impl DevicePorts {
             .map(|device| {
                 let spec = PortSpec::new(device.port(), WORLD)
                     .clock(clock.clone())
-                    .user_list([device.user()]);
+                    .user_list([device.user(), LINE_SUPERVISOR.to_owned()]);
                 (device, DevicePort::new(spec))
             })
             .collect();
@@ -41,6 +44,14 @@ impl DevicePorts {
     /// Every port, with the device it serves.
     pub fn iter(&self) -> impl Iterator<Item = &DevicePort> {
         self.ports.iter().map(|(_, port)| port)
+    }
+
+    /// The port of `device`.
+    pub fn of(&self, device: Device) -> Option<&DevicePort> {
+        self.ports
+            .iter()
+            .find(|(served, _)| *served == device)
+            .map(|(_, port)| port)
     }
 }
 
@@ -55,9 +66,17 @@ pub fn world(ports: &DevicePorts, sim: &Sim) -> ModuleSpec<()> {
             let (port, devices) = (port.clone(), devices.clone());
             async move {
                 let mut calls = port.owner()?;
+                // The latest run of the line's process heard from: a call of an earlier
+                // run, sent just before that run died, is not carried out.
+                let mut latest = 0;
                 loop {
                     // One call at a time: a device does one thing at a time.
                     let (call, reply) = ctx.receive(&mut calls).await?;
+                    if call.run() < latest {
+                        reply.reply(DeviceAnswer::new(&Answer::Stale));
+                        continue;
+                    }
+                    latest = call.run();
                     let answer = match call.op() {
                         Some(op) => carry_out(&devices, device, op).await,
                         None => DeviceAnswer::new(&Answer::Malformed),

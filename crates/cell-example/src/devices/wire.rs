@@ -64,6 +64,9 @@ pub struct DeviceCall {
     from_feeder: u32,
     from_at: [f32; 2],
     samples: u32,
+    /// The run of the caller's line process (see [`crate::zone_asker`]): the world heeds no
+    /// call of a run before the latest it has heard from.
+    run: u32,
 }
 
 const MOVE: u32 = 1;
@@ -144,6 +147,17 @@ impl DeviceCall {
         call
     }
 
+    /// The call, sent from `run` of its line's process.
+    pub fn in_run(mut self, run: u32) -> Self {
+        self.run = run;
+        self
+    }
+
+    /// The run of its line's process it was sent from.
+    pub fn run(&self) -> u32 {
+        self.run
+    }
+
     /// The call it encodes; `None` for a record no [`DeviceCall::new`] wrote.
     pub fn op(&self) -> Option<Op> {
         let feeder = || u8::try_from(self.feeder).ok().map(FeederId);
@@ -189,6 +203,7 @@ const VALUE: u32 = 1;
 const FAILED: u32 = 2;
 const MALFORMED: u32 = 3;
 const SWEPT: u32 = 4;
+const STALE: u32 = 5;
 
 /// What a device answered, decoded.
 #[derive(Debug, Clone, PartialEq)]
@@ -201,6 +216,8 @@ pub enum Answer {
     Failed(DeviceError),
     /// The world could not read the call.
     Malformed,
+    /// Not carried out: a call of a run of the line's process that has died since.
+    Stale,
     /// A sweep's poses: at most [`MAX_SWEEP_SAMPLES`] + 1.
     Sweep(Vec<Pose>),
 }
@@ -240,6 +257,10 @@ impl DeviceAnswer {
                 status: MALFORMED,
                 ..Self::default()
             },
+            Answer::Stale => Self {
+                status: STALE,
+                ..Self::default()
+            },
         }
     }
 
@@ -267,6 +288,7 @@ impl DeviceAnswer {
             VALUE => Answer::Value(self.value),
             FAILED => Answer::Failed(decode_error(self.error)?),
             MALFORMED => Answer::Malformed,
+            STALE => Answer::Stale,
             SWEPT => Answer::Sweep(
                 self.poses
                     .get(..usize::try_from(self.value).ok()?)?
@@ -283,7 +305,7 @@ impl Answer {
         match self {
             Answer::Value(pallet) => Some(Release::Released(PalletId(*pallet))),
             Answer::Done => Some(Release::BackedUp),
-            Answer::Failed(_) | Answer::Malformed | Answer::Sweep(_) => None,
+            Answer::Failed(_) | Answer::Malformed | Answer::Stale | Answer::Sweep(_) => None,
         }
     }
 }
@@ -495,6 +517,7 @@ mod tests {
             Answer::Done,
             Answer::Value(7),
             Answer::Malformed,
+            Answer::Stale,
             Answer::Sweep(sweep),
             Answer::Sweep(Vec::new()),
         ] {

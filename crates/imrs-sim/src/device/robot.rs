@@ -66,6 +66,7 @@ impl Robot {
     /// Moves the tool in a straight line to `target`, taking the time its trapezoidal
     /// profile takes.
     pub async fn move_to(&self, target: Target) -> Result<(), DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         let robot = self.id;
         let duration = self.sim.with(|world, now| {
             let to = world.reachable(robot, target)?;
@@ -83,6 +84,7 @@ impl Robot {
     /// Grasps a chip from `feeder`, where the tool must be. Fails on an empty feeder, which
     /// calls the operator: it is refilled [`REFILL_DELAY`](crate::layout::REFILL_DELAY) later.
     pub async fn grasp(&self, feeder: FeederId) -> Result<u32, DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         self.require_at(Target::Feeder(feeder), "feeder")?;
         self.spend_working(GRASP_TIME).await?;
         let robot = self.id;
@@ -106,6 +108,7 @@ impl Robot {
     /// tool is over the card (the simulation records the place, measured against the
     /// pallet's pose).
     pub async fn insert(&self) -> Result<u32, DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         let robot = self.id;
         let over_card = self
             .sim
@@ -146,6 +149,7 @@ impl Robot {
 
     /// Picks a blank card from the magazine, where the tool must be.
     pub async fn pick_card(&self) -> Result<(), DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         self.require_at(Target::Magazine, "magazine")?;
         self.spend_working(PICK_CARD_TIME).await?;
         let robot = self.id;
@@ -156,6 +160,7 @@ impl Robot {
 
     /// Lays the card it holds on the pallet its station holds.
     pub async fn place_card(&self) -> Result<(), DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         let robot = self.id;
         self.require_at(Target::Card, "card")?;
         if self.sim.with(|world, _| world.arm(robot).holding) != Some(Held::Card) {
@@ -182,6 +187,7 @@ impl Robot {
 
     /// Screws the card on the pallet its station holds to the pallet.
     pub async fn screw(&self) -> Result<(), DeviceError> {
+        let _turn = self.sim.turn(self.id).await;
         self.require_at(Target::Card, "card")?;
         self.spend_working(SCREW_TIME).await?;
         self.on_pallet(Station::Load, |world, line, now| {

@@ -111,6 +111,20 @@ impl Conveyor {
         Some(pallet.id)
     }
 
+    /// Takes off the line every pallet a station holds.
+    pub(crate) fn scrap_held(&mut self, physics: &mut Physics) -> Vec<PalletId> {
+        let mut scrapped = Vec::new();
+        self.pallets.retain(|pallet| {
+            let held = matches!(pallet.state, PalletState::Held(_));
+            if held {
+                physics.remove_pallet(pallet.body);
+                scrapped.push(pallet.id);
+            }
+            !held
+        });
+        scrapped
+    }
+
     /// Moves the pallets on by `seconds`, front first, recording arrivals and exits.
     pub(crate) fn advance(
         &mut self,

@@ -529,6 +529,11 @@ impl World {
         self.lines[line.index()].scrap(station, &mut self.physics)
     }
 
+    /// Takes off `line` every pallet its stations hold.
+    pub(crate) fn scrap_held(&mut self, line: Line) -> Vec<PalletId> {
+        self.lines[line.index()].scrap_held(&mut self.physics)
+    }
+
     /// The cell as rapier has it now.
     pub(crate) fn scene(&self, at: Instant) -> Scene {
         let arms = self
