@@ -12,7 +12,7 @@ use imrs_sim::Line;
 
 use crate::chip::FeederPolicy;
 use crate::faults::CellFault;
-use crate::processes::{DEFAULT_SPEED, LineProcess};
+use crate::processes::{DEFAULT_SPEED, LineProcess, Transport};
 use crate::run::{CellConfig, MAX_HOURS, TimelineConfig};
 
 /// The chip-insertion cell of Shin (1985), Appendix, on two lines, with a report.
@@ -61,6 +61,10 @@ struct Flags {
     /// up by --speed.
     #[arg(long)]
     processes: bool,
+    /// With --processes: what carries the ports between the processes: iceoryx2 on this
+    /// host, or zenoh with each process a host of its own (a network namespace, as root).
+    #[arg(long, value_enum, default_value_t = Transport::Ipc, requires = "processes")]
+    transport: Transport,
     /// With --processes: how many times as fast as the wall clock the cell runs.
     #[arg(long, value_name = "X", default_value_t = DEFAULT_SPEED, value_parser = speed, requires = "processes")]
     speed: f64,
@@ -74,6 +78,9 @@ struct Flags {
     /// since 1970.
     #[arg(long, hide = true, requires = "line_process")]
     epoch: Option<u64>,
+    /// Set by the world on a line's process over zenoh: the world's host's endpoint.
+    #[arg(long, hide = true, requires = "line_process")]
+    connect: Option<String>,
     /// Set by the world on a line's process: which run of the line's process it is (the
     /// world restarts a line whose process died).
     #[arg(long, hide = true, default_value_t = 0, requires = "line_process")]
@@ -161,6 +168,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
             line,
             run: flags.run,
             remote,
+            connect: flags.connect,
             epoch: UNIX_EPOCH + Duration::from_nanos(epoch),
         }),
         _ => None,
@@ -177,6 +185,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         timeline,
         processes: flags.processes,
         speed: flags.speed,
+        transport: flags.transport,
         line_process,
         ..CellConfig::default()
     })

@@ -15,6 +15,7 @@
 //! once, and the [`report`] sets them side by side, with what rapier measured.
 
 pub mod alarms;
+pub mod carrier;
 pub mod chip;
 pub mod cli;
 pub mod compare;

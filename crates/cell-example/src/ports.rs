@@ -2,14 +2,15 @@
 //! and replies in a recording (`--record`).
 
 use std::fmt;
-use std::sync::Arc;
 use std::time::Duration;
 
 use imrs_core::{Cell, Ctx};
-use imrs_ipc::{FromBytes, Imported, ZeroCopySend};
+use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_ports::{AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage};
 use imrs_sim::{Line, PalletId};
+use serde::{Deserialize, Serialize};
 
+use crate::carrier::Imported;
 use crate::chip::FeederPolicy;
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LINE_DOWN, LineNames, ZONE_FREE, ZONE_RELEASE,
@@ -46,7 +47,7 @@ pub type LineDownPort = Port<(Line, u32), (), usage::Receive, AnyUser, 1>;
 const MODULE_NAME: usize = 32;
 
 /// A module's name as a message that can cross processes: fixed-size and self-contained.
-#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes)]
+#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes, Serialize, Deserialize)]
 #[repr(C)]
 #[type_name("cell_example::ModuleName")]
 pub struct ModuleName {
@@ -98,7 +99,7 @@ pub enum ZoneLink<Req: Send + 'static = ModuleName> {
     /// The port itself.
     Here(ZonePort<Req>),
     /// The port of another process, through its bridge.
-    Imported(Arc<Imported<Req, ()>>),
+    Imported(Imported<Req, ()>),
 }
 
 impl<Req: Send + 'static> fmt::Debug for ZoneLink<Req> {

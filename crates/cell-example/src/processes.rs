@@ -42,21 +42,26 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_core::CellErrors;
 use imrs_core::prelude::*;
-use imrs_ipc::{Exported, Imported, IpcError, Remote, export, import};
+use imrs_ipc::Remote;
 use imrs_ports::{End, Instant, RealClock, SharedClock, usage};
-use imrs_sim::{Line, RobotId, Role, Sim, SimConfig, Target};
+use imrs_sim::{DeviceError, Line, RobotId, Role, Sim, SimConfig, Target};
+use imrs_zenoh::Host;
+use imrs_zenoh::netns::Netns;
 use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::alarms::AlarmKind;
+use crate::carrier::{Carrier, CarrierError, Crossing, Exported, Imported};
 use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_coordinator, feeder_monitor};
 use crate::devices::{
-    Answer, Device, DeviceAnswer, DeviceCall, DevicePorts, Devices, Op, RemoteDevices, world,
+    Answer, Device, DeviceAnswer, DeviceCall, DevicePorts, Devices, LineRuns, Op, RemoteDevices,
+    world,
 };
 use crate::faults::{CellFault, CellFaultKind};
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
@@ -88,8 +93,27 @@ pub const RESTARTS: u32 = 3;
 /// dies loses at most this much of them.
 const SNAPSHOT_PERIOD: Duration = Duration::from_secs(60);
 
+/// What carries the ports between the processes of a run across processes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Transport {
+    /// iceoryx2: the processes of one host, through shared memory.
+    Ipc,
+    /// zenoh: each process a host of its own (a network namespace, where they can be made).
+    Zenoh,
+}
+
+impl Transport {
+    /// Its name, as `--transport` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Ipc => "ipc",
+            Transport::Zenoh => "zenoh",
+        }
+    }
+}
+
 /// What makes a process one line's part of a cell run across processes: the line, the
-/// cell's name on this host, and the moment its time starts.
+/// cell's name, where the world's host is (over zenoh), and the moment its time starts.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineProcess {
     /// The line whose modules it runs.
@@ -97,8 +121,11 @@ pub struct LineProcess {
     /// Which run of the line's process it is: 0 first, then one more each time the world
     /// starts it again.
     pub run: u32,
-    /// The cell's name, from which every port's service name is derived.
+    /// The cell's name, from which every port's service name (or key) is derived.
     pub remote: String,
+    /// Over zenoh, the world's host's endpoint, which the line's host connects to; over
+    /// iceoryx2, `None`.
+    pub connect: Option<String>,
     /// When the cell's time is zero, on the system clock.
     pub epoch: SystemTime,
 }
@@ -118,6 +145,11 @@ pub(crate) fn check_config(config: &CellConfig) -> Result<(), RunError> {
         Some("--tree: each process has a module tree of its own")
     } else if config.realtime {
         Some("--realtime: a run across processes is on the wall clock already (see --speed)")
+    } else if config.transport == Transport::Zenoh && config.feeder == FeederPolicy::Appendix {
+        Some(
+            "--transport zenoh with --feeder appendix: under the Appendix's policy the lines \
+             ask each other, and over zenoh each line's host reaches the world's only",
+        )
     } else {
         None
     };
@@ -147,8 +179,72 @@ fn clock(process: &str, epoch: SystemTime, speed: f64) -> Result<SharedClock, Ru
     }
 }
 
-fn ipc(process: &str) -> impl Fn(IpcError) -> RunError + '_ {
+fn carried<E: std::fmt::Display>(process: &str) -> impl Fn(E) -> RunError + '_ {
     move |error| refused(process, error)
+}
+
+/// Over zenoh, where the lines' hosts are: a network namespace each, joined to the world's
+/// by a veth link, or (where namespaces cannot be made) this host's loopback.
+struct Hosts {
+    /// Per line: its namespace, if made.
+    netns: Vec<Netns>,
+    /// Per line: the world's endpoint as the line reaches it.
+    endpoints: [String; 2],
+    /// How the report names them.
+    described: String,
+}
+
+/// The world's side of what carries the ports: iceoryx2 under the cell's name, or a zenoh
+/// host listening for the lines' hosts.
+async fn world_carrier(
+    config: &CellConfig,
+    cell: &str,
+) -> Result<(Carrier, Option<Hosts>), RunError> {
+    match config.transport {
+        Transport::Ipc => Ok((
+            Carrier::Ipc(Remote::new(cell).map_err(carried("world"))?),
+            None,
+        )),
+        Transport::Zenoh => {
+            let probe = std::net::TcpListener::bind("0.0.0.0:0")
+                .map_err(|error| refused("world", format!("no free port: {error}")))?;
+            let port = probe
+                .local_addr()
+                .map_err(|error| refused("world", error))?
+                .port();
+            drop(probe);
+            let hosts = match Netns::make(0).and_then(|a| Ok(vec![a, Netns::make(1)?])) {
+                Ok(netns) => Hosts {
+                    endpoints: [0, 1].map(|i| format!("tcp/{}:{port}", netns[i].outside_address())),
+                    netns,
+                    described: "each a host of its own (a network namespace, joined to the \
+                                world's by a veth link)"
+                        .into(),
+                },
+                Err(why) => {
+                    eprintln!(
+                        "\n*** HOSTS ON LOOPBACK, NOT APART: network namespaces could not be \
+                         made ({why}); the lines run as processes of this host, over zenoh \
+                         on 127.0.0.1 ***\n"
+                    );
+                    Hosts {
+                        netns: Vec::new(),
+                        endpoints: [0, 1].map(|_| format!("tcp/127.0.0.1:{port}")),
+                        described: format!(
+                            "ON LOOPBACK, not hosts apart (network namespaces could not be \
+                             made: {why})"
+                        ),
+                    }
+                }
+            };
+            let host = Host::builder(cell)
+                .listen(format!("tcp/0.0.0.0:{port}"))
+                .open()
+                .await
+                .map_err(carried("world"))?;
+            Ok((Carrier::Zenoh(host), Some(hosts)))
+        }
+    }
 }
 
 /// Runs the cell across three processes — this one the world's — and folds the lines'
@@ -169,8 +265,8 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
         .unwrap_or_default()
         .subsec_nanos();
     // Unique on this host: two runs never meet.
-    let remote =
-        Remote::new(&format!("chip_cell-{}-{nanos}", std::process::id())).map_err(ipc("world"))?;
+    let cell_name = format!("chip_cell-{}-{nanos}", std::process::id());
+    let (carrier, hosts) = world_carrier(config, &cell_name).await?;
     let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let cell = Cell::new(clock.clone());
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
@@ -220,47 +316,55 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
         FeederPolicy::Coordinator => Some(feeder_coordinator(&ports)),
         FeederPolicy::Appendix => None,
     };
-    let mut declarations = vec![world(&devices, &sim).declaration()];
+    // The run of each line's process whose device calls WORLD carries out.
+    let runs: LineRuns = Arc::default();
+    let mut declarations = vec![world(&devices, &sim, &runs).declaration()];
     declarations.extend(keeper.iter().map(ModuleSpec::declaration));
     cell.check(&declarations)?;
     // Exported before a line starts: a line imports them at once.
     let mut exported: Vec<Exported> = Vec::new();
     for port in asked {
-        exported.push(export(&remote, port).map_err(ipc("world"))?);
+        exported.push(carrier.export(port).await.map_err(carried("world"))?);
     }
     if let Some(port) = free {
-        exported.push(export(&remote, port).map_err(ipc("world"))?);
+        exported.push(carrier.export(port).await.map_err(carried("world"))?);
     }
     if let Some(port) = reserve {
-        exported.push(export(&remote, port).map_err(ipc("world"))?);
+        exported.push(carrier.export(port).await.map_err(carried("world"))?);
     }
     for port in devices.iter() {
-        exported.push(export(&remote, port).map_err(ipc("world"))?);
+        exported.push(carrier.export(port).await.map_err(carried("world"))?);
     }
     sim.spawn();
-    cell.start(world(&devices, &sim))?;
+    cell.start(world(&devices, &sim, &runs))?;
     if let Some(keeper) = keeper {
         cell.start(keeper)?;
     }
 
     // The world's hands on a dead line: its chip robot's port, and FEEDER_MONITOR's ear.
     let supervisor = match config.feeder {
-        FeederPolicy::Arbiter => Some(Supervisor::new(&devices, &ports)?),
+        FeederPolicy::Arbiter => Some(Supervisor::new(&devices, &ports, &runs)?),
         FeederPolicy::Appendix | FeederPolicy::Coordinator => None,
     };
     let (tell, mut hear) = unbounded_channel();
     let mut lines = Lines(Vec::new());
+    let start = |line: Line, run: u32, faults: &[CellFault]| {
+        let place = LinePlace {
+            cell: &cell_name,
+            netns: hosts
+                .as_ref()
+                .and_then(|hosts| hosts.netns.get(line.index())),
+            connect: hosts
+                .as_ref()
+                .map(|hosts| hosts.endpoints[line.index()].as_str()),
+        };
+        start_line(config, line, run, &place, epoch, faults, tell.clone())
+    };
     for line in Line::ALL {
-        lines.0.push(start_line(
-            config,
-            line,
-            0,
-            &remote,
-            epoch,
-            &config.faults,
-            tell.clone(),
-        )?);
+        lines.0.push((line, 0, start(line, 0, &config.faults)?));
     }
+    // A line that cannot start (or dies before it is first ready) fails the run: there is
+    // nothing yet to go on from.
     for _ in Line::ALL {
         match hear_from(&mut hear).await? {
             (_, _, Said::Ready) => {}
@@ -312,6 +416,18 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             Said::Figures(figures) if finals[i].is_none() => finals[i] = Some(figures),
             // A line that sent its figures may end before the other sends its own.
             Said::Ended(_) if finals[i].is_some() => {}
+            // A line's last words cut short by its death: the death follows.
+            Said::Garbled(text) => {
+                eprintln!(
+                    "{}: said {text:?}, which the world does not read",
+                    process_name(line)
+                );
+            }
+            // A line that dies after the end, before its figures: its figures of the last
+            // minute stand for them.
+            Said::Ended(_) | Said::Failed(_) if ended && latest[i].is_some() => {
+                finals[i] = latest[i].take();
+            }
             Said::Ended(_) | Said::Failed(_) if !ended => {
                 let Some(supervisor) = &supervisor else {
                     return Err(said.refusal_restartless(line, config.feeder));
@@ -328,7 +444,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                 let died = clock.now();
                 let next = runs[i] + 1;
                 banked[i].extend(latest[i].take());
-                let scrapped = supervisor.take_over(line, next, &sim).await?;
+                // A run that said it failed may still be ending: it goes first.
+                lines.stop(line, runs[i]);
+                let scrapped = supervisor.take_over(line, next, &sim).await? as u32;
                 runs[i] = next;
                 // Faults still to come; those past happened to the run that died.
                 let faults: Vec<CellFault> = config
@@ -337,22 +455,24 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                     .filter(|fault| Instant::from_start(fault.at) > clock.now())
                     .cloned()
                     .collect();
-                lines.0.push(start_line(
-                    config,
-                    line,
-                    next,
-                    &remote,
-                    epoch,
-                    &faults,
-                    tell.clone(),
-                )?);
-                outages.push(Outage {
-                    line,
-                    died: died.since_start().as_secs_f64(),
-                    back: None,
-                    run: next,
-                    scrapped: scrapped as u32,
-                });
+                lines.0.push((line, next, start(line, next, &faults)?));
+                // A run that died before it was ready prolongs the outage it was to end.
+                match outages
+                    .iter_mut()
+                    .find(|outage| outage.line == line && outage.back.is_none())
+                {
+                    Some(outage) => {
+                        outage.run = next;
+                        outage.scrapped += scrapped;
+                    }
+                    None => outages.push(Outage {
+                        line,
+                        died: died.since_start().as_secs_f64(),
+                        back: None,
+                        run: next,
+                        scrapped,
+                    }),
+                }
             }
             other => return Err(other.refusal(line, "its figures")),
         }
@@ -385,58 +505,87 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             .map(|line| (process_name(line).into(), late[line.index()])),
     );
     record.outages = outages;
+    record.hosts = hosts.map(|hosts| hosts.described);
     Ok(record)
 }
 
-/// The world's hands on a line whose process died: the chip robot's port, as
-/// [`LINE_SUPERVISOR`], and FEEDER_MONITOR's LINE_DOWN.
+/// The world's hands on a line whose process died: a place, as [`LINE_SUPERVISOR`], on
+/// every device's port (a port is never left without a user while a line's next run
+/// attaches, which would end WORLD's service of it for good), FEEDER_MONITOR's LINE_DOWN,
+/// and the runs WORLD carries out calls of.
 struct Supervisor {
-    chip_robots: [tokio::sync::Mutex<End<DeviceCall, DeviceAnswer, usage::Send>>; 2],
+    devices: Vec<(Device, tokio::sync::Mutex<DeviceEnd>)>,
     line_down: tokio::sync::Mutex<End<(Line, u32), (), usage::Send>>,
+    runs: LineRuns,
 }
 
+/// The supervision's end on a device's port.
+type DeviceEnd = End<DeviceCall, DeviceAnswer, usage::Send>;
+
+/// How many times the world tries to drive a dead line's chip robot home while a robot
+/// fault stops it.
+const HOMING_TRIES: u32 = 5;
+
 impl Supervisor {
-    fn new(devices: &DevicePorts, ports: &CellPorts) -> Result<Self, RunError> {
-        let robot = |line: Line| {
-            let device = Device::Robot(RobotId::new(line, Role::ChipIt));
-            let port = devices
-                .of(device)
-                .ok_or_else(|| refused("world", format!("no port for {}", device.port())))?;
-            let end = port
-                .user_named(LINE_SUPERVISOR)
-                .map_err(|error| refused("world", error))?;
-            Ok::<_, RunError>(tokio::sync::Mutex::new(end))
-        };
+    fn new(devices: &DevicePorts, ports: &CellPorts, runs: &LineRuns) -> Result<Self, RunError> {
+        let ends = Line::ALL
+            .into_iter()
+            .flat_map(Device::of_line)
+            .map(|device| {
+                let port = devices
+                    .of(device)
+                    .ok_or_else(|| refused("world", format!("no port for {}", device.port())))?;
+                let end = port
+                    .user_named(LINE_SUPERVISOR)
+                    .map_err(|error| refused("world", error))?;
+                Ok((device, tokio::sync::Mutex::new(end)))
+            })
+            .collect::<Result<_, RunError>>()?;
         let line_down = ports
             .line_down
             .user_named(LINE_SUPERVISOR)
             .map_err(|error| refused("world", error))?;
         Ok(Self {
-            chip_robots: [robot(Line::A)?, robot(Line::B)?],
+            devices: ends,
             line_down: tokio::sync::Mutex::new(line_down),
+            runs: Arc::clone(runs),
         })
     }
 
-    /// Makes `line`, whose process died, safe for its `next` run: scraps the pallets its
-    /// stations hold, drives its chip robot home (as `next`, so that WORLD carries out no
-    /// call the dead run left on its way), then tells FEEDER_MONITOR. Returns how many
-    /// pallets were scrapped.
+    /// Makes `line`, whose process died, safe for its `next` run: WORLD heeds no call of the
+    /// dead run from now on; the chip robot is driven home (once what it is doing is done);
+    /// the pallets the line's stations hold are scrapped; then FEEDER_MONITOR is told.
+    /// Returns how many pallets were scrapped.
     async fn take_over(&self, line: Line, next: u32, sim: &Sim) -> Result<usize, RunError> {
-        let scrapped = sim.scrap_held(line).len();
+        self.runs[line.index()].store(next, Ordering::Release);
+        let robot = Device::Robot(RobotId::new(line, Role::ChipIt));
+        let Some((_, end)) = self.devices.iter().find(|(device, _)| *device == robot) else {
+            return Err(refused("world", format!("no port for {}", robot.port())));
+        };
+        let mut end = end.lock().await;
         let home = DeviceCall::new(Op::Move(Target::Home)).in_run(next);
-        let answer = self.chip_robots[line.index()]
-            .lock()
-            .await
-            .send(home)
-            .await
-            .map_err(|error| refused("world", format!("{line:?}'s chip robot: {error}")))?;
-        if let Some(Answer::Failed(error)) = answer.answer() {
-            // A robot that cannot go home stays where it is: the zone stays its line's.
-            return Err(refused(
-                process_name(line),
-                format!("its chip robot could not be driven home: {error}"),
-            ));
+        let mut tries = 0;
+        loop {
+            tries += 1;
+            let answer = end
+                .send(home)
+                .await
+                .map_err(|error| refused("world", format!("{}: {error}", robot.port())))?;
+            match answer.answer() {
+                // A robot fault is passing (an injected one): try again, as a module would.
+                Some(Answer::Failed(DeviceError::RobotFault { .. })) if tries < HOMING_TRIES => {}
+                // A robot that cannot go home stays where it is: the run cannot go on safely.
+                Some(Answer::Failed(error)) => {
+                    return Err(refused(
+                        process_name(line),
+                        format!("its chip robot could not be driven home: {error}"),
+                    ));
+                }
+                _ => break,
+            }
         }
+        drop(end);
+        let scrapped = sim.scrap_held(line).len();
         self.line_down
             .lock()
             .await
@@ -519,9 +668,23 @@ async fn hear_from(hear: &mut UnboundedReceiver<Heard>) -> Result<Heard, RunErro
 }
 
 /// The lines' processes: killed if the world gives up on them.
-struct Lines(Vec<Child>);
+struct Lines(Vec<(Line, u32, Child)>);
 
 impl Lines {
+    /// Kills `line`'s process of `run`, if it still runs, and waits for its end.
+    fn stop(&mut self, line: Line, run: u32) {
+        for (_, _, child) in self
+            .0
+            .iter_mut()
+            .filter(|(l, r, _)| (*l, *r) == (line, run))
+        {
+            if let Ok(None) = child.try_wait() {
+                let _ = child.kill();
+            }
+            let _ = child.wait();
+        }
+    }
+
     /// Gives the lines, which have sent their figures, the world's patience to end on
     /// their own (so that they let go of their shared memory); any still running then is
     /// killed when `self` drops. The world never hangs on a line that does not end.
@@ -531,7 +694,7 @@ impl Lines {
             && self
                 .0
                 .iter_mut()
-                .any(|child| matches!(child.try_wait(), Ok(None)))
+                .any(|(_, _, child)| matches!(child.try_wait(), Ok(None)))
         {
             tokio::time::sleep(Duration::from_millis(20)).await;
         }
@@ -540,7 +703,7 @@ impl Lines {
 
 impl Drop for Lines {
     fn drop(&mut self) {
-        for child in &mut self.0 {
+        for (_, _, child) in &mut self.0 {
             if let Ok(None) = child.try_wait() {
                 let _ = child.kill();
                 let _ = child.wait();
@@ -551,11 +714,19 @@ impl Drop for Lines {
 
 /// Starts `line`'s process — this same program, told which line it is — and a thread that
 /// hands on what it says.
+/// Where a line's process runs: the cell's name, and over zenoh its host's namespace (if
+/// made) and the world's endpoint as it reaches it.
+struct LinePlace<'a> {
+    cell: &'a str,
+    netns: Option<&'a Netns>,
+    connect: Option<&'a str>,
+}
+
 fn start_line(
     config: &CellConfig,
     line: Line,
     run: u32,
-    remote: &Remote,
+    place: &LinePlace<'_>,
     epoch: SystemTime,
     faults: &[CellFault],
     said: UnboundedSender<Heard>,
@@ -567,17 +738,23 @@ fn start_line(
         .duration_since(UNIX_EPOCH)
         .map_err(|_| refused(name, "the epoch lies before 1970"))?
         .as_nanos();
-    let mut command = Command::new(program);
+    let mut command = match place.netns {
+        Some(netns) => netns.command(program),
+        None => Command::new(program),
+    };
     command
         .args(["--processes", "--line-process", &format!("{line:?}")])
         .args(["--run", &run.to_string()])
-        .args(["--remote", remote.cell(), "--epoch", &epoch_ns.to_string()])
+        .args(["--remote", place.cell, "--epoch", &epoch_ns.to_string()])
         .args(["--speed", &config.speed.to_string()])
         .args(["--hours", &config.hours.to_string()])
         .args(["--seed", &config.seed.to_string()])
         .args(["--feeder", config.feeder.name()]);
     for fault in faults {
         command.arg(format!("--fault={fault}"));
+    }
+    if let Some(endpoint) = place.connect {
+        command.args(["--transport", "zenoh", "--connect", endpoint]);
     }
     let mut child = command
         .stdin(Stdio::piped())
@@ -634,7 +811,16 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let (line, name) = (process.line, process_name(process.line));
     let clock = clock(name, process.epoch, config.speed)?;
     let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
-    let remote = Remote::new(&process.remote).map_err(ipc(name))?;
+    let carrier = match &process.connect {
+        None => Carrier::Ipc(Remote::new(&process.remote).map_err(carried(name))?),
+        Some(endpoint) => Carrier::Zenoh(
+            Host::builder(&process.remote)
+                .connect(endpoint)
+                .open()
+                .await
+                .map_err(carried(name))?,
+        ),
+    };
     let cell = Cell::new(clock.clone());
     // The report counts the time lost to deadlocks from how long each wait lasted.
     cell.observe(true);
@@ -648,22 +834,26 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let mut ports = CellPorts::new(&clock);
     // The feeder zone's keeper runs in the world's process: its ports are imported.
     let failed = |error: ZoneImport| match error {
-        ZoneImport::Ipc(error) => refused(name, error),
+        ZoneImport::Carrier(error) => refused(name, error),
         ZoneImport::Wiring(error) => RunError::from(CellErrors::from(error)),
     };
     let chip_it = &names.chip_it;
     match config.feeder {
         FeederPolicy::Arbiter => {
-            ports.zone_request =
-                zone_link(&remote, &cell, ZONE_REQUEST, FEEDER_MONITOR, chip_it).map_err(failed)?;
-            ports.zone_release =
-                zone_link(&remote, &cell, ZONE_RELEASE, FEEDER_MONITOR, chip_it).map_err(failed)?;
+            ports.zone_request = zone_link(&carrier, &cell, ZONE_REQUEST, FEEDER_MONITOR, chip_it)
+                .await
+                .map_err(failed)?;
+            ports.zone_release = zone_link(&carrier, &cell, ZONE_RELEASE, FEEDER_MONITOR, chip_it)
+                .await
+                .map_err(failed)?;
         }
         FeederPolicy::Coordinator => {
-            ports.zone_free = zone_link(&remote, &cell, ZONE_FREE, FEEDER_COORDINATOR, chip_it)
+            ports.zone_free = zone_link(&carrier, &cell, ZONE_FREE, FEEDER_COORDINATOR, chip_it)
+                .await
                 .map_err(failed)?;
             ports.zone_reserve =
-                zone_link(&remote, &cell, ZONE_RESERVE, FEEDER_COORDINATOR, chip_it)
+                zone_link(&carrier, &cell, ZONE_RESERVE, FEEDER_COORDINATOR, chip_it)
+                    .await
                     .map_err(failed)?;
         }
         FeederPolicy::Appendix => {}
@@ -677,16 +867,21 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     // nobody queries them, and the twin's stays a port of this process.
     let mut shared: Option<(Exported, Imported<(), i32, usage::Query>)> = None;
     if config.feeder == FeederPolicy::Appendix {
-        let own = export(&remote, &ports.lines[line.index()].share_feeder).map_err(ipc(name))?;
-        let imported = import_twin(&remote, &twin.share_feeder, &twin.chip_it, &names.chip_it)
+        let own = carrier
+            .export(&ports.lines[line.index()].share_feeder)
             .await
-            .map_err(ipc(name))?;
+            .map_err(carried(name))?;
+        let imported = import_twin(&carrier, &twin.share_feeder, &twin.chip_it, &names.chip_it)
+            .await
+            .map_err(carried(name))?;
         ports.lines[line.other().index()].share_feeder = imported.port().clone();
         shared = Some((own, imported));
     }
     cell.declare_imported(&ports.lines[line.other().index()].share_feeder)
         .map_err(CellErrors::from)?;
-    let devices = RemoteDevices::import(&remote, line, process.run).map_err(ipc(name))?;
+    let devices = RemoteDevices::import(&carrier, line, process.run)
+        .await
+        .map_err(carried(name))?;
 
     let death: ReleaseDeath = Arc::default();
     for fault in &config.faults {
@@ -737,38 +932,40 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
 
 /// Why a port of the feeder zone's keeper could not be imported.
 enum ZoneImport {
-    Ipc(IpcError),
+    Carrier(CarrierError),
     Wiring(imrs_ports::WireError),
 }
 
 /// The keeper's port `port`, imported for `module` and made known to `cell`.
-fn zone_link<Req: imrs_ipc::Wire>(
-    remote: &Remote,
+async fn zone_link<Req: Crossing>(
+    carrier: &Carrier,
     cell: &Cell,
     port: &str,
     keeper: &str,
     module: &str,
 ) -> Result<ZoneLink<Req>, ZoneImport> {
-    let imported = import::<Imported<Req, (), usage::Receive>, _>(remote, port, keeper, module)
-        .map_err(ZoneImport::Ipc)?;
+    let imported = carrier
+        .import::<Req, (), usage::Receive>(port, keeper, module)
+        .await
+        .map_err(ZoneImport::Carrier)?;
     cell.declare_imported(imported.port())
         .map_err(ZoneImport::Wiring)?;
-    Ok(ZoneLink::Imported(Arc::new(imported)))
+    Ok(ZoneLink::Imported(imported))
 }
 
 /// Imports the twin's SHARE_FEEDER for `module`, waiting (up to the world's patience) until
 /// the twin's process has exported it: the two lines start at once, and each exports its own
 /// before it imports the other's.
 async fn import_twin(
-    remote: &Remote,
+    carrier: &Carrier,
     port: &str,
     owner: &str,
     module: &str,
-) -> Result<Imported<(), i32, usage::Query>, IpcError> {
+) -> Result<Imported<(), i32, usage::Query>, CarrierError> {
     let deadline = std::time::Instant::now() + PATIENCE;
     loop {
-        match import::<Imported<(), i32, usage::Query>, _>(remote, port, owner, module) {
-            Err(IpcError::NoOwner { .. }) if std::time::Instant::now() < deadline => {
+        match carrier.import(port, owner, module).await {
+            Err(error) if error.is_no_owner() && std::time::Instant::now() < deadline => {
                 tokio::time::sleep(Duration::from_millis(20)).await;
             }
             other => return other,

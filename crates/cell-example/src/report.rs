@@ -142,6 +142,8 @@ pub struct Report {
     pub lateness: Vec<(String, f64)>,
     /// Across processes: each line's process that died, and its return.
     pub outages: Vec<Outage>,
+    /// Across processes over zenoh: where the lines' hosts were; `None` over iceoryx2.
+    pub hosts: Option<String>,
 }
 
 impl Report {
@@ -296,6 +298,7 @@ impl Report {
             wall: record.wall.as_secs_f64(),
             processes: record.config.processes.then_some(record.config.speed),
             outages: record.outages.clone(),
+            hosts: record.hosts.clone(),
             lateness: record
                 .lateness
                 .iter()
@@ -412,10 +415,14 @@ impl fmt::Display for Report {
                 FeederPolicy::Coordinator => ", FEEDER_COORDINATOR",
                 FeederPolicy::Appendix => "",
             };
+            let carried = match &self.hosts {
+                Some(hosts) => format!("over zenoh, {hosts}"),
+                None => "over iceoryx2".into(),
+            };
             writeln!(
                 f,
-                "processes: world (simulation, WORLD{keeper}), line A, line B over iceoryx2, \
-                 on the wall clock x {speed}"
+                "processes: world (simulation, WORLD{keeper}), line A, line B {carried}, on \
+                 the wall clock x {speed}"
             )?;
             if self.outages.is_empty() {
                 writeln!(f, "outages: none")?;

@@ -4,6 +4,8 @@
 use std::fmt;
 
 use imrs_ipc::{FromBytes, ZeroCopySend};
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::devices::Pose;
 use crate::ports::ModuleName;
@@ -68,6 +70,27 @@ impl fmt::Debug for Reservation {
     }
 }
 
+/// Across hosts a reservation is its robot and the poses it holds, no more: the record's
+/// unused room does not cross.
+impl Serialize for Reservation {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        (self.robot, self.sweep().unwrap_or_default()).serialize(serializer)
+    }
+}
+
+/// A reservation read from a peer: refused if it holds more poses than a reservation can.
+impl<'de> Deserialize<'de> for Reservation {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let (robot, sweep): (ModuleName, Vec<Pose>) = Deserialize::deserialize(deserializer)?;
+        Reservation::new(robot.as_str(), &sweep).ok_or_else(|| {
+            D::Error::custom(format!(
+                "a reservation of {} poses, past the {MAX_POSES} one can hold",
+                sweep.len()
+            ))
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,5 +110,24 @@ mod tests {
             ..Reservation::default()
         };
         assert_eq!(garbled.sweep(), None);
+    }
+
+    #[test]
+    fn a_reservation_crosses_hosts_as_its_robot_and_poses() {
+        let sweep: Vec<Pose> = (0..3)
+            .map(|i| [[0.0, 0.0], [0.01 * i as f32, 0.2], [0.3, 0.4]])
+            .collect();
+        let reservation = Reservation::new("CHIP_IT", &sweep).unwrap();
+        let text = serde_json::to_string(&reservation).unwrap();
+        let back: Reservation = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.robot(), reservation.robot());
+        assert_eq!(back.sweep(), Some(&sweep[..]));
+        let too_long = (
+            ModuleName::new("CHIP_IT"),
+            vec![Pose::default(); MAX_POSES + 1],
+        );
+        let error = serde_json::from_str::<Reservation>(&serde_json::to_string(&too_long).unwrap())
+            .unwrap_err();
+        assert!(error.to_string().contains("65 poses"), "{error}");
     }
 }

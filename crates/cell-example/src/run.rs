@@ -23,7 +23,7 @@ use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes, gate};
 use crate::load::{load_card, load_it, screw_in_card};
 use crate::outage::Outage;
 use crate::ports::CellPorts;
-use crate::processes::{self, DEFAULT_SPEED, LineProcess};
+use crate::processes::{self, DEFAULT_SPEED, LineProcess, Transport};
 use crate::tally::Tally;
 
 /// How a run is made.
@@ -55,6 +55,8 @@ pub struct CellConfig {
     pub processes: bool,
     /// Across processes, how many times as fast as the wall clock the cell runs.
     pub speed: f64,
+    /// Across processes, what carries the ports between them.
+    pub transport: Transport,
     /// Set in a line's process, which the world started.
     pub line_process: Option<LineProcess>,
 }
@@ -85,6 +87,7 @@ impl Default for CellConfig {
             timeline: None,
             processes: false,
             speed: DEFAULT_SPEED,
+            transport: Transport::Ipc,
             line_process: None,
         }
     }
@@ -125,6 +128,8 @@ pub struct RunRecord {
     pub lateness: Vec<(String, Duration)>,
     /// Across processes: each line's process that died, and its return.
     pub outages: Vec<Outage>,
+    /// Across processes over zenoh: where the lines' hosts were.
+    pub hosts: Option<String>,
 }
 
 /// The longest run: a year of shifts.
@@ -401,6 +406,7 @@ impl RunRecord {
             wall: Duration::ZERO,
             lateness: Vec::new(),
             outages: Vec::new(),
+            hosts: None,
         }
     }
 }

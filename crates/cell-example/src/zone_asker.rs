@@ -11,12 +11,13 @@ use std::fmt;
 
 use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_sim::Line;
+use serde::{Deserialize, Serialize};
 
 use crate::ports::ModuleName;
 
 /// A chip robot's word to the feeder zone's monitor: a fixed-size record that crosses
 /// processes as it is.
-#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes)]
+#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes, Serialize, Deserialize)]
 #[repr(C)]
 #[type_name("cell_example::ZoneAsker")]
 pub struct ZoneAsker {

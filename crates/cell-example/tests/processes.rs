@@ -370,6 +370,43 @@ fn a_line_killed_mid_run_is_started_again_and_the_other_goes_on() {
 }
 
 #[test]
+fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
+    // Six simulated minutes at twenty times the wall clock, the lines' processes each in a
+    // network namespace of its own (as root; else on loopback, said loudly).
+    let world = World::start(&["--transport", "zenoh", "--hours", "0.1", "--speed", "20"]);
+    world.lines();
+    let line_b = line_process(world.pid(), "B").unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    kill_9(line_process(world.pid(), "A").unwrap());
+    let report = world.report(Duration::from_secs(120));
+    let apart = report.contains(
+        "line A, line B over zenoh, each a host of its own (a network namespace, joined to \
+         the world's by a veth link)",
+    );
+    let loopback = report.contains("line A, line B over zenoh, ON LOOPBACK, not hosts apart");
+    assert!(apart || loopback, "{report}");
+    if loopback {
+        eprintln!("\n*** this run's hosts were on loopback, not apart: see the report ***\n");
+    }
+    assert!(!alive(line_b), "line B outlived the run");
+    let outage = report
+        .lines()
+        .find_map(|line| line.strip_prefix("outage: "))
+        .unwrap_or_else(|| panic!("no outage in\n{report}"));
+    assert!(
+        outage.starts_with("line A's process died at ") && outage.contains("(run 1), back "),
+        "{outage}"
+    );
+    // The restarted line worked again: its device calls were served (no LET_1_GO went
+    // unanswered), and both lines completed cards.
+    assert!(report.contains("timeouts: none"), "{report}");
+    let (a, b) = row(&report, "pallets completed");
+    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
+    assert!(!report.contains("[FAILED]"), "{report}");
+}
+
+#[test]
 fn a_line_that_keeps_dying_fails_the_run_past_its_restarts() {
     // An hour at ten times the wall clock: six minutes, unless the restarts run out.
     let world = World::start(&["--hours", "1", "--speed", "10"]);
@@ -444,6 +481,10 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
         (&["--record", "x.mcap"][..], "--record"),
         (&["--tree"][..], "--tree"),
         (&["--realtime"][..], "--realtime"),
+        (
+            &["--transport", "zenoh", "--feeder", "appendix"][..],
+            "--transport zenoh with --feeder appendix",
+        ),
     ] {
         let output = Command::new(chip_cell())
             .arg("--processes")
@@ -457,9 +498,11 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
     }
     // Refused before anything starts: no recording was begun.
     assert!(!std::path::Path::new("x.mcap").exists());
-    // A speed-up without processes, or one that means nothing, is a mistake of the flags.
+    // A speed-up or a transport without processes, or a speed-up that means nothing, is a
+    // mistake of the flags.
     for flags in [
         &["--speed", "10"][..],
+        &["--transport", "zenoh"][..],
         &["--processes", "--speed", "0.5"][..],
     ] {
         let output = Command::new(chip_cell()).args(flags).output().unwrap();

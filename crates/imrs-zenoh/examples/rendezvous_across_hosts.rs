@@ -14,8 +14,9 @@ mod common;
 use std::process::Stdio;
 use std::time::Instant;
 
-use common::{Namespace, cdr, read, rounds, table};
+use common::{cdr, command_in, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_zenoh::netns::Netns;
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
 
@@ -68,19 +69,16 @@ async fn serve(endpoint: &str) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::Error>> {
-    let namespace = netns.then(|| Namespace::make(0)).transpose()?;
+    let namespace = netns.then(|| Netns::make(0)).transpose()?;
     let endpoint = match &namespace {
-        Some(ns) => format!("tcp/{}:7447", ns.inside),
+        Some(ns) => format!("tcp/{}:7447", ns.inside_address()),
         None => {
             let probe = std::net::TcpListener::bind("127.0.0.1:0")?;
             format!("tcp/127.0.0.1:{}", probe.local_addr()?.port())
         }
     };
     let me = std::env::current_exe()?;
-    let mut command = match &namespace {
-        Some(ns) => ns.command(&me),
-        None => tokio::process::Command::new(&me),
-    };
+    let mut command = command_in(namespace.as_ref(), &me);
     let mut owner = command
         .args(["--serve", &endpoint])
         .stdout(Stdio::piped())

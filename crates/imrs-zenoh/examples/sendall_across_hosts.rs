@@ -16,8 +16,9 @@ mod common;
 use std::process::Stdio;
 use std::time::Instant;
 
-use common::{Namespace, cdr, read, rounds, table};
+use common::{cdr, command_in, read, rounds, table};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_zenoh::netns::Netns;
 use imrs_zenoh::{Host, Imported, export, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
 use zenoh::query::{ConsolidationMode, QueryTarget};
@@ -70,7 +71,7 @@ async fn listen(endpoint: &str, module: &str) -> Result<(), Box<dyn std::error::
 async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::Error>> {
     let namespaces = if netns {
         (0..MODULES.len() as u32)
-            .map(Namespace::make)
+            .map(|k| Netns::make(k as u8))
             .collect::<Result<Vec<_>, _>>()?
     } else {
         Vec::new()
@@ -89,10 +90,9 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
     let mut listeners = Vec::new();
     for (i, module) in MODULES.into_iter().enumerate() {
         // Each listener reaches this host over its own link, or over loopback.
-        let (mut command, address) = match namespaces.get(i) {
-            Some(ns) => (ns.command(&me), ns.outside.as_str()),
-            None => (tokio::process::Command::new(&me), "127.0.0.1"),
-        };
+        let netns = namespaces.get(i);
+        let address = netns.map_or("127.0.0.1", Netns::outside_address);
+        let mut command = command_in(netns, &me);
         let endpoint = format!("tcp/{address}:{port}");
         let mut child = command
             .args(["--listen", &endpoint, module])

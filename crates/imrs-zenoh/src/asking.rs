@@ -1,6 +1,7 @@
 //! How a bridge asks the other host: a zenoh `get` whose reply is handed to the waiting
 //! module from zenoh's own callback, so that the module wakes once, as it would for a raw
-//! `get`, and the bridge is free for the next request at once.
+//! `get`. The bridge takes the module's next request once the query has ended, so that a
+//! module has one request at a time on the other host, as in one process.
 
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -49,25 +50,30 @@ impl Asking {
     /// Asks the other host with `request`: its answer goes to `reply` as it comes. Without
     /// one (an error reply, no reply in time, bytes that are no reply) the handle is
     /// dropped when the query ends, and the local sender gets `NoReply`; the reason is
-    /// logged. The request stays pending until then; dropping what this returns drops its
-    /// reply at once.
+    /// logged. Dropping what this returns drops the reply at once, if it has not come.
     pub(crate) async fn ask<Req: Message, Rep: Message>(
         &self,
         request: Req,
         reply: ReplyHandle<Rep>,
     ) -> Pending<Rep> {
-        let pending = Pending(Arc::new(Mutex::new(Some(reply))));
+        let (ended, ends) = tokio::sync::oneshot::channel();
+        let pending = Pending {
+            handle: Arc::new(Mutex::new(Some(reply))),
+            ends,
+        };
         let bytes = match encode(&self.port, &request) {
             Ok(bytes) => bytes,
             Err(error) => {
                 self.no_reply(&error.to_string());
-                return Pending(Arc::default());
+                pending.give_up();
+                return pending;
             }
         };
         drop(request);
         let answering = Answering {
-            pending: Pending(Arc::clone(&pending.0)),
+            handle: Arc::clone(&pending.handle),
             port: Arc::clone(&self.port),
+            _ended: ended,
         };
         let asked = self
             .session
@@ -89,37 +95,53 @@ impl Asking {
     }
 }
 
-/// The reply handle of a request asked and not yet answered.
-pub(crate) struct Pending<Rep>(Arc<Mutex<Option<ReplyHandle<Rep>>>>);
+/// The reply handle of a request asked and not yet answered, and the word that its query
+/// has ended.
+pub(crate) struct Pending<Rep> {
+    handle: Arc<Mutex<Option<ReplyHandle<Rep>>>>,
+    ends: tokio::sync::oneshot::Receiver<()>,
+}
 
 impl<Rep> Pending<Rep> {
-    fn take(&self) -> Option<ReplyHandle<Rep>> {
-        self.0.lock().unwrap_or_else(PoisonError::into_inner).take()
-    }
-
     /// Whether the request still waits for its answer.
     pub(crate) fn waits(&self) -> bool {
-        self.0
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .is_some()
+        lock(&self.handle).is_some()
     }
 
     /// Drops the reply handle: the sender gets `NoReply` now.
     pub(crate) fn give_up(&self) {
-        drop(self.take());
+        drop(lock(&self.handle).take());
+    }
+
+    /// Until the query has ended: answered, refused, or out of time.
+    pub(crate) async fn ended(&mut self) {
+        let _ = (&mut self.ends).await;
     }
 }
 
-/// What zenoh's callback holds while the query is open.
+impl<Rep> Drop for Pending<Rep> {
+    fn drop(&mut self) {
+        self.give_up();
+    }
+}
+
+fn lock<Rep>(
+    handle: &Mutex<Option<ReplyHandle<Rep>>>,
+) -> std::sync::MutexGuard<'_, Option<ReplyHandle<Rep>>> {
+    handle.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// What zenoh's callback holds while the query is open: dropped when it ends.
 struct Answering<Rep> {
-    pending: Pending<Rep>,
+    handle: Arc<Mutex<Option<ReplyHandle<Rep>>>>,
     port: Arc<str>,
+    /// Dropped with the callback: the query has ended.
+    _ended: tokio::sync::oneshot::Sender<()>,
 }
 
 impl<Rep: Message> Answering<Rep> {
     fn answer(&self, reply: Reply) {
-        let Some(handle) = self.pending.take() else {
+        let Some(handle) = lock(&self.handle).take() else {
             return;
         };
         let answer = match reply.into_result() {
@@ -139,6 +161,6 @@ impl<Rep: Message> Answering<Rep> {
 impl<Rep> Drop for Answering<Rep> {
     /// The query has ended: a request still unanswered never will be.
     fn drop(&mut self) {
-        self.pending.give_up();
+        drop(lock(&self.handle).take());
     }
 }

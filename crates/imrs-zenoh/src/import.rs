@@ -291,23 +291,25 @@ async fn serve_while_live<Req: Message, Rep: Message, T: Take<Req, Rep>>(
     watch: &Watch,
     asking: &Asking,
 ) -> bool {
-    // The request asked last: dropped unanswered if the owner's host goes. A module asks one
-    // at a time, so no other can be waiting.
-    let mut pending: Option<Pending<Rep>> = None;
-    let live = loop {
+    loop {
         tokio::select! {
             taken = end.next() => match taken {
-                Ok((request, reply)) => pending = Some(asking.ask(request, reply).await),
+                Ok((request, reply)) => {
+                    // The module has its answer from zenoh's callback; its next request is
+                    // taken once the query has ended, or dropped (its reply with it) if the
+                    // owner's host goes first.
+                    let mut pending: Pending<Rep> = asking.ask(request, reply).await;
+                    tokio::select! {
+                        () = pending.ended() => {}
+                        live = watch.gone() => return live,
+                    }
+                }
                 // Nobody can use the local port any more.
-                Err(_) => break false,
+                Err(_) => return false,
             },
-            live = watch.gone() => break live,
+            live = watch.gone() => return live,
         }
-    };
-    if let Some(pending) = pending {
-        pending.give_up();
     }
-    live
 }
 
 /// `module`'s connection to `port`: the owner's host's answer, or why there is none.

@@ -85,6 +85,7 @@ mod host;
 mod import;
 mod key;
 mod message;
+pub mod netns;
 mod opening;
 mod relay;
 mod take;

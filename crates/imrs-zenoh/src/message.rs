@@ -65,9 +65,17 @@ pub(crate) fn decode<T: DeserializeOwned>(port: &str, bytes: &[u8]) -> Result<T,
             )));
         }
     };
-    decoded
-        .map(|(message, _)| message)
-        .map_err(|error| refused(format!("not a message of this port: {error}")))
+    let (message, read) =
+        decoded.map_err(|error| refused(format!("not a message of this port: {error}")))?;
+    // What follows the message may only be the padding that rounds it to four bytes.
+    let rest = body.get(read..).unwrap_or_default();
+    if rest.len() > 3 || rest.iter().any(|&byte| byte != 0) {
+        return Err(refused(format!(
+            "not a message of this port: {} bytes follow it",
+            rest.len()
+        )));
+    }
+    Ok(message)
 }
 
 #[cfg(test)]
@@ -101,6 +109,13 @@ mod tests {
         }
         let error = decode::<u64>("DOUBLE", &[7, 7, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0]).unwrap_err();
         assert!(error.to_string().contains("not plain CDR"), "{error}");
+        // Bytes after the message, past its padding, are refused; the padding is not.
+        let mut padded = encode("P", &7_u8).unwrap();
+        padded.extend([0, 0, 0]);
+        assert_eq!(decode::<u8>("P", &padded).unwrap(), 7);
+        padded.push(0);
+        let error = decode::<u8>("P", &padded).unwrap_err();
+        assert!(error.to_string().contains("4 bytes follow it"), "{error}");
     }
 
     #[test]

@@ -149,21 +149,31 @@ async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(
     stop: Arc<tokio::sync::Notify>,
     grace: std::time::Duration,
 ) {
-    // The broadcast or query asked last: the owner asks one at a time.
+    // The broadcast or query asked last: the owner asks one at a time, and the next is taken
+    // once its query has ended.
     let mut pending: Option<Pending<Rep>> = None;
-    if let Ok(asking) = asking.await {
-        loop {
+    match asking.await {
+        Ok(asking) => loop {
             tokio::select! {
                 biased;
                 () = stop.notified() => break,
                 taken = end.next() => match taken {
-                    Ok((request, reply)) => pending = Some(asking.ask(request, reply).await),
+                    Ok((request, reply)) => {
+                        let asked = pending.insert(asking.ask(request, reply).await);
+                        tokio::select! {
+                            biased;
+                            () = stop.notified() => break,
+                            () = asked.ended() => {}
+                        }
+                    }
                     // A quiet spell past the port's TIMEOUT: the module is still there.
                     Err(ReceiveError::Timeout { .. }) => {}
                     Err(_) => break,
                 },
             }
-        }
+        },
+        // The module is told its owner is gone when this ends: its waits on the port end.
+        Err(error) => tracing::warn!(%error, "a relay to a module could not start"),
     }
     // A host that is gone ends the query, with its answer if it gave one first; one cut off
     // is given a lease to answer, then the reply is dropped (`NoReply`).

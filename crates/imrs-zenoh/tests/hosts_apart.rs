@@ -10,6 +10,7 @@ use std::time::Duration;
 
 use common::{PROMPTLY, free_endpoint, within};
 use imrs_ports::{SendError, usage};
+use imrs_zenoh::netns::Netns;
 use imrs_zenoh::{Host, Imported, import};
 use tokio::io::{AsyncBufReadExt, BufReader};
 use tokio::process::{Child, Command};
@@ -114,100 +115,9 @@ async fn killed_and_restarted(cell: &str) {
     served_again(&mut asker, PROMPTLY).await;
 }
 
-/// A network namespace and the veth link that joins it to this one, removed when dropped.
-struct Netns {
-    name: String,
-    outside: String,
-    inside_address: String,
-}
-
-impl Netns {
-    /// Makes one, or says why it cannot.
-    fn make() -> Result<Self, String> {
-        let id = std::process::id() % 100_000;
-        let (name, outside, inside) = (
-            format!("imrs-{id}"),
-            format!("imrso{id}"),
-            format!("imrsi{id}"),
-        );
-        let subnet = format!("10.{}.{}", 100 + id % 100, id / 100 % 250);
-        let netns = Self {
-            name: name.clone(),
-            outside: outside.clone(),
-            inside_address: format!("{subnet}.2"),
-        };
-        let steps: [Vec<String>; 7] = [
-            vec!["netns".into(), "add".into(), name.clone()],
-            vec![
-                "link", "add", &outside, "type", "veth", "peer", "name", &inside, "netns", &name,
-            ]
-            .into_iter()
-            .map(String::from)
-            .collect(),
-            vec![
-                "addr".into(),
-                "add".into(),
-                format!("{subnet}.1/30"),
-                "dev".into(),
-                outside.clone(),
-            ],
-            vec!["link".into(), "set".into(), outside.clone(), "up".into()],
-            netns.inside(&["addr", "add", &format!("{subnet}.2/30"), "dev", &inside]),
-            netns.inside(&["link", "set", &inside, "up"]),
-            netns.inside(&["link", "set", "lo", "up"]),
-        ];
-        for step in steps {
-            ip(&step)?;
-        }
-        Ok(netns)
-    }
-
-    fn inside(&self, args: &[&str]) -> Vec<String> {
-        ["-n", &self.name]
-            .iter()
-            .chain(args)
-            .map(|s| s.to_string())
-            .collect()
-    }
-
-    fn set_link(&self, state: &str) {
-        ip(&[
-            "link".into(),
-            "set".into(),
-            self.outside.clone(),
-            state.into(),
-        ])
-        .expect("the veth link set");
-    }
-}
-
-impl Drop for Netns {
-    fn drop(&mut self) {
-        // Deleting the namespace deletes its end of the link, and with it ours.
-        let _ = ip(&["netns".into(), "del".into(), self.name.clone()]);
-    }
-}
-
-/// Runs `ip args`, or says what it printed.
-fn ip(args: &[String]) -> Result<(), String> {
-    let output = std::process::Command::new("ip")
-        .args(args)
-        .output()
-        .map_err(|error| format!("ip {}: {error}", args.join(" ")))?;
-    if output.status.success() {
-        Ok(())
-    } else {
-        Err(format!(
-            "ip {}: {}",
-            args.join(" "),
-            String::from_utf8_lossy(&output.stderr).trim()
-        ))
-    }
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
-    let netns = match Netns::make() {
+    let netns = match Netns::make(0) {
         Ok(netns) => netns,
         Err(why) => {
             eprintln!(
@@ -217,8 +127,8 @@ async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
             return killed_and_restarted("loopback_cell").await;
         }
     };
-    let endpoint = format!("tcp/{}:7447", netns.inside_address);
-    let _owner = peer("netns_cell", &endpoint, Some(&netns.name)).await;
+    let endpoint = format!("tcp/{}:7447", netns.inside_address());
+    let _owner = peer("netns_cell", &endpoint, Some(netns.name())).await;
     let host = Host::builder("netns_cell")
         .connect(&endpoint)
         .open()
@@ -236,11 +146,11 @@ async fn a_link_set_down_mid_rendezvous_ends_waits_and_its_heal_is_served() {
     let lease = host.lease();
     let cut = async {
         tokio::task::yield_now().await;
-        netns.set_link("down");
+        netns.set_link(false).expect("the veth link set down");
     };
     // Nothing tells this host the link is gone: the lease does.
     held_send_ends_with_no_reply(&mut asker, cut, 2 * lease + PROMPTLY).await;
     seen_gone(&mut asker, 2 * lease + PROMPTLY).await;
-    netns.set_link("up");
+    netns.set_link(true).expect("the veth link set up");
     served_again(&mut asker, PROMPTLY + 2 * lease).await;
 }

@@ -15,7 +15,7 @@ use imrs_sim::{
 };
 
 pub use remote::{Device, Link, RemoteDevices};
-pub use server::{DevicePort, DevicePorts, WORLD, world};
+pub use server::{DevicePort, DevicePorts, LineRuns, WORLD, world};
 pub use wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op, Pose};
 
 /// Where the cell's devices are.

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
-use imrs_ipc::{Imported, IpcError, Remote, import};
+use crate::carrier::{Carrier, Imported};
 use imrs_ports::{End, usage};
 use imrs_sim::{DeviceError, Line, RobotId, Role, Station, Target};
 use tokio::sync::Mutex;
@@ -35,6 +35,14 @@ impl Device {
             Device::Relay(line, Station::Load),
             Device::Relay(line, Station::Chip),
         ]
+    }
+
+    /// Its line.
+    pub fn line(self) -> Line {
+        match self {
+            Device::Robot(robot) => robot.line,
+            Device::Gate(line) | Device::Relay(line, _) => line,
+        }
     }
 
     /// The name of the world's port that serves it.
@@ -166,20 +174,22 @@ impl fmt::Debug for RemoteDevices {
 }
 
 impl RemoteDevices {
-    /// Imports every device of `line` from the world's process of `remote`'s cell, each for
-    /// the module that drives it, whose calls are sent from `run` of the line's process.
-    /// Call it within the tokio runtime the line runs on.
-    pub fn import(remote: &Remote, line: Line, run: u32) -> Result<Self, IpcError> {
+    /// Imports every device of `line` from the world's process, each for the module that
+    /// drives it, whose calls are sent from `run` of the line's process. Call it within the
+    /// tokio runtime the line runs on.
+    pub async fn import(carrier: &Carrier, line: Line, run: u32) -> Result<Self, String> {
         let mut links = BTreeMap::new();
         let mut imported = Vec::new();
         for device in Device::of_line(line) {
             let user = device.user();
-            let port: Imported<DeviceCall, DeviceAnswer> =
-                import(remote, &device.port(), WORLD, &user)?;
+            let port: Imported<DeviceCall, DeviceAnswer> = carrier
+                .import(&device.port(), WORLD, &user)
+                .await
+                .map_err(|error| error.to_string())?;
             let end = port
                 .port()
                 .user_named(user.as_str())
-                .map_err(IpcError::Local)?;
+                .map_err(|error| error.to_string())?;
             links.insert(device, Link(Some((Arc::new(Mutex::new(end)), run))));
             imported.push(port);
         }

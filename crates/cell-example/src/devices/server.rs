@@ -1,6 +1,9 @@
 //! The world's side: a module that owns a port per device and carries out each call on the
 //! simulation, for the lines' modules in other processes.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use imrs_core::prelude::*;
 use imrs_ports::{AnyUser, Port, PortSpec, SharedClock, usage};
 use imrs_sim::{Line, Sim};
@@ -55,28 +58,32 @@ impl DevicePorts {
     }
 }
 
+/// The run of each line's process whose calls WORLD carries out (A, then B): raised by the
+/// world's supervision when a line's process dies, before anything else is done for it, so
+/// that no call the dead run left on its way is carried out after.
+pub type LineRuns = Arc<[AtomicU32; 2]>;
+
 /// WORLD: carries out each device call on the simulation and answers with its outcome. A
-/// call the world cannot read is answered as such, and the world goes on serving.
-pub fn world(ports: &DevicePorts, sim: &Sim) -> ModuleSpec<()> {
+/// call the world cannot read is answered as such, and one of a run of its line's process
+/// that has died ([`LineRuns`]) is not carried out; the world goes on serving.
+pub fn world(ports: &DevicePorts, sim: &Sim, runs: &LineRuns) -> ModuleSpec<()> {
     let devices = Devices::Local(sim.clone());
     let mut spec = ModuleSpec::new(WORLD, ());
     for (device, port) in &ports.ports {
         let (device, port, devices) = (*device, port.clone(), devices.clone());
+        let runs = Arc::clone(runs);
         spec = spec.task(device.port(), move |ctx| {
-            let (port, devices) = (port.clone(), devices.clone());
+            let (port, devices, runs) = (port.clone(), devices.clone(), Arc::clone(&runs));
             async move {
                 let mut calls = port.owner()?;
-                // The latest run of the line's process heard from: a call of an earlier
-                // run, sent just before that run died, is not carried out.
-                let mut latest = 0;
+                let line = device.line().index();
                 loop {
                     // One call at a time: a device does one thing at a time.
                     let (call, reply) = ctx.receive(&mut calls).await?;
-                    if call.run() < latest {
+                    if call.run() < runs[line].load(Ordering::Acquire) {
                         reply.reply(DeviceAnswer::new(&Answer::Stale));
                         continue;
                     }
-                    latest = call.run();
                     let answer = match call.op() {
                         Some(op) => carry_out(&devices, device, op).await,
                         None => DeviceAnswer::new(&Answer::Malformed),

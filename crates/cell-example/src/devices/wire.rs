@@ -5,6 +5,7 @@
 
 use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_sim::{DeviceError, FeederId, Line, PalletId, Release, RobotId, Role, Station, Target};
+use serde::{Deserialize, Serialize};
 
 /// What a line's module asks of a device.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,7 +52,9 @@ const SWEEP_POSES: usize = 32;
 pub type Pose = [[f32; 2]; 3];
 
 /// An [`Op`] in shared memory.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes, Serialize, Deserialize,
+)]
 #[repr(C)]
 #[type_name("cell_example::DeviceCall")]
 pub struct DeviceCall {
@@ -187,7 +190,9 @@ impl DeviceCall {
 
 /// How a device call went, in shared memory: a value (a chip number, a pallet), nothing, or
 /// the device's error.
-#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes, Serialize, Deserialize,
+)]
 #[repr(C)]
 #[type_name("cell_example::DeviceAnswer")]
 pub struct DeviceAnswer {

@@ -1,5 +1,5 @@
 //! What the benchmarks against raw zenoh share: the message both sides move (a CDR `u64`),
-//! the run's length, the table of their percentiles, and hosts as network namespaces.
+//! the run's length, and the table of their percentiles.
 
 use std::time::Duration;
 
@@ -46,85 +46,13 @@ fn percentile(samples: &mut [Duration], q: f64) -> Duration {
     samples[((samples.len() - 1) as f64 * q).round() as usize]
 }
 
-/// A network namespace joined to this one by a veth link, removed when dropped.
-pub(crate) struct Namespace {
-    /// Its name, for `ip netns exec`.
-    pub(crate) name: String,
-    /// Its address on the link.
-    #[allow(dead_code)] // each example reads the end of the link it needs
-    pub(crate) inside: String,
-    /// This namespace's address on the link.
-    #[allow(dead_code)]
-    pub(crate) outside: String,
-}
-
-impl Namespace {
-    /// The `k`th namespace of this process (root is needed).
-    pub(crate) fn make(k: u32) -> Result<Self, Box<dyn std::error::Error>> {
-        let id = std::process::id() % 100_000;
-        let name = format!("imrsb-{id}-{k}");
-        let (outside_dev, inside_dev) = (format!("imrsbo{id}{k}"), format!("imrsbi{id}{k}"));
-        let subnet = format!("10.{}.{}", 200 + k, id % 250);
-        let ns = Self {
-            name: name.clone(),
-            inside: format!("{subnet}.2"),
-            outside: format!("{subnet}.1"),
-        };
-        let steps: [&[&str]; 7] = [
-            &["netns", "add", &name],
-            &[
-                "link",
-                "add",
-                &outside_dev,
-                "type",
-                "veth",
-                "peer",
-                "name",
-                &inside_dev,
-                "netns",
-                &name,
-            ],
-            &[
-                "addr",
-                "add",
-                &format!("{subnet}.1/30"),
-                "dev",
-                &outside_dev,
-            ],
-            &["link", "set", &outside_dev, "up"],
-            &[
-                "-n",
-                &name,
-                "addr",
-                "add",
-                &format!("{subnet}.2/30"),
-                "dev",
-                &inside_dev,
-            ],
-            &["-n", &name, "link", "set", &inside_dev, "up"],
-            &["-n", &name, "link", "set", "lo", "up"],
-        ];
-        for step in steps {
-            let status = std::process::Command::new("ip").args(step).status()?;
-            if !status.success() {
-                return Err(format!("ip {} failed (root is needed)", step.join(" ")).into());
-            }
-        }
-        Ok(ns)
-    }
-
-    /// A command that runs `program` inside the namespace.
-    pub(crate) fn command(&self, program: &std::path::Path) -> tokio::process::Command {
-        let mut command = tokio::process::Command::new("ip");
-        command.args(["netns", "exec", &self.name]).arg(program);
-        command
-    }
-}
-
-impl Drop for Namespace {
-    fn drop(&mut self) {
-        let _ = std::process::Command::new("ip")
-            .args(["netns", "del", &self.name])
-            .status();
+/// A command that runs `program` inside `netns`, or here.
+pub(crate) fn command_in(
+    netns: Option<&imrs_zenoh::netns::Netns>,
+    program: &std::path::Path,
+) -> tokio::process::Command {
+    match netns {
+        Some(netns) => netns.command(program).into(),
+        None => tokio::process::Command::new(program),
     }
 }
