@@ -93,11 +93,16 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
         import(&host, "DOUBLE", "DOUBLER", "ASKER").await?;
     let mut asker = imported.port().user_named("ASKER")?;
     let session = host.session().clone();
+    // Declared once, as IMRS declares each request's key: the wire carries a number.
+    let raw_key = session
+        .declare_keyexpr(RAW)
+        .await
+        .map_err(|e| e.to_string())?;
     let raw = |n: u64| {
-        let session = session.clone();
+        let (session, raw_key) = (session.clone(), raw_key.clone());
         async move {
             let replies = session
-                .get(RAW)
+                .get(&raw_key)
                 .payload(cdr(n))
                 .await
                 .map_err(|e| e.to_string())?;

@@ -110,6 +110,11 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
     }
     let mut line = alarm.owner()?;
     let session = host.session().clone();
+    // Declared once, as IMRS declares each module's `deliver` key.
+    let raw_key = session
+        .declare_keyexpr("bench/raw/*")
+        .await
+        .map_err(|e| e.to_string())?;
     let (mut imrs, mut zenoh) = (Vec::with_capacity(rounds), Vec::with_capacity(rounds));
     let mut block = 0;
     while imrs.len() < rounds {
@@ -129,7 +134,7 @@ async fn measure(rounds: usize, netns: bool) -> Result<(), Box<dyn std::error::E
         for n in 1..=BLOCK as u64 {
             let start = Instant::now();
             let replies = session
-                .get("bench/raw/*")
+                .get(&raw_key)
                 .payload(cdr(n))
                 .target(QueryTarget::All)
                 .consolidation(ConsolidationMode::None)
