@@ -5,8 +5,10 @@
 //! in a process of its own, which the world starts. The lines reach their robots, gate and
 //! relays through the world's device ports (a chip robot's sweep, too, is computed there),
 //! and the feeder zone through the keeper's ports or, under the Appendix's policy, through
-//! each other's SHARE_FEEDER, all carried by iceoryx2 (`imrs-ipc`); the modules' code is
-//! that of the single-process cell.
+//! each other's SHARE_FEEDER, all carried by iceoryx2 (`imrs-ipc`), or with
+//! `--transport zenoh` by zenoh (`imrs-zenoh`), each line then a host of its own (a network
+//! namespace, where they can be made); the modules' code is that of the single-process
+//! cell.
 //!
 //! Time: every process runs on the wall clock sped up by `--speed`, from one epoch the world
 //! chooses and hands to the lines when it starts them, so the processes agree on one time
@@ -28,13 +30,13 @@
 //!
 //! The world supervises the lines' processes, as a module's supervisor does its tasks: a
 //! line's process that dies before the end (killed, crashed) is started again, at most
-//! [`RESTARTS`] times a line, and the other line goes on. Before the next run starts, the
-//! world takes off as scrap the pallets the dead line's stations held (in a state nobody
-//! knows), drives its chip robot home through the robot's own port, and tells
-//! FEEDER_MONITOR on LINE_DOWN, which then frees the zone if the dead line held it. Each
-//! run of a line's process is numbered, and its calls and words to the zone carry the
-//! number: a call the dead run left on its way, carried by iceoryx2 after the next run has
-//! started, is not carried out (see [`crate::zone_asker`]). The report shows each outage:
+//! [`RESTARTS`] times a line, and the other line goes on. Each run of a line's process is
+//! numbered, and its device calls and words to the zone carry the number. Before the next
+//! run starts, the world stops WORLD taking calls of the dead run (one a device had already
+//! taken is let end), drives the dead line's chip robot home through the robot's own port,
+//! takes off as scrap the pallets the dead line's stations held (in a state nobody knows),
+//! and tells FEEDER_MONITOR on LINE_DOWN, which then frees the zone if the dead line held it
+//! and heeds no word of the dead run (see [`crate::zone_asker`]). The report shows each outage:
 //! when, how long, and the pallets scrapped. Only the arbiter's policy is supervised so:
 //! under the Appendix's the survivor would wait on its dead twin's SHARE_FEEDER, and under
 //! the coordinator's on reservations nobody frees, so there a line that dies still fails
@@ -206,43 +208,67 @@ async fn world_carrier(
             None,
         )),
         Transport::Zenoh => {
-            let probe = std::net::TcpListener::bind("0.0.0.0:0")
-                .map_err(|error| refused("world", format!("no free port: {error}")))?;
-            let port = probe
-                .local_addr()
-                .map_err(|error| refused("world", error))?
-                .port();
-            drop(probe);
-            let hosts = match Netns::make(0).and_then(|a| Ok(vec![a, Netns::make(1)?])) {
-                Ok(netns) => Hosts {
-                    endpoints: [0, 1].map(|i| format!("tcp/{}:{port}", netns[i].outside_address())),
-                    netns,
-                    described: "each a host of its own (a network namespace, joined to the \
+            let netns = Netns::make(0).and_then(|a| Ok(vec![a, Netns::make(1)?]));
+            // The world listens only where its lines reach it: on each namespace's link, or
+            // on loopback. A port found free may be taken before it is listened on: another
+            // is tried.
+            let mut tries = 0;
+            loop {
+                tries += 1;
+                let port = free_port()?;
+                let addresses: Vec<&str> = match &netns {
+                    Ok(netns) => netns.iter().map(Netns::outside_address).collect(),
+                    Err(_) => vec!["127.0.0.1"],
+                };
+                let mut builder = Host::builder(cell);
+                for address in &addresses {
+                    builder = builder.listen(format!("tcp/{address}:{port}"));
+                }
+                match builder.open().await {
+                    Ok(host) => return Ok((Carrier::Zenoh(host), Some(hosts(netns, port)))),
+                    Err(error) if tries >= 3 => return Err(refused("world", error)),
+                    Err(_) => {}
+                }
+            }
+        }
+    }
+}
+
+/// A port of this host free now.
+fn free_port() -> Result<u16, RunError> {
+    let probe = std::net::TcpListener::bind("0.0.0.0:0")
+        .map_err(|error| refused("world", format!("no free port: {error}")))?;
+    Ok(probe
+        .local_addr()
+        .map_err(|error| refused("world", error))?
+        .port())
+}
+
+/// The lines' hosts: in `netns`, or on loopback (said loudly) where they could not be
+/// made; the world listening on `port`.
+fn hosts(netns: Result<Vec<Netns>, String>, port: u16) -> Hosts {
+    match netns {
+        Ok(netns) => Hosts {
+            endpoints: [0, 1].map(|i| format!("tcp/{}:{port}", netns[i].outside_address())),
+            netns,
+            described: "each a host of its own (a network namespace, joined to the \
                                 world's by a veth link)"
-                        .into(),
-                },
-                Err(why) => {
-                    eprintln!(
-                        "\n*** HOSTS ON LOOPBACK, NOT APART: network namespaces could not be \
+                .into(),
+        },
+        Err(why) => {
+            eprintln!(
+                "\n*** HOSTS ON LOOPBACK, NOT APART: network namespaces could not be \
                          made ({why}); the lines run as processes of this host, over zenoh \
                          on 127.0.0.1 ***\n"
-                    );
-                    Hosts {
-                        netns: Vec::new(),
-                        endpoints: [0, 1].map(|_| format!("tcp/127.0.0.1:{port}")),
-                        described: format!(
-                            "ON LOOPBACK, not hosts apart (network namespaces could not be \
+            );
+            Hosts {
+                netns: Vec::new(),
+                endpoints: [0, 1].map(|_| format!("tcp/127.0.0.1:{port}")),
+                described: format!(
+                    "ON LOOPBACK, not hosts apart (network namespaces could not be \
                              made: {why})"
-                        ),
-                    }
-                }
-            };
-            let host = Host::builder(cell)
-                .listen(format!("tcp/0.0.0.0:{port}"))
-                .open()
-                .await
-                .map_err(carried("world"))?;
-            Ok((Carrier::Zenoh(host), Some(hosts)))
+                ),
+            }
         }
     }
 }
@@ -258,15 +284,16 @@ pub fn run_world(config: &CellConfig) -> Result<RunRecord, RunError> {
 }
 
 async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
-    let epoch = SystemTime::now() + STARTUP;
-    let clock = clock("world", epoch, config.speed)?;
     let nanos = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .unwrap_or_default()
         .subsec_nanos();
     // Unique on this host: two runs never meet.
     let cell_name = format!("chip_cell-{}-{nanos}", std::process::id());
+    // The hosts are made before the epoch is chosen: the lines get all of STARTUP.
     let (carrier, hosts) = world_carrier(config, &cell_name).await?;
+    let epoch = SystemTime::now() + STARTUP;
+    let clock = clock("world", epoch, config.speed)?;
     let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let cell = Cell::new(clock.clone());
     let sim = Sim::new(SimConfig::seeded(config.seed), clock.clone());
@@ -342,10 +369,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     }
 
     // The world's hands on a dead line: its chip robot's port, and FEEDER_MONITOR's ear.
-    let supervisor = match config.feeder {
-        FeederPolicy::Arbiter => Some(Supervisor::new(&devices, &ports, &runs)?),
-        FeederPolicy::Appendix | FeederPolicy::Coordinator => None,
-    };
+    // It holds a place on every device port under every policy; it restarts a line under
+    // the arbiter's only.
+    let supervisor = Supervisor::new(&devices, &ports, &runs, config.feeder)?;
     let (tell, mut hear) = unbounded_channel();
     let mut lines = Lines(Vec::new());
     let start = |line: Line, run: u32, faults: &[CellFault]| {
@@ -425,13 +451,21 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             }
             // A line that dies after the end, before its figures: its figures of the last
             // minute stand for them.
-            Said::Ended(_) | Said::Failed(_) if ended && latest[i].is_some() => {
-                finals[i] = latest[i].take();
+            Said::Ended(_) | Said::Failed(_) if ended && (latest[i].is_some() || runs[i] > 0) => {
+                finals[i] = Some(latest[i].take().unwrap_or_else(|| {
+                    // A run that died before its first minute: nothing more to count.
+                    figures(
+                        &Tally::default(),
+                        &ZoneWaits::default(),
+                        &CycleTimeHistory::default(),
+                        Duration::ZERO,
+                    )
+                }));
             }
             Said::Ended(_) | Said::Failed(_) if !ended => {
-                let Some(supervisor) = &supervisor else {
+                if config.feeder != FeederPolicy::Arbiter {
                     return Err(said.refusal_restartless(line, config.feeder));
-                };
+                }
                 if runs[i] >= RESTARTS {
                     return Err(refused(
                         process_name(line),
@@ -515,19 +549,31 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
 /// and the runs WORLD carries out calls of.
 struct Supervisor {
     devices: Vec<(Device, tokio::sync::Mutex<DeviceEnd>)>,
-    line_down: tokio::sync::Mutex<End<(Line, u32), (), usage::Send>>,
+    /// FEEDER_MONITOR's ear, under the arbiter's policy.
+    line_down: Option<tokio::sync::Mutex<LineDownEnd>>,
     runs: LineRuns,
 }
 
 /// The supervision's end on a device's port.
 type DeviceEnd = End<DeviceCall, DeviceAnswer, usage::Send>;
 
+/// The supervision's end on LINE_DOWN.
+type LineDownEnd = End<(Line, u32), (), usage::Send>;
+
+/// How long, in wall time, the world lets a device finish a call of a dead run.
+const MARKER_PATIENCE: Duration = Duration::from_secs(1);
+
 /// How many times the world tries to drive a dead line's chip robot home while a robot
 /// fault stops it.
 const HOMING_TRIES: u32 = 5;
 
 impl Supervisor {
-    fn new(devices: &DevicePorts, ports: &CellPorts, runs: &LineRuns) -> Result<Self, RunError> {
+    fn new(
+        devices: &DevicePorts,
+        ports: &CellPorts,
+        runs: &LineRuns,
+        policy: FeederPolicy,
+    ) -> Result<Self, RunError> {
         let ends = Line::ALL
             .into_iter()
             .flat_map(Device::of_line)
@@ -541,23 +587,40 @@ impl Supervisor {
                 Ok((device, tokio::sync::Mutex::new(end)))
             })
             .collect::<Result<_, RunError>>()?;
-        let line_down = ports
-            .line_down
-            .user_named(LINE_SUPERVISOR)
-            .map_err(|error| refused("world", error))?;
+        let line_down = match policy {
+            FeederPolicy::Arbiter => Some(tokio::sync::Mutex::new(
+                ports
+                    .line_down
+                    .user_named(LINE_SUPERVISOR)
+                    .map_err(|error| refused("world", error))?,
+            )),
+            FeederPolicy::Appendix | FeederPolicy::Coordinator => None,
+        };
         Ok(Self {
             devices: ends,
-            line_down: tokio::sync::Mutex::new(line_down),
+            line_down,
             runs: Arc::clone(runs),
         })
     }
 
-    /// Makes `line`, whose process died, safe for its `next` run: WORLD heeds no call of the
-    /// dead run from now on; the chip robot is driven home (once what it is doing is done);
-    /// the pallets the line's stations hold are scrapped; then FEEDER_MONITOR is told.
-    /// Returns how many pallets were scrapped.
+    /// Makes `line`, whose process died, safe for its `next` run: WORLD takes no call of the
+    /// dead run from now on, and the call each device was carrying out for it is let end;
+    /// the chip robot is driven home; the pallets the line's stations hold are scrapped;
+    /// then FEEDER_MONITOR is told. Returns how many pallets were scrapped.
     async fn take_over(&self, line: Line, next: u32, sim: &Sim) -> Result<usize, RunError> {
         self.runs[line.index()].store(next, Ordering::Release);
+        // A call of the dead run's that a device took before the store is carried out to
+        // its end: a word of a run before it, answered `Stale` once that call is done, marks
+        // the end. A relay waiting for a pallet may wait long: it is given a while.
+        for (_, end) in self
+            .devices
+            .iter()
+            .filter(|(device, _)| device.line() == line)
+        {
+            let marker = DeviceCall::new(Op::LetGo).in_run(next - 1);
+            let done = async { end.lock().await.send(marker).await };
+            let _ = tokio::time::timeout(MARKER_PATIENCE, done).await;
+        }
         let robot = Device::Robot(RobotId::new(line, Role::ChipIt));
         let Some((_, end)) = self.devices.iter().find(|(device, _)| *device == robot) else {
             return Err(refused("world", format!("no port for {}", robot.port())));
@@ -586,12 +649,14 @@ impl Supervisor {
         }
         drop(end);
         let scrapped = sim.scrap_held(line).len();
-        self.line_down
-            .lock()
-            .await
-            .send((line, next))
-            .await
-            .map_err(|error| refused("world", format!("LINE_DOWN: {error}")))?;
+        if let Some(line_down) = &self.line_down {
+            line_down
+                .lock()
+                .await
+                .send((line, next))
+                .await
+                .map_err(|error| refused("world", format!("LINE_DOWN: {error}")))?;
+        }
         Ok(scrapped)
     }
 }
@@ -681,7 +746,10 @@ impl Lines {
             if let Ok(None) = child.try_wait() {
                 let _ = child.kill();
             }
-            let _ = child.wait();
+            // Killed: its end is at hand, and the runtime's other workers go on meanwhile.
+            tokio::task::block_in_place(|| {
+                let _ = child.wait();
+            });
         }
     }
 

@@ -82,6 +82,9 @@ impl Serialize for Reservation {
 impl<'de> Deserialize<'de> for Reservation {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
         let (robot, sweep): (ModuleName, Vec<Pose>) = Deserialize::deserialize(deserializer)?;
+        if robot.as_str().is_empty() {
+            return Err(D::Error::custom("a reservation that names no robot"));
+        }
         Reservation::new(robot.as_str(), &sweep).ok_or_else(|| {
             D::Error::custom(format!(
                 "a reservation of {} poses, past the {MAX_POSES} one can hold",

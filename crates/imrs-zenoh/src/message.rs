@@ -67,9 +67,11 @@ pub(crate) fn decode<T: DeserializeOwned>(port: &str, bytes: &[u8]) -> Result<T,
     };
     let (message, read) =
         decoded.map_err(|error| refused(format!("not a message of this port: {error}")))?;
-    // What follows the message may only be the padding that rounds it to four bytes.
+    // What follows the message may only be the zeros that round it to four bytes.
     let rest = body.get(read..).unwrap_or_default();
-    if rest.len() > 3 || rest.iter().any(|&byte| byte != 0) {
+    let padding = rest.is_empty()
+        || (rest.len() <= 3 && (read + rest.len()) % 4 == 0 && rest.iter().all(|&byte| byte == 0));
+    if !padding {
         return Err(refused(format!(
             "not a message of this port: {} bytes follow it",
             rest.len()
@@ -116,6 +118,10 @@ mod tests {
         padded.push(0);
         let error = decode::<u8>("P", &padded).unwrap_err();
         assert!(error.to_string().contains("4 bytes follow it"), "{error}");
+        // Zeros that do not round the message to four bytes are no padding.
+        let mut short = encode("P", &7_u8).unwrap();
+        short.extend([0, 0]);
+        assert!(decode::<u8>("P", &short).is_err());
     }
 
     #[test]

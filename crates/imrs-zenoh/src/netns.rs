@@ -16,30 +16,36 @@ pub struct Netns {
 
 impl Netns {
     /// Makes namespace `k` of this process, or says why it cannot (not root, no `ip`).
-    /// Each `k` has a link and a /30 subnet of its own.
+    /// Each `k` has a link and a /30 subnet of its own, found from this process's id. The
+    /// namespaces of processes that have died without removing theirs are removed first.
     pub fn make(k: u8) -> Result<Self, String> {
-        let id = std::process::id() % 100_000;
+        sweep_dead();
+        let pid = std::process::id();
+        let id = pid % 100_000;
         let (name, outside, inside) = (
-            format!("imrs-{id}-{k}"),
+            format!("imrs-{pid}-{k}"),
             format!("imrso{id}x{k}"),
             format!("imrsi{id}x{k}"),
         );
-        let subnet = format!("10.{}.{}", 100 + k % 100, id % 250);
+        // 16,384 subnets of four addresses for each `k`.
+        let (third, base) = ((id >> 6) & 255, (id & 63) * 4);
+        let at = |host: u32| format!("10.{}.{third}.{}", 100 + k % 100, base + host);
+        // Nothing to remove if it cannot be made: it may be another's.
+        ip(&args(&["netns", "add", &name]))?;
         let netns = Self {
             name: name.clone(),
             outside: outside.clone(),
-            inside_address: format!("{subnet}.2"),
-            outside_address: format!("{subnet}.1"),
+            inside_address: at(2),
+            outside_address: at(1),
         };
         let link = [
             "link", "add", &outside, "type", "veth", "peer", "name", &inside, "netns", &name,
         ];
-        let steps: [Vec<String>; 7] = [
-            args(&["netns", "add", &name]),
+        let steps: [Vec<String>; 6] = [
             args(&link),
-            args(&["addr", "add", &format!("{subnet}.1/30"), "dev", &outside]),
+            args(&["addr", "add", &format!("{}/30", at(1)), "dev", &outside]),
             args(&["link", "set", &outside, "up"]),
-            netns.inside(&["addr", "add", &format!("{subnet}.2/30"), "dev", &inside]),
+            netns.inside(&["addr", "add", &format!("{}/30", at(2)), "dev", &inside]),
             netns.inside(&["link", "set", &inside, "up"]),
             netns.inside(&["link", "set", "lo", "up"]),
         ];
@@ -47,6 +53,11 @@ impl Netns {
             ip(&step)?;
         }
         Ok(netns)
+    }
+
+    /// The name of this namespace's end of the link, on this side.
+    pub fn link(&self) -> &str {
+        &self.outside
     }
 
     /// Its name, for `ip netns exec`.
@@ -92,6 +103,26 @@ impl Drop for Netns {
     fn drop(&mut self) {
         // Deleting the namespace deletes its end of the link, and with it ours.
         let _ = ip(&args(&["netns", "del", &self.name]));
+    }
+}
+
+/// Removes the namespaces of this module's making (`imrs-<pid>-<k>`) whose process has died
+/// without removing them (killed): their links would hold addresses a new one may need.
+fn sweep_dead() {
+    let Ok(listed) = Command::new("ip").args(["netns", "list"]).output() else {
+        return;
+    };
+    for line in String::from_utf8_lossy(&listed.stdout).lines() {
+        let name = line.split_whitespace().next().unwrap_or_default();
+        let pid = name
+            .strip_prefix("imrs-")
+            .and_then(|rest| rest.split_once('-'))
+            .and_then(|(pid, _)| pid.parse::<u32>().ok());
+        if let Some(pid) = pid
+            && !std::path::Path::new(&format!("/proc/{pid}")).exists()
+        {
+            let _ = ip(&args(&["netns", "del", name]));
+        }
     }
 }
 
