@@ -5,12 +5,15 @@ use std::fmt;
 
 use imrs_sim::Line;
 
-/// One death of a line's process, and the line's return.
+/// One death of a line's process (or the cut of its host), and the line's return.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outage {
     /// The line.
     pub line: Line,
-    /// When its process was seen dead, in simulated seconds.
+    /// Whether its host was cut off (its process, alive behind the cut, was stopped), rather
+    /// than its process dead.
+    pub cut_off: bool,
+    /// When its process was seen dead, or its host cut off, in simulated seconds.
     pub died: f64,
     /// When the next run said it was ready, in simulated seconds; `None` if the cell's run
     /// ended first.
@@ -34,9 +37,14 @@ impl fmt::Display for Outage {
             Line::A => "A",
             Line::B => "B",
         };
+        let what = if self.cut_off {
+            "host was cut off"
+        } else {
+            "process died"
+        };
         write!(
             f,
-            "line {line}'s process died at {:.1} s; started again (run {}), ",
+            "line {line}'s {what} at {:.1} s; started again (run {}), ",
             self.died, self.run
         )?;
         match self.lasted() {
@@ -56,6 +64,7 @@ mod tests {
     fn an_outage_says_when_how_long_and_what_it_cost() {
         let outage = Outage {
             line: Line::A,
+            cut_off: false,
             died: 120.25,
             back: Some(131.5),
             run: 1,
@@ -75,6 +84,14 @@ mod tests {
             unfinished
                 .to_string()
                 .ends_with("not back before the end; 1 pallet it held scrapped")
+        );
+        let cut = Outage {
+            cut_off: true,
+            ..outage
+        };
+        assert!(
+            cut.to_string()
+                .starts_with("line A's host was cut off at 120.2 s")
         );
     }
 }

@@ -389,6 +389,25 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     for line in Line::ALL {
         lines.0.push((line, 0, start(line, 0, &config.faults)?));
     }
+    // Over zenoh, each line's host is watched: one cut off is treated as one that died.
+    let mut watchers = Vec::new();
+    if let Carrier::Zenoh(host) = &carrier {
+        for line in Line::ALL {
+            let gate = Device::Gate(line);
+            let mut watch = imrs_zenoh::watch_user(host, &gate.port(), &gate.user())
+                .await
+                .map_err(carried("world"))?;
+            let tell = tell.clone();
+            watchers.push(tokio::spawn(async move {
+                loop {
+                    watch.gone().await;
+                    if tell.send((line, UNSEEN, Said::Unseen)).is_err() {
+                        return;
+                    }
+                }
+            }));
+        }
+    }
     // A line that cannot start (or dies before it is first ready) fails the run: there is
     // nothing yet to go on from.
     for _ in Line::ALL {
@@ -405,6 +424,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     let mut banked: [Vec<Value>; 2] = Default::default();
     let mut finals: [Option<Value>; 2] = Default::default();
     let mut outages: Vec<Outage> = Vec::new();
+    // Per line: whether its run now has said it is ready, and whether its host was cut off.
+    let mut ready = [true; 2];
+    let mut cut_off = [false; 2];
     // Until the end, a line that dies is started again (or fails the run, past its
     // restarts); then each line's figures are due.
     let end = clock.sleep_until(Instant::from_start(total));
@@ -423,12 +445,22 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             }
         };
         let i = line.index();
+        // A line's host out of sight: its run, ready and not yet seen dead, is stopped, and
+        // its end is a death. (A run not yet ready is what started after a death.)
+        if let Said::Unseen = said {
+            if !ended && ready[i] && finals[i].is_none() {
+                cut_off[i] = true;
+                lines.stop(line, runs[i]);
+            }
+            continue;
+        }
         // The last words of a run that has died, heard late.
         if run != runs[i] {
             continue;
         }
         match said {
             Said::Ready => {
+                ready[i] = true;
                 let now = clock.now().since_start().as_secs_f64();
                 if let Some(outage) = outages
                     .iter_mut()
@@ -490,6 +522,8 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                     .cloned()
                     .collect();
                 lines.0.push((line, next, start(line, next, &faults)?));
+                ready[i] = false;
+                let cut = std::mem::take(&mut cut_off[i]);
                 // A run that died before it was ready prolongs the outage it was to end.
                 match outages
                     .iter_mut()
@@ -501,6 +535,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                     }
                     None => outages.push(Outage {
                         line,
+                        cut_off: cut,
                         died: died.since_start().as_secs_f64(),
                         back: None,
                         run: next,
@@ -510,6 +545,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
             }
             other => return Err(other.refusal(line, "its figures")),
         }
+    }
+    for watcher in watchers {
+        watcher.abort();
     }
     lines.ended().await;
     drop(exported);
@@ -681,6 +719,9 @@ enum Said {
     Failed(String),
     /// Its output closed: it ended, with this status if known.
     Ended(Option<ExitStatus>),
+    /// Over zenoh: its host is gone from the world's sight (killed, or cut off), as the
+    /// world watches it, whatever run it is in.
+    Unseen,
     /// A line the world does not understand.
     Garbled(String),
 }
@@ -697,6 +738,7 @@ impl Said {
             Said::Ready | Said::Snapshot(_) | Said::Figures(_) => {
                 format!("answered out of turn, before {expected}")
             }
+            Said::Unseen => format!("was cut off before it sent {expected}"),
         };
         refused(process_name(line), why)
     }
@@ -720,6 +762,9 @@ impl Said {
 
 /// What a line's process said, with its line and run.
 type Heard = (Line, u32, Said);
+
+/// The run of what the world's watch of a line's host says: whichever run is up.
+const UNSEEN: u32 = u32::MAX;
 
 async fn hear_from(hear: &mut UnboundedReceiver<Heard>) -> Result<Heard, RunError> {
     match tokio::time::timeout(PATIENCE, hear.recv()).await {
@@ -881,13 +926,18 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let carrier = match &process.connect {
         None => Carrier::Ipc(Remote::new(&process.remote).map_err(carried(name))?),
-        Some(endpoint) => Carrier::Zenoh(
-            Host::builder(&process.remote)
+        Some(endpoint) => {
+            let host = Host::builder(&process.remote)
                 .connect(endpoint)
                 .open()
                 .await
-                .map_err(carried(name))?,
-        ),
+                .map_err(carried(name))?;
+            // A run started while its host is cut off waits for the link to come back.
+            await_world(&host, line)
+                .await
+                .map_err(|why| refused(name, why))?;
+            Carrier::Zenoh(host)
+        }
     };
     let cell = Cell::new(clock.clone());
     // The report counts the time lost to deadlocks from how long each wait lasted.
@@ -996,6 +1046,26 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     clock.sleep_until(Instant::from_start(total)).await;
     drop(shared);
     Ok(so_far())
+}
+
+/// Waits (up to the world's patience) until the world's host is seen exporting `line`'s
+/// gate device, by its liveliness token (`imrs/<cell>/live/<PORT>`).
+async fn await_world(host: &Host, line: Line) -> Result<(), String> {
+    let key = format!("imrs/{}/live/{}", host.cell(), Device::Gate(line).port());
+    let deadline = std::time::Instant::now() + PATIENCE;
+    loop {
+        let seen = match host.session().liveliness().get(&key).await {
+            Ok(replies) => replies.recv_async().await.is_ok(),
+            Err(_) => false,
+        };
+        if seen {
+            return Ok(());
+        }
+        if std::time::Instant::now() >= deadline {
+            return Err(format!("the world's host was not seen for {PATIENCE:?}"));
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
 }
 
 /// Why a port of the feeder zone's keeper could not be imported.

@@ -407,6 +407,46 @@ fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
 }
 
 #[test]
+fn over_zenoh_a_line_whose_host_is_cut_off_and_healed_is_started_again() {
+    let world = World::start(&["--transport", "zenoh", "--hours", "0.1", "--speed", "20"]);
+    world.lines();
+    // Line A's namespace's link, on the world's side (`imrs_zenoh::netns`).
+    let link = format!("imrso{}x0", world.pid() % 100_000);
+    let set = |state: &str| {
+        Command::new("ip")
+            .args(["link", "set", &link, state])
+            .status()
+            .is_ok_and(|status| status.success())
+    };
+    std::thread::sleep(Duration::from_secs(3));
+    if !set("down") {
+        // No namespaces here (not root, no `ip`): the hosts are on loopback and cannot be cut.
+        eprintln!(
+            "\n*** LOOPBACK: line A's host cannot be cut off here; the cut is not tried ***\n"
+        );
+        let report = world.report(Duration::from_secs(120));
+        assert!(report.contains("ON LOOPBACK, not hosts apart"), "{report}");
+        return;
+    }
+    // Longer than the hosts' lease (2 s): the world sees line A's host gone.
+    std::thread::sleep(Duration::from_secs(4));
+    assert!(set("up"), "the link set up again");
+    let report = world.report(Duration::from_secs(120));
+    let outage = report
+        .lines()
+        .find_map(|line| line.strip_prefix("outage: "))
+        .unwrap_or_else(|| panic!("no outage in\n{report}"));
+    assert!(
+        outage.starts_with("line A's host was cut off at ") && outage.contains("(run 1), back "),
+        "{outage}"
+    );
+    let (a, b) = row(&report, "pallets completed");
+    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
+    assert!(!report.contains("[FAILED]"), "{report}");
+}
+
+#[test]
 fn a_line_that_keeps_dying_fails_the_run_past_its_restarts() {
     // An hour at ten times the wall clock: six minutes, unless the restarts run out.
     let world = World::start(&["--hours", "1", "--speed", "10"]);

@@ -89,6 +89,7 @@ pub mod netns;
 mod opening;
 mod relay;
 mod take;
+mod user_watch;
 mod watch;
 
 pub use access::TlsFiles;
@@ -97,3 +98,4 @@ pub use export::{Export, Exported, export};
 pub use host::{Host, HostBuilder};
 pub use import::{Import, Imported, import};
 pub use message::{MAX_MESSAGE, Message};
+pub use user_watch::{UserWatch, watch_user};

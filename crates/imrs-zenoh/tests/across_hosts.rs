@@ -379,3 +379,31 @@ async fn a_flood_under_one_name_is_refused_past_its_room() {
     }
     assert_eq!((refused, waited), (84, 16));
 }
+
+/// A supervisor's watch of a module on another host: it stays quiet while the module's
+/// host imports the port again at once, and ends when that host is gone.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_watched_module_is_seen_gone_with_its_host() {
+    let (owner_host, user_host) = two_hosts("watched_cell", &free_endpoint()).await;
+    let port: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("WATCHED", "OWNER"));
+    let _exported = export(&owner_host, &port).await.unwrap();
+    let imported: Imported<u64, u64, usage::Receive> =
+        import(&user_host, "WATCHED", "OWNER", "USER")
+            .await
+            .unwrap();
+    let mut watch = imrs_zenoh::watch_user(&owner_host, "WATCHED", "USER")
+        .await
+        .unwrap();
+    assert!(watch.is_there().await);
+    // Imported again at once: the first token's end is heard, but the module is there.
+    drop(imported);
+    let _again: Imported<u64, u64, usage::Receive> = import(&user_host, "WATCHED", "OWNER", "USER")
+        .await
+        .unwrap();
+    let quiet = tokio::time::timeout(Duration::from_millis(500), watch.gone()).await;
+    assert!(quiet.is_err(), "a module imported again was seen gone");
+    // Its host closes: gone.
+    user_host.close().await.unwrap();
+    within(PROMPTLY, "the module seen gone", watch.gone()).await;
+    assert!(!watch.is_there().await);
+}
