@@ -1049,23 +1049,17 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
 }
 
 /// Waits (up to the world's patience) until the world's host is seen exporting `line`'s
-/// gate device, by its liveliness token (`imrs/<cell>/live/<PORT>`).
+/// gate device.
 async fn await_world(host: &Host, line: Line) -> Result<(), String> {
-    let key = format!("imrs/{}/live/{}", host.cell(), Device::Gate(line).port());
+    let port = Device::Gate(line).port();
     let deadline = std::time::Instant::now() + PATIENCE;
-    loop {
-        let seen = match host.session().liveliness().get(&key).await {
-            Ok(replies) => replies.recv_async().await.is_ok(),
-            Err(_) => false,
-        };
-        if seen {
-            return Ok(());
-        }
+    while !host.is_exported(&port).await.map_err(|e| e.to_string())? {
         if std::time::Instant::now() >= deadline {
             return Err(format!("the world's host was not seen for {PATIENCE:?}"));
         }
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
+    Ok(())
 }
 
 /// Why a port of the feeder zone's keeper could not be imported.

@@ -322,6 +322,24 @@ fn line_process(world: u32, line: &str) -> Option<u32> {
     })
 }
 
+/// `report` shows line A's outage (its `what`: "process died", "host was cut off") and its
+/// next run back before the end; both lines completed cards, and no invariant failed.
+fn line_a_came_back(report: &str, what: &str) {
+    let outage = report
+        .lines()
+        .find_map(|line| line.strip_prefix("outage: "))
+        .unwrap_or_else(|| panic!("no outage in\n{report}"));
+    assert!(
+        outage.starts_with(&format!("line A's {what} at "))
+            && outage.contains("started again (run 1), back "),
+        "{outage}"
+    );
+    let (a, b) = row(report, "pallets completed");
+    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
+    assert!(!report.contains("[FAILED]"), "{report}");
+}
+
 #[test]
 fn a_line_killed_mid_run_is_started_again_and_the_other_goes_on() {
     // Six simulated minutes at twenty times the wall clock: 18 s.
@@ -349,23 +367,11 @@ fn a_line_killed_mid_run_is_started_again_and_the_other_goes_on() {
     assert!(alive(line_b), "line B stopped");
     assert_eq!(line_process(world.pid(), "B"), Some(line_b));
     let report = world.report(Duration::from_secs(120));
-    let outage = report
-        .lines()
-        .find_map(|line| line.strip_prefix("outage: "))
-        .unwrap_or_else(|| panic!("no outage in\n{report}"));
-    assert!(
-        outage.starts_with("line A's process died at ")
-            && outage.contains("started again (run 1), back "),
-        "{outage}"
-    );
-    assert_eq!(report.matches("outage: ").count(), 1, "{report}");
     // Both lines completed cards, before and after, and every invariant held: no pallet
     // lost (those the dead line held are counted as scrapped), nothing in the zone
     // together, no arms touching.
-    let (a, b) = row(&report, "pallets completed");
-    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
-    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
-    assert!(!report.contains("[FAILED]"), "{report}");
+    line_a_came_back(&report, "process died");
+    assert_eq!(report.matches("outage: ").count(), 1, "{report}");
     assert!(report.contains("[ok] no pallet lost"), "{report}");
 }
 
@@ -389,21 +395,10 @@ fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
         eprintln!("\n*** this run's hosts were on loopback, not apart: see the report ***\n");
     }
     assert!(!alive(line_b), "line B outlived the run");
-    let outage = report
-        .lines()
-        .find_map(|line| line.strip_prefix("outage: "))
-        .unwrap_or_else(|| panic!("no outage in\n{report}"));
-    assert!(
-        outage.starts_with("line A's process died at ") && outage.contains("(run 1), back "),
-        "{outage}"
-    );
     // The restarted line worked again: its device calls were served (no LET_1_GO went
     // unanswered), and both lines completed cards.
+    line_a_came_back(&report, "process died");
     assert!(report.contains("timeouts: none"), "{report}");
-    let (a, b) = row(&report, "pallets completed");
-    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
-    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
-    assert!(!report.contains("[FAILED]"), "{report}");
 }
 
 #[test]
@@ -432,18 +427,7 @@ fn over_zenoh_a_line_whose_host_is_cut_off_and_healed_is_started_again() {
     std::thread::sleep(Duration::from_secs(4));
     assert!(set("up"), "the link set up again");
     let report = world.report(Duration::from_secs(120));
-    let outage = report
-        .lines()
-        .find_map(|line| line.strip_prefix("outage: "))
-        .unwrap_or_else(|| panic!("no outage in\n{report}"));
-    assert!(
-        outage.starts_with("line A's host was cut off at ") && outage.contains("(run 1), back "),
-        "{outage}"
-    );
-    let (a, b) = row(&report, "pallets completed");
-    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
-    assert!(a > 0 && b > 0, "{a} and {b}\n{report}");
-    assert!(!report.contains("[FAILED]"), "{report}");
+    line_a_came_back(&report, "host was cut off");
 }
 
 #[test]

@@ -98,6 +98,12 @@ impl Host {
         }
     }
 
+    /// Whether a host of the cell is seen exporting `port` now, by its liveliness token.
+    pub async fn is_exported(&self, port: &str) -> Result<bool, ZenohError> {
+        let keys = crate::key::Keys::new(&self.cell, port)?;
+        Ok(crate::watch::alive(&self.session, &keys.live).await)
+    }
+
     /// Closes the session: every port it exports is withdrawn, and its peers see it gone.
     pub async fn close(&self) -> Result<(), ZenohError> {
         self.session.close().await.map_err(ZenohError::session)

@@ -395,6 +395,8 @@ async fn a_watched_module_is_seen_gone_with_its_host() {
         .await
         .unwrap();
     assert!(watch.is_there().await);
+    assert!(user_host.is_exported("WATCHED").await.unwrap());
+    assert!(!user_host.is_exported("UNEXPORTED").await.unwrap());
     // Imported again at once: the first token's end is heard, but the module is there.
     drop(imported);
     let _again: Imported<u64, u64, usage::Receive> = import(&user_host, "WATCHED", "OWNER", "USER")

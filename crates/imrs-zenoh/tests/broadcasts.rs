@@ -122,33 +122,7 @@ async fn a_gone_owner_ends_a_listeners_wait_and_its_return_reaches_the_same_impo
         "{waited:?}"
     );
     // The owner's host comes back: its broadcasts reach the panel, with no new import.
-    let back_host = listening("gone_alarm_cell", &endpoint).await;
-    let back: Port<u32, u32, usage::SendAll, AnyUser, 1> =
-        Port::new(PortSpec::new("ALARM", "LINE"));
-    let _exported = export(&back_host, &back).await.unwrap();
-    // Until the panel's host has seen the owner back, a wait still finds it gone.
-    let heard = tokio::spawn(async move {
-        loop {
-            match panel.receive().await {
-                Ok((n, reply)) => {
-                    reply.reply(n + 1);
-                    break n;
-                }
-                Err(ReceiveError::PeerGone { .. }) => tokio::task::yield_now().await,
-                Err(error) => panic!("{error}"),
-            }
-        }
-    });
-    let mut line = back.owner().unwrap();
-    let answer = within(PROMPTLY, "the returned owner's broadcast", async {
-        while back.users_attached() < 1 {
-            tokio::task::yield_now().await;
-        }
-        line.send_all(41).await.map(|broadcast| broadcast.first)
-    })
-    .await;
-    assert_eq!(answer.unwrap(), 42);
-    assert_eq!(within(PROMPTLY, "the panel", heard).await.unwrap(), 41);
+    owner_back_reaches(&endpoint, "gone_alarm_cell", panel).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -238,7 +212,17 @@ async fn a_gone_owner_is_seen_while_its_broadcasts_reply_is_held() {
     // The panel lets the old reply go (one rendezvous at a time, as in one process), and the
     // owner's host comes back: its broadcast reaches the panel, with no new import.
     drop(held);
-    let back_host = listening("held_alarm_cell", &endpoint).await;
+    owner_back_reaches(&endpoint, "held_alarm_cell", panel).await;
+}
+
+/// ALARM's owner's host, back on `endpoint`: its broadcast reaches `panel` on the same
+/// import, whose waits find the owner gone until its host has seen it back.
+async fn owner_back_reaches(
+    endpoint: &str,
+    cell: &str,
+    mut panel: imrs_ports::End<u32, u32, usage::Receive>,
+) {
+    let back_host = listening(cell, endpoint).await;
     let back: Port<u32, u32, usage::SendAll, AnyUser, 1> =
         Port::new(PortSpec::new("ALARM", "LINE"));
     let _exported = export(&back_host, &back).await.unwrap();
