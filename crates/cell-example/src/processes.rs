@@ -391,10 +391,18 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     }
     // Over zenoh, each line's host is watched: one cut off is treated as one that died.
     let mut watchers = Vec::new();
-    if let Carrier::Zenoh(host) = &carrier {
+    if let Carrier::Zenoh(_) = &carrier {
         for line in Line::ALL {
             let gate = Device::Gate(line);
-            let mut watch = imrs_zenoh::watch_user(host, &gate.port(), &gate.user())
+            let exported_gate = exported
+                .iter()
+                .find_map(|exported| match exported {
+                    Exported::Zenoh(exported) if exported.port() == gate.port() => Some(exported),
+                    _ => None,
+                })
+                .ok_or_else(|| refused("world", format!("port {} is not exported", gate.port())))?;
+            let mut watch = exported_gate
+                .watch_user(&gate.user())
                 .await
                 .map_err(carried("world"))?;
             let tell = tell.clone();

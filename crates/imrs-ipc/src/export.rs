@@ -24,7 +24,7 @@ use crate::dispatch::{Dispatch, Work};
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
     CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TIGHT,
-    TOO_MANY_USERS,
+    TOO_MANY_NAMES, TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -61,6 +61,9 @@ pub(crate) enum Refusal {
         /// The port's number of users.
         capacity: usize,
     },
+    /// The module's name would be one more than the process keeps from peers
+    /// ([`Name::MOST_FROM_PEERS`]).
+    TooManyNames,
     /// Something else failed (a relay back to the module's process).
     Failed,
 }
@@ -70,6 +73,7 @@ impl From<ClaimRefused> for Refusal {
         match refused {
             ClaimRefused::NotOnUserList { .. } => Self::NotOnUserList,
             ClaimRefused::Full { capacity, .. } => Self::Full { capacity },
+            ClaimRefused::TooManyNames { .. } => Self::TooManyNames,
         }
     }
 }
@@ -230,7 +234,7 @@ where
         tight,
         move |module: &str| {
             // Refused by its name's text before the name is made: see `Port::claim`.
-            attached.claim(module)?;
+            let module = attached.claim(module)?;
             // The remote module's end waits in the bridge's task, which a spinning wait
             // would keep off its worker: it parks, whatever the port's process type.
             let mut end = attached.user_named(module)?;
@@ -613,6 +617,10 @@ fn user<E>(
         Err(
             Refusal::Wire(WireError::TooManyUsers { capacity, .. }) | Refusal::Full { capacity },
         ) => Err((TOO_MANY_USERS, u32::try_from(capacity).unwrap_or(u32::MAX))),
+        Err(Refusal::TooManyNames) => Err((
+            TOO_MANY_NAMES,
+            u32::try_from(Name::MOST_FROM_PEERS).unwrap_or(u32::MAX),
+        )),
         Err(_) => Err((REFUSED, 0)),
     }
 }

@@ -26,7 +26,8 @@ use crate::export::InFlight;
 use crate::sweep::sweep_dead;
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{
-    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_USERS,
+    CONNECT, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, RequestMeta, SEND, TIGHT, TOO_MANY_NAMES,
+    TOO_MANY_USERS,
 };
 use crate::{IpcError, Remote, Wire};
 
@@ -640,6 +641,11 @@ pub(crate) fn answered(meta: ReplyMeta, port: &Name, module: &str) -> Result<boo
             module,
             capacity: meta.detail as usize,
         })),
+        TOO_MANY_NAMES => Err(transport(format!(
+            "the owner's process keeps {} module names its peers made already and refused \
+             {module}: give port {port} a user list",
+            meta.detail
+        ))),
         REFUSED => Err(transport(format!("the owner refused {module}"))),
         status => Err(transport(format!("the owner answered status {status}"))),
     }

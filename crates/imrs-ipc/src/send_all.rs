@@ -259,7 +259,8 @@ where
         bridge::<Req, Rep, Req, Rep, _, _>(remote, name, N, true, false, move |module: &str| {
             port.claim(module)?;
             // The relay back is the module's process's service: one that is not there is
-            // refused before any name of the claim is made.
+            // refused. Its name, if the claim made it, counts among the names the process
+            // keeps from peers (`Name::MOST_FROM_PEERS`).
             if !is_served(&cell, &format!("{served}/to/{module}")) {
                 return Err(Refusal::Failed);
             }

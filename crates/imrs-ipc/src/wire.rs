@@ -91,6 +91,9 @@ pub(crate) const TOO_MANY_USERS: u32 = 2;
 pub(crate) const REFUSED: u32 = 3;
 pub(crate) const MALFORMED: u32 = 4;
 pub(crate) const NO_REPLY: u32 = 5;
+/// The module's name would be one more than the owner's process keeps from peers; the
+/// detail is that number.
+pub(crate) const TOO_MANY_NAMES: u32 = 6;
 
 /// In the answer to a connection: the owner declared the port TIGHT.
 pub(crate) const TIGHT: u32 = 1;

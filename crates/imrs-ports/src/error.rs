@@ -438,6 +438,14 @@ pub enum ClaimRefused {
         /// The declared number of users.
         capacity: usize,
     },
+    /// The module's name would be one more than the process keeps from peers
+    /// ([`Name::MOST_FROM_PEERS`]): a port without a user list met that many new names.
+    TooManyNames {
+        /// The port.
+        port: Name,
+        /// The module refused, as claimed.
+        module: String,
+    },
 }
 
 impl fmt::Display for ClaimRefused {
@@ -453,6 +461,12 @@ impl fmt::Display for ClaimRefused {
             } => write!(
                 f,
                 "module {module} cannot use port {port}: it allows {capacity} active user(s) and all are attached"
+            ),
+            Self::TooManyNames { port, module } => write!(
+                f,
+                "module {module} cannot use port {port}: this process already keeps {} module \
+                 names its peers made; give port {port} a user list",
+                Name::MOST_FROM_PEERS
             ),
         }
     }

@@ -9,6 +9,14 @@
 //! The cost: each distinct name is kept for the life of the process. Name modules, ports and
 //! sections by role (`CHIP_IT`, `SHARE_FEEDER`), as the seed does, not by part or time: a cell
 //! that makes a new name per pallet would keep every one.
+//!
+//! Text a peer sends is made a name only once a port accepts it ([`Port::claim`]), and at
+//! most [`Name::MOST_FROM_PEERS`] names are first made that way: a peer that claims a new
+//! name at every connection, on a port without a user list, is refused by name once that
+//! many are kept, instead of growing its owner for ever. Names on user lists are made when
+//! the port is declared, so they are never refused.
+//!
+//! [`Port::claim`]: crate::Port::claim
 
 use std::cmp::Ordering;
 use std::collections::HashSet;
@@ -20,31 +28,53 @@ use std::sync::{OnceLock, PoisonError, RwLock};
 #[derive(Clone)]
 pub struct Name(&'static str);
 
-/// Every name made so far.
-fn interned() -> &'static RwLock<HashSet<&'static str>> {
-    static INTERNED: OnceLock<RwLock<HashSet<&'static str>>> = OnceLock::new();
+/// Every name made so far, and how many of them were first made from a peer's text.
+#[derive(Default)]
+struct Interned {
+    names: HashSet<&'static str>,
+    from_peers: usize,
+}
+
+fn interned() -> &'static RwLock<Interned> {
+    static INTERNED: OnceLock<RwLock<Interned>> = OnceLock::new();
     INTERNED.get_or_init(RwLock::default)
 }
 
 impl Name {
+    /// The most names a process makes from peers' text: see the module's documentation.
+    pub const MOST_FROM_PEERS: usize = 4096;
+
     /// The name `text`, the same `Name` for the same text wherever it is made.
     fn intern(text: &str) -> Self {
-        // Each critical section is one lookup or one insert: a panic cannot leave the set
-        // half-changed.
-        if let Some(known) = interned()
-            .read()
-            .unwrap_or_else(PoisonError::into_inner)
-            .get(text)
-        {
-            return Self(known);
+        Self::made(text, false).unwrap_or_else(|| unreachable!("only a peer's name is refused"))
+    }
+
+    /// The name `text` from a peer, made if it is new and fewer than
+    /// [`MOST_FROM_PEERS`](Self::MOST_FROM_PEERS) names have been made from peers' text;
+    /// `None` if it would be one too many.
+    pub(crate) fn from_peer(text: &str) -> Option<Self> {
+        Self::made(text, true)
+    }
+
+    fn made(text: &str, from_peer: bool) -> Option<Self> {
+        // Each critical section is one lookup, or one check and insert: a panic cannot leave
+        // the set half-changed.
+        if let Some(known) = Self::known(text) {
+            return Some(known);
         }
-        let mut names = interned().write().unwrap_or_else(PoisonError::into_inner);
-        if let Some(known) = names.get(text) {
-            return Self(known);
+        let mut interned = interned().write().unwrap_or_else(PoisonError::into_inner);
+        if let Some(known) = interned.names.get(text) {
+            return Some(Self(known));
+        }
+        if from_peer {
+            if interned.from_peers >= Self::MOST_FROM_PEERS {
+                return None;
+            }
+            interned.from_peers += 1;
         }
         let kept: &'static str = Box::leak(text.into());
-        names.insert(kept);
-        Self(kept)
+        interned.names.insert(kept);
+        Some(Self(kept))
     }
 
     /// The name `text`, if it has been made already; never keeps a new one. For text from
@@ -53,6 +83,7 @@ impl Name {
         interned()
             .read()
             .unwrap_or_else(PoisonError::into_inner)
+            .names
             .get(text)
             .map(|known| Self(known))
     }

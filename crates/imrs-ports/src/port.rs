@@ -252,11 +252,13 @@ where
         self.core.users_attached()
     }
 
-    /// Checks a remote module's claim to attach as a user, by its name's text alone: refused
-    /// if it is not on the port's user list or every user place is taken. A transport
-    /// checks this before it attaches a module a peer names, so that a refused claim leaves
-    /// no name behind (names are kept for the life of the process, see [`Name`]).
-    pub fn claim(&self, module: &str) -> Result<(), ClaimRefused> {
+    /// Checks a remote module's claim to attach as a user, by its name's text alone, and
+    /// gives the module's name: refused if it is not on the port's user list, every user
+    /// place is taken, or the name is new and the process keeps
+    /// [`Name::MOST_FROM_PEERS`] made from peers already. A transport checks this before
+    /// it attaches a module a peer names, so that a refused claim leaves no name behind
+    /// (names are kept for the life of the process, see [`Name`]).
+    pub fn claim(&self, module: &str) -> Result<Name, ClaimRefused> {
         let port = self.core.meta.name.clone();
         if !self.core.meta.admits(module) {
             Err(ClaimRefused::NotOnUserList {
@@ -270,8 +272,17 @@ where
                 capacity: self.core.capacity(),
             })
         } else {
-            Ok(())
+            Name::from_peer(module).ok_or_else(|| ClaimRefused::TooManyNames {
+                port,
+                module: module.to_owned(),
+            })
         }
+    }
+
+    /// Whether module `module` may use this port by its user list (any module, on a port
+    /// without one). Makes no name.
+    pub fn admits(&self, module: &str) -> bool {
+        self.core.meta.admits(module)
     }
 
     /// Attaches the owner end. One owner end at a time; after it is dropped (its module

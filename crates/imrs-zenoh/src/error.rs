@@ -45,6 +45,14 @@ pub enum ZenohError {
         /// The module.
         module: String,
     },
+    /// A module watched as a port's user that is not on the port's user list: no host can
+    /// import the port for it ([`Exported::watch_user`](crate::Exported::watch_user)).
+    NotAUser {
+        /// The port.
+        port: String,
+        /// The module.
+        module: String,
+    },
     /// A message that could not be encoded, or bytes that are not the port's message.
     Encoding {
         /// The port.
@@ -82,6 +90,11 @@ impl fmt::Display for ZenohError {
                 f,
                 "module {module} is not admitted to port {port} on this host: admit it with \
                  its host (HostBuilder::admit) on the port's owner's host and on its own"
+            ),
+            Self::NotAUser { port, module } => write!(
+                f,
+                "module {module} is not on the user list of port {port}: no host can import \
+                 the port for it, so there is nothing to watch"
             ),
             Self::Encoding { port, reason } => write!(f, "port {port}: {reason}"),
         }

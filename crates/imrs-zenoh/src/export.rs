@@ -25,26 +25,35 @@ use crate::forward::Forward;
 use crate::key::checked;
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
-use crate::{Host, ZenohError};
+use crate::{Host, UserWatch, ZenohError};
 
 /// A port exported to other hosts: served while this is held, withdrawn when dropped.
 pub struct Exported {
     port: String,
+    host: Host,
+    admits: Box<Admits>,
     tasks: Vec<JoinHandle<()>>,
     /// What serves the port besides the tasks: a queryable, or the relays to its users.
     _held: Box<dyn Send + Sync>,
     _token: zenoh::liveliness::LivelinessToken,
 }
 
+/// Whether the port's user list has a module, by its name's text (any, without a list).
+pub(crate) type Admits = dyn Fn(&str) -> bool + Send + Sync;
+
 impl Exported {
     pub(crate) fn new(
         port: &str,
+        host: &Host,
+        admits: Box<Admits>,
         tasks: Vec<JoinHandle<()>>,
         held: Box<dyn Send + Sync>,
         token: zenoh::liveliness::LivelinessToken,
     ) -> Self {
         Self {
             port: port.to_owned(),
+            host: host.clone(),
+            admits,
             tasks,
             _held: held,
             _token: token,
@@ -54,6 +63,22 @@ impl Exported {
     /// The port.
     pub fn port(&self) -> &str {
         &self.port
+    }
+
+    /// Watches module `module`, a user of this port on another host, for a supervisor that
+    /// must act when the module's host is gone, whether killed or cut off. Refused, by
+    /// name, for a module that is not on the port's user list or that this host does not
+    /// admit to the port (it could never import it); on a port without a user list, any
+    /// name is watched.
+    pub async fn watch_user(&self, module: &str) -> Result<UserWatch, ZenohError> {
+        if !(self.admits)(module) {
+            return Err(ZenohError::NotAUser {
+                port: self.port.clone(),
+                module: module.to_owned(),
+            });
+        }
+        self.host.carries_for(&self.port, module)?;
+        UserWatch::new(&self.host, &self.port, module).await
     }
 }
 
@@ -142,7 +167,7 @@ impl<E> Users<E> {
         }
         // Refused by its text alone, before its name is made (names are kept for the life
         // of the process): a refused claim grows nothing here. An accepted name is kept,
-        // so a port open to any user is open to that too.
+        // at most `Name::MOST_FROM_PEERS` of them made from peers' text.
         claim(module)?;
         let presence = Presence::new(module);
         // The end is held by the remote module's presence, so that its peers see it gone
@@ -208,7 +233,7 @@ async fn serve<Req, Rep, E>(
     host: &Host,
     port_name: &str,
     owner: String,
-    claim: Box<Claim>,
+    (claim, admits): (Box<Claim>, Box<Admits>),
     attach: impl Fn(&str) -> Result<E, WireError> + Send + Sync + 'static,
 ) -> Result<Exported, ZenohError>
 where
@@ -285,6 +310,8 @@ where
     };
     Ok(Exported::new(
         port_name,
+        host,
+        admits,
         vec![connecting, watching],
         Box::new(serving),
         token,
@@ -396,7 +423,7 @@ macro_rules! asked {
                     host,
                     self.name().as_str(),
                     owner,
-                    claim_of(self),
+                    checks_of(self),
                     move |module| port.user_named(module),
                 )
                 .await
@@ -413,16 +440,28 @@ macro_rules! asked {
 asked!(usage::Receive);
 asked!(usage::Response);
 
-/// `port`'s check of a remote module's claim, refused in words that name the port.
-fn claim_of<Req, Rep, U, L, const N: usize>(port: &Port<Req, Rep, U, L, N>) -> Box<Claim>
+/// `port`'s checks of a remote module: its claim, refused in words that name the port; and
+/// its user list, as [`Exported::watch_user`] checks it.
+fn checks_of<Req, Rep, U, L, const N: usize>(
+    port: &Port<Req, Rep, U, L, N>,
+) -> (Box<Claim>, Box<Admits>)
 where
     Req: Send + 'static,
     Rep: Send + 'static,
     U: imrs_ports::usage::Usage,
     L: UserList,
 {
-    let port = port.clone();
-    Box::new(move |module: &str| port.claim(module).map_err(|refused| refused.to_string()))
+    let claimed = port.clone();
+    let listed = port.clone();
+    (
+        Box::new(move |module: &str| {
+            claimed
+                .claim(module)
+                .map(drop)
+                .map_err(|refused| refused.to_string())
+        }),
+        Box::new(move |module: &str| listed.admits(module)),
+    )
 }
 
 /// Exports with [`crate::relay`], for a port whose owner starts each rendezvous.
@@ -438,7 +477,7 @@ macro_rules! relayed {
                     host,
                     self.name().as_str(),
                     owner,
-                    claim_of(self),
+                    checks_of(self),
                     move |module| port.attach_relayed(module),
                 )
                 .await

@@ -98,4 +98,4 @@ pub use export::{Export, Exported, export};
 pub use host::{Host, HostBuilder};
 pub use import::{Import, Imported, import};
 pub use message::{MAX_MESSAGE, Message};
-pub use user_watch::{UserWatch, watch_user};
+pub use user_watch::UserWatch;

@@ -21,7 +21,7 @@ use tokio::task::JoinHandle;
 
 use crate::asking::{Asking, Pending};
 use crate::connected::Connected;
-use crate::export::{Claim, Exported, module_of, reply, sender_of};
+use crate::export::{Admits, Claim, Exported, module_of, reply, sender_of};
 use crate::import::{NO_TIMEOUT, begin, connect_to, reconnect};
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
@@ -63,7 +63,7 @@ pub(crate) async fn export_relayed<Req, Rep, T>(
     host: &Host,
     port_name: &str,
     owner: String,
-    claim: Box<Claim>,
+    (claim, admits): (Box<Claim>, Box<Admits>),
     attach: impl Fn(&str) -> Result<T, WireError> + Send + Sync + 'static,
 ) -> Result<Exported, ZenohError>
 where
@@ -132,6 +132,8 @@ where
     };
     Ok(Exported::new(
         port_name,
+        host,
+        admits,
         vec![connecting, watching],
         Box::new(relays),
         token,

@@ -1,5 +1,6 @@
-//! A module of another host watched from the host that exports a port it uses: for a
-//! supervisor that must act when a host is gone, whether killed or cut off.
+//! A module of another host watched from the host that exports a port it uses
+//! ([`Exported::watch_user`](crate::Exported::watch_user)): for a supervisor that must act
+//! when a host is gone, whether killed or cut off.
 
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::sample::{Sample, SampleKind};
@@ -21,23 +22,23 @@ impl std::fmt::Debug for UserWatch {
     }
 }
 
-/// Watches module `module`, which uses port `port` from another host of `host`'s cell.
-pub async fn watch_user(host: &Host, port: &str, module: &str) -> Result<UserWatch, ZenohError> {
-    let key = Keys::new(&host.cell, port)?.user(checked("module", module)?);
-    let subscriber = host
-        .session
-        .liveliness()
-        .declare_subscriber(&key)
-        .await
-        .map_err(ZenohError::session)?;
-    Ok(UserWatch {
-        subscriber,
-        session: host.session.clone(),
-        key,
-    })
-}
-
 impl UserWatch {
+    /// Watches module `module`, which uses port `port` from another host of `host`'s cell.
+    pub(crate) async fn new(host: &Host, port: &str, module: &str) -> Result<Self, ZenohError> {
+        let key = Keys::new(&host.cell, port)?.user(checked("module", module)?);
+        let subscriber = host
+            .session
+            .liveliness()
+            .declare_subscriber(&key)
+            .await
+            .map_err(ZenohError::session)?;
+        Ok(Self {
+            subscriber,
+            session: host.session.clone(),
+            key,
+        })
+    }
+
     /// Until the module's host is seen gone: killed, closed, or cut off for longer than its
     /// lease. A token's end is confirmed (a host that imported the port again at once is
     /// not gone). Also ends when this host's session closes.

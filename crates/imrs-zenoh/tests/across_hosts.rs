@@ -385,15 +385,22 @@ async fn a_flood_under_one_name_is_refused_past_its_room() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_watched_module_is_seen_gone_with_its_host() {
     let (owner_host, user_host) = two_hosts("watched_cell", &free_endpoint()).await;
-    let port: Port<u64, u64, usage::Receive> = Port::new(PortSpec::new("WATCHED", "OWNER"));
-    let _exported = export(&owner_host, &port).await.unwrap();
+    let port: Port<u64, u64, usage::Receive> =
+        Port::new(PortSpec::new("WATCHED", "OWNER").user_list(["USER"]));
+    let exported = export(&owner_host, &port).await.unwrap();
     let imported: Imported<u64, u64, usage::Receive> =
         import(&user_host, "WATCHED", "OWNER", "USER")
             .await
             .unwrap();
-    let mut watch = imrs_zenoh::watch_user(&owner_host, "WATCHED", "USER")
-        .await
-        .unwrap();
+    // A misspelt module is refused by name, never watched in silence.
+    assert_eq!(
+        exported.watch_user("USRE").await.unwrap_err(),
+        ZenohError::NotAUser {
+            port: "WATCHED".into(),
+            module: "USRE".into()
+        }
+    );
+    let mut watch = exported.watch_user("USER").await.unwrap();
     assert!(watch.is_there().await);
     assert!(user_host.is_exported("WATCHED").await.unwrap());
     assert!(!user_host.is_exported("UNEXPORTED").await.unwrap());

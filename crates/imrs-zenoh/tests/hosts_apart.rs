@@ -12,7 +12,7 @@ use common::{PROMPTLY, free_endpoint, within};
 use imrs_ports::{SendError, usage};
 use imrs_zenoh::netns::Netns;
 use imrs_zenoh::{Host, Imported, import};
-use tokio::io::{AsyncBufReadExt, BufReader};
+use tokio::io::{AsyncBufReadExt, AsyncReadExt, BufReader};
 use tokio::process::{Child, Command};
 
 /// The owner's host, `zenoh_peer`, started (inside `netns` if given) and ready.
@@ -29,17 +29,21 @@ async fn peer(cell: &str, endpoint: &str, netns: Option<&str>) -> Child {
     let mut child = command
         .args([cell, endpoint])
         .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
         .kill_on_drop(true)
         .spawn()
         .expect("zenoh_peer starts");
     let stdout = child.stdout.take().expect("its stdout");
     let mut lines = BufReader::new(stdout).lines();
     let line = within(PROMPTLY, "the peer's start", lines.next_line()).await;
-    assert_eq!(
-        line.unwrap().as_deref(),
-        Some("ready"),
-        "zenoh_peer did not start"
-    );
+    if line.as_ref().ok().and_then(Option::as_deref) != Some("ready") {
+        // Why it did not start is on its stderr: the test says it.
+        let mut why = String::new();
+        if let Some(mut stderr) = child.stderr.take() {
+            let _ = within(PROMPTLY, "its stderr", stderr.read_to_string(&mut why)).await;
+        }
+        panic!("zenoh_peer on {endpoint} did not start: it wrote {line:?}, and on stderr: {why}");
+    }
     child
 }
 
