@@ -17,8 +17,8 @@ use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
     ZONE_RESERVE,
 };
-use crate::ports::{CellPorts, ModuleName};
-use crate::reservation::{MAX_POSES, Reservation};
+use crate::ports::CellPorts;
+use crate::reservation::{MAX_POSES, Reservation, chip_robot};
 use crate::zone_asker::ZoneAsker;
 
 /// How the two chip robots share the feeder zone.
@@ -143,7 +143,9 @@ enum Access {
     },
     Coordinator {
         reserve: End<Reservation, (), usage::Send>,
-        free: End<ModuleName, (), usage::Send>,
+        free: End<ZoneAsker, (), usage::Send>,
+        /// Who asks, from which run of its line's process, as to the arbiter.
+        asker: ZoneAsker,
     },
 }
 
@@ -181,7 +183,7 @@ impl Access {
         step: ChipStep,
         waits: &SharedWaits,
     ) -> Result<(), DeviceError> {
-        let Access::Coordinator { reserve, .. } = self else {
+        let Access::Coordinator { reserve, asker, .. } = self else {
             return Ok(());
         };
         let (feeder, place) = (step.feeder, step.place());
@@ -199,7 +201,7 @@ impl Access {
         );
         // Two sweeps of `SWEEP_SAMPLES + 1` poses at most always fit (checked below, at
         // compile time).
-        let Some(reservation) = Reservation::new(ctx.module().as_str(), &sweep) else {
+        let Some(reservation) = Reservation::new(*asker, &sweep) else {
             unreachable!(
                 "a step's sweep has at most {} poses",
                 2 * (SWEEP_SAMPLES + 1)
@@ -222,9 +224,8 @@ impl Access {
                     ctx.delay(Duration::from_secs(1)).await;
                 }
             }
-            Access::Coordinator { free, .. } => {
-                let robot = ModuleName::new(ctx.module().as_str());
-                while ctx.send(free, robot).await.is_err() {
+            Access::Coordinator { free, asker, .. } => {
+                while ctx.send(free, *asker).await.is_err() {
                     ctx.delay(Duration::from_secs(1)).await;
                 }
             }
@@ -329,6 +330,7 @@ pub fn chip_it(
                 FeederPolicy::Coordinator => Access::Coordinator {
                     reserve: zone_reserve.user(&ctx)?,
                     free: zone_free.user(&ctx)?,
+                    asker: ZoneAsker::new(ctx.module().as_str(), line, run),
                 },
             };
             let mut work = work_schedule();
@@ -453,49 +455,87 @@ async fn chip_step(
 /// FEEDER_COORDINATOR: reserves for each chip robot the space its trajectory to the feeder
 /// and back to the card will sweep, granting it at once where it keeps clear of the other
 /// robot's reservation, and in turn where it does not.
+///
+/// Across processes the world tells it, on LINE_DOWN, that a line's process has died and
+/// which run of it comes next, once the dead line's chip robot is home: what the dead run
+/// held or asked for is let go, and the word of a dead run is not heeded, as FEEDER_MONITOR
+/// does. In one process nothing is said on LINE_DOWN, and every word is of run 0.
 pub fn feeder_coordinator(ports: &CellPorts) -> ModuleSpec<()> {
-    let (reserve, free) = (ports.zone_reserve.clone(), ports.zone_free.clone());
+    let (reserve, free, line_down) = (
+        ports.zone_reserve.clone(),
+        ports.zone_free.clone(),
+        ports.coordinator_down.clone(),
+    );
     ModuleSpec::new(FEEDER_COORDINATOR, ()).task(FEEDER_COORDINATOR, move |_ctx| {
-        let (reserve, free) = (reserve.clone(), free.clone());
+        let (reserve, free, line_down) = (reserve.clone(), free.clone(), line_down.clone());
         async move {
             let (mut reserve, mut free) = (reserve.owner()?, free.owner()?);
+            let mut line_down = line_down.owner()?;
             let mut space = Reservations::new(LINK_RADIUS, SWEEP_MARGIN);
-            // Requests not yet granted, by robot: answered when their space frees.
-            let mut asleep = Vec::new();
+            // The run of each line's process whose word counts.
+            let mut runs = [0_u32; 2];
+            // Requests not yet granted: answered when their space frees.
+            let mut asleep: Vec<(ZoneAsker, ReplyHandle<()>)> = Vec::new();
+            // The line of a word from a live run of a chip robot; `None` for any other.
+            let live = |asker: &ZoneAsker, runs: &[u32; 2]| {
+                chip_robot(asker).filter(|line| runs[line.index()] == asker.run())
+            };
             loop {
                 enum Event {
+                    Down(Line, u32, ReplyHandle<()>),
                     // Boxed: a reservation is a record of 1.6 KiB.
                     Reserve(Box<Reservation>, ReplyHandle<()>),
-                    Free(ModuleName, ReplyHandle<()>),
+                    Free(ZoneAsker, ReplyHandle<()>),
                 }
                 let event = select()
-                    .or(&mut free, |(robot, reply)| Event::Free(robot, reply))
+                    .or(&mut line_down, |((line, next), reply)| {
+                        Event::Down(line, next, reply)
+                    })
+                    .or(&mut free, |(asker, reply)| Event::Free(asker, reply))
                     .or(&mut reserve, |(reservation, reply)| {
                         Event::Reserve(Box::new(reservation), reply)
                     })
                     .await?;
-                match event {
+                let granted = match event {
+                    Event::Down(line, next, reply) => {
+                        runs[line.index()] = next;
+                        // A dead run's request still asleep is dropped: nobody is there.
+                        asleep.retain(|(asker, _)| asker.line() != Some(line));
+                        reply.reply(());
+                        space.withdraw(&LineNames::of(line).chip_it)
+                    }
                     Event::Reserve(reservation, reply) => {
-                        // A record no robot wrote (a garbled peer) is not answered:
-                        // its sender fails, and asks again.
-                        let Some(sweep) = reservation.sweep() else {
+                        // A record no live chip robot wrote (a garbled peer, a dead run) is
+                        // not answered: its sender fails. Its name is never kept.
+                        let (Some(_), Some(sweep)) =
+                            (live(reservation.asker(), &runs), reservation.sweep())
+                        else {
                             continue;
                         };
-                        let robot = *reservation.robot();
-                        if space.request(robot.as_str(), &sweep.to_vec()) {
+                        let asker = *reservation.asker();
+                        if space.request(asker.robot().as_str(), &sweep.to_vec()) {
                             reply.reply(());
                         } else {
-                            asleep.push((robot, reply));
+                            asleep.push((asker, reply));
+                        }
+                        continue;
+                    }
+                    // A free from any but a live chip robot (a dead run's, sent on its way
+                    // out) is answered, and changes nothing.
+                    Event::Free(asker, reply) => {
+                        reply.reply(());
+                        match live(&asker, &runs) {
+                            Some(_) => space.release(asker.robot().as_str()),
+                            None => continue,
                         }
                     }
-                    Event::Free(robot, reply) => {
-                        reply.reply(());
-                        for granted in space.release(robot.as_str()) {
-                            if let Some(at) = asleep.iter().position(|(r, _)| granted == r.as_str())
-                            {
-                                asleep.swap_remove(at).1.reply(());
-                            }
-                        }
+                };
+                for granted in granted {
+                    if let Some(at) = asleep
+                        .iter()
+                        .position(|(asker, _)| granted == asker.robot().as_str())
+                    {
+                        asleep.swap_remove(at).1.reply(());
                     }
                 }
             }

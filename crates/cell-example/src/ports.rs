@@ -37,7 +37,7 @@ pub type ReadyToChip = Port<PalletId, (), usage::Receive, AnyUser, 1>;
 pub type ShareFeeder = Port<(), i32, usage::Query>;
 /// The feeder zone's ports: a chip robot sends its name (or, to the coordinator, the space
 /// it will sweep) and waits until it may enter (or has left).
-pub type ZonePort<Req = ModuleName> = Port<Req, (), usage::Receive, AnyUser, 2>;
+pub type ZonePort<Req = ZoneAsker> = Port<Req, (), usage::Receive, AnyUser, 2>;
 
 /// LINE_DOWN: the world tells FEEDER_MONITOR that a line's process has died, and which run
 /// of it comes next (see [`ZoneAsker`]). It stays in the world's process.
@@ -95,7 +95,7 @@ impl fmt::Display for ModuleName {
 /// Where a chip robot finds a port of the feeder zone's keeper — the arbiter or the
 /// coordinator: declared in this process, or imported from the process the keeper runs in.
 #[derive(Clone)]
-pub enum ZoneLink<Req: Send + 'static = ModuleName> {
+pub enum ZoneLink<Req: Send + 'static = ZoneAsker> {
     /// The port itself.
     Here(ZonePort<Req>),
     /// The port of another process, through its bridge.
@@ -184,6 +184,8 @@ pub struct CellPorts {
     pub zone_reserve: ZoneLink<Reservation>,
     /// The coordinator's port for freeing a reservation.
     pub zone_free: ZoneLink,
+    /// The coordinator's port where the world says a line's process died.
+    pub coordinator_down: LineDownPort,
 }
 
 fn spec(name: &str, owner: &str, clock: &SharedClock) -> PortSpec {
@@ -278,6 +280,7 @@ impl CellPorts {
             zone_free: ZoneLink::Here(
                 ZonePort::new(spec(ZONE_FREE, FEEDER_COORDINATOR, clock)).shown(),
             ),
+            coordinator_down: LineDownPort::new(spec(LINE_DOWN, FEEDER_COORDINATOR, clock)).shown(),
         }
     }
 
@@ -304,6 +307,7 @@ impl CellPorts {
                 if let Some(port) = ports.zone_free.here() {
                     cell.declare(port)?;
                 }
+                cell.declare(&ports.coordinator_down)?;
             }
             FeederPolicy::Appendix => {}
         }

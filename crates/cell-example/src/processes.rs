@@ -35,12 +35,13 @@
 //! run starts, the world stops WORLD taking calls of the dead run (one a device had already
 //! taken is let end), drives the dead line's chip robot home through the robot's own port,
 //! takes off as scrap the pallets the dead line's stations held (in a state nobody knows),
-//! and tells FEEDER_MONITOR on LINE_DOWN, which then frees the zone if the dead line held it
-//! and heeds no word of the dead run (see [`crate::zone_asker`]). The report shows each outage:
-//! when, how long, and the pallets scrapped. Only the arbiter's policy is supervised so:
-//! under the Appendix's the survivor would wait on its dead twin's SHARE_FEEDER, and under
-//! the coordinator's on reservations nobody frees, so there a line that dies still fails
-//! the run, by name.
+//! and tells the feeder zone's keeper on LINE_DOWN: FEEDER_MONITOR then frees the zone if
+//! the dead line held it, FEEDER_COORDINATOR lets go of what the dead line's chip robot held
+//! or asked for, and neither heeds a word of the dead run (see [`crate::zone_asker`]). The
+//! report shows each outage: when, how long, and the pallets scrapped. The Appendix's
+//! policy is not supervised so: there the lines ask each other, with no keeper between
+//! them, and the survivor would wait on its dead twin's SHARE_FEEDER; a line that dies
+//! under it fails the run, by name.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -329,6 +330,10 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     if arbiter {
         cell.declare(&ports.line_down).map_err(CellErrors::from)?;
     }
+    if coordinator {
+        cell.declare(&ports.coordinator_down)
+            .map_err(CellErrors::from)?;
+    }
     if let Some(port) = free {
         cell.declare(port).map_err(CellErrors::from)?;
     }
@@ -368,9 +373,9 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
         cell.start(keeper)?;
     }
 
-    // The world's hands on a dead line: its chip robot's port, and FEEDER_MONITOR's ear.
+    // The world's hands on a dead line: its chip robot's port, and the zone keeper's ear.
     // It holds a place on every device port under every policy; it restarts a line under
-    // the arbiter's only.
+    // the arbiter's and the coordinator's.
     let supervisor = Supervisor::new(&devices, &ports, &runs, config.feeder)?;
     let (tell, mut hear) = unbounded_channel();
     let mut lines = Lines(Vec::new());
@@ -503,7 +508,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                 }));
             }
             Said::Ended(_) | Said::Failed(_) if !ended => {
-                if config.feeder != FeederPolicy::Arbiter {
+                if config.feeder == FeederPolicy::Appendix {
                     return Err(said.refusal_restartless(line, config.feeder));
                 }
                 if runs[i] >= RESTARTS {
@@ -591,11 +596,11 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
 
 /// The world's hands on a line whose process died: a place, as [`LINE_SUPERVISOR`], on
 /// every device's port (a port is never left without a user while a line's next run
-/// attaches, which would end WORLD's service of it for good), FEEDER_MONITOR's LINE_DOWN,
-/// and the runs WORLD carries out calls of.
+/// attaches, which would end WORLD's service of it for good), the feeder zone's keeper's
+/// LINE_DOWN, and the runs WORLD carries out calls of.
 struct Supervisor {
     devices: Vec<(Device, tokio::sync::Mutex<DeviceEnd>)>,
-    /// FEEDER_MONITOR's ear, under the arbiter's policy.
+    /// The feeder zone's keeper's ear: FEEDER_MONITOR's or FEEDER_COORDINATOR's.
     line_down: Option<tokio::sync::Mutex<LineDownEnd>>,
     runs: LineRuns,
 }
@@ -633,15 +638,17 @@ impl Supervisor {
                 Ok((device, tokio::sync::Mutex::new(end)))
             })
             .collect::<Result<_, RunError>>()?;
+        // The feeder zone's keeper's ear.
         let line_down = match policy {
-            FeederPolicy::Arbiter => Some(tokio::sync::Mutex::new(
-                ports
-                    .line_down
-                    .user_named(LINE_SUPERVISOR)
-                    .map_err(|error| refused("world", error))?,
-            )),
-            FeederPolicy::Appendix | FeederPolicy::Coordinator => None,
+            FeederPolicy::Arbiter => Some(&ports.line_down),
+            FeederPolicy::Coordinator => Some(&ports.coordinator_down),
+            FeederPolicy::Appendix => None,
         };
+        let line_down = line_down
+            .map(|port| port.user_named(LINE_SUPERVISOR))
+            .transpose()
+            .map_err(|error| refused("world", error))?
+            .map(tokio::sync::Mutex::new);
         Ok(Self {
             devices: ends,
             line_down,
@@ -652,7 +659,7 @@ impl Supervisor {
     /// Makes `line`, whose process died, safe for its `next` run: WORLD takes no call of the
     /// dead run from now on, and the call each device was carrying out for it is let end;
     /// the chip robot is driven home; the pallets the line's stations hold are scrapped;
-    /// then FEEDER_MONITOR is told. Returns how many pallets were scrapped.
+    /// then the feeder zone's keeper is told. Returns how many pallets were scrapped.
     async fn take_over(&self, line: Line, next: u32, sim: &Sim) -> Result<usize, RunError> {
         self.runs[line.index()].store(next, Ordering::Release);
         // A call of the dead run's that a device took before the store is carried out to
@@ -760,8 +767,8 @@ impl Said {
         RunError::Processes {
             process,
             why: format!(
-                "{why} (a line is started again under the arbiter's policy only, not under \
-                 --feeder {})",
+                "{why} (a line is started again under the arbiter's or the coordinator's \
+                 policy, not under --feeder {})",
                 policy.name()
             ),
         }

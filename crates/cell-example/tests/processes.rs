@@ -44,9 +44,15 @@ fn alive(pid: u32) -> bool {
     })
 }
 
+/// Kills `pid` with SIGKILL, and waits until it has died: `kill` returns once the signal
+/// is sent, before the process is gone.
 fn kill_9(pid: u32) {
     let killed = Command::new("kill").args(["-9", &pid.to_string()]).status();
     assert!(killed.is_ok_and(|status| status.success()), "kill -9 {pid}");
+    assert!(
+        within(Duration::from_secs(5), || !alive(pid)),
+        "{pid} outlived SIGKILL"
+    );
 }
 
 /// Waits (polling, bounded) until `condition` holds; whether it did.
@@ -373,6 +379,37 @@ fn a_line_killed_mid_run_is_started_again_and_the_other_goes_on() {
     line_a_came_back(&report, "process died");
     assert_eq!(report.matches("outage: ").count(), 1, "{report}");
     assert!(report.contains("[ok] no pallet lost"), "{report}");
+}
+
+#[test]
+fn under_the_coordinator_a_line_killed_is_started_again_and_the_other_goes_on() {
+    // What the dead line's chip robot held or asked for of the coordinator is let go: the
+    // other line's reservations are granted on, and the next run's too.
+    let world = World::start(&["--feeder", "coordinator", "--hours", "0.1", "--speed", "20"]);
+    world.lines();
+    let line_b = line_process(world.pid(), "B").unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    kill_9(line_process(world.pid(), "A").unwrap());
+    std::thread::sleep(Duration::from_secs(8));
+    assert_eq!(
+        line_process(world.pid(), "B"),
+        Some(line_b),
+        "line B stopped"
+    );
+    let report = world.report(Duration::from_secs(120));
+    line_a_came_back(&report, "process died");
+    assert!(report.contains("timeouts: none"), "{report}");
+    assert!(report.contains("[ok] no pallet lost"), "{report}");
+    assert!(
+        report.contains("[ok] no two arms touching (rapier)"),
+        "{report}"
+    );
+    for (requests, refused) in zone_requests(&report) {
+        assert!(
+            requests > 0 && refused == 0,
+            "{requests}/{refused}\n{report}"
+        );
+    }
 }
 
 #[test]

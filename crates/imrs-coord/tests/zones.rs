@@ -349,21 +349,23 @@ fn a_geometric_deadlock_is_resolved_by_an_alternative_trajectory() {
     assert_eq!(detour(&path, radius, &[on_goal], margin, 0.6), None);
 }
 
+/// An arm from (0, 0) reaching straight out to x = 0.7 at height `y`.
+fn reach(y: f32) -> imrs_coord::zones::Sweep {
+    (0..=5)
+        .map(|i| {
+            let x = 0.7 * i as f32 / 5.0;
+            [[0.0, y], [x / 2.0, y], [x, y]]
+        })
+        .collect()
+}
+
 /// Zones that follow the trajectories: sweeps that keep clear are held at once, one that
 /// meets a held sweep waits for its release, and a later request never jumps an earlier
 /// one it would block.
 #[test]
 fn reservations_grant_sweeps_that_keep_clear_and_queue_the_others() {
-    use imrs_coord::zones::{Reservations, Sweep};
+    use imrs_coord::zones::Reservations;
     // An arm from (0, 0) reaching straight out to x = 0.7 at height y.
-    let reach = |y: f32| -> Sweep {
-        (0..=5)
-            .map(|i| {
-                let x = 0.7 * i as f32 / 5.0;
-                [[0.0, y], [x / 2.0, y], [x, y]]
-            })
-            .collect()
-    };
     let mut space = Reservations::new(0.035, 0.03);
     assert!(space.request("ARM_A", &reach(0.0)));
     assert!(space.request("ARM_B", &reach(0.2)), "20 cm apart: clear");
@@ -377,6 +379,27 @@ fn reservations_grant_sweeps_that_keep_clear_and_queue_the_others() {
     assert_eq!(space.release("ARM_A"), ["ARM_C"]);
     assert_eq!(space.release("ARM_C"), ["ARM_D"]);
     assert_eq!(space.holders(), ["ARM_D"]);
+}
+
+/// A robot that is gone lets go of what it held and of what it asked for: a request of its
+/// that waited is never granted, and those behind it are.
+#[test]
+fn a_withdrawn_robot_leaves_no_reservation_held_or_waiting() {
+    use imrs_coord::zones::Reservations;
+    let mut space = Reservations::new(0.035, 0.03);
+    assert!(space.request("ARM_A", &reach(0.0)));
+    assert!(
+        !space.request("ARM_B", &reach(0.05)),
+        "5 cm from A's: waits"
+    );
+    assert!(!space.request("ARM_C", &reach(0.1)), "behind B's request");
+    // B is gone while it waits: C, clear of A, is granted at once.
+    assert_eq!(space.withdraw("ARM_B"), ["ARM_C"]);
+    // A is gone while it holds: nothing waits.
+    assert_eq!(space.withdraw("ARM_A"), Vec::<imrs_ports::Name>::new());
+    assert_eq!(space.holders(), ["ARM_C"]);
+    // B, back, is granted where A was.
+    assert!(space.request("ARM_B", &reach(0.0)));
 }
 
 /// Two cycles at once: one whose victim was woken and is on its way to ask again (not

@@ -79,6 +79,13 @@ impl Reservations {
         granted
     }
 
+    /// `robot` is gone (its process died): what it held and what it asked for are let go
+    /// alike; returns the waiting robots granted now, in turn.
+    pub fn withdraw(&mut self, robot: &str) -> Vec<Name> {
+        self.waiting.retain(|(waiter, _)| *waiter != robot);
+        self.release(robot)
+    }
+
     /// Who holds a reservation now.
     pub fn holders(&self) -> Vec<Name> {
         self.held.iter().map(|(robot, _)| robot.clone()).collect()
