@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use imrs_coord::zones::Reservations;
 use imrs_core::prelude::*;
-use imrs_ports::{End, ReplyHandle, select, usage, when};
+use imrs_ports::{End, QueryError, ReplyHandle, select, usage, when};
 use imrs_sim::layout::LINK_RADIUS;
 use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station, Target};
 
@@ -161,9 +161,16 @@ impl Access {
         let asked = ctx.now();
         let ok = match self {
             // QUERY SHARE_FEEDER.CRIT_SECTION(OK)
-            Access::Appendix(share_feeder) => {
-                matches!(ctx.query(share_feeder, ()).await, Ok(clear) if clear != 0)
-            }
+            Access::Appendix(share_feeder) => match ctx.query(share_feeder, ()).await {
+                Ok(clear) => clear != 0,
+                // The twin's process died (across processes): no permission until its next
+                // run answers. Asked again in a second, not at once.
+                Err(QueryError::PeerGone { .. } | QueryError::NoResponse { .. }) => {
+                    ctx.delay(Duration::from_secs(1)).await;
+                    false
+                }
+                Err(_) => false,
+            },
             Access::Arbiter { request, asker, .. } => ctx.send(request, *asker).await.is_ok(),
             // The coordinator is asked per step, with the step's trajectory: see `reserve`.
             Access::Coordinator { .. } => return true,

@@ -38,10 +38,9 @@
 //! and tells the feeder zone's keeper on LINE_DOWN: FEEDER_MONITOR then frees the zone if
 //! the dead line held it, FEEDER_COORDINATOR lets go of what the dead line's chip robot held
 //! or asked for, and neither heeds a word of the dead run (see [`crate::zone_asker`]). The
-//! report shows each outage: when, how long, and the pallets scrapped. The Appendix's
-//! policy is not supervised so: there the lines ask each other, with no keeper between
-//! them, and the survivor would wait on its dead twin's SHARE_FEEDER; a line that dies
-//! under it fails the run, by name.
+//! report shows each outage: when, how long, and the pallets scrapped. Under the
+//! Appendix's policy, with no keeper between the lines, the dead line's twin has no
+//! permission to enter the zone until the next run answers its queries.
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -508,9 +507,6 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
                 }));
             }
             Said::Ended(_) | Said::Failed(_) if !ended => {
-                if config.feeder == FeederPolicy::Appendix {
-                    return Err(said.refusal_restartless(line, config.feeder));
-                }
                 if runs[i] >= RESTARTS {
                     return Err(refused(
                         process_name(line),
@@ -756,22 +752,6 @@ impl Said {
             Said::Unseen => format!("was cut off before it sent {expected}"),
         };
         refused(process_name(line), why)
-    }
-
-    /// Why a line that died before the end fails the run under `policy`, which the world
-    /// does not restart a line under.
-    fn refusal_restartless(self, line: Line, policy: FeederPolicy) -> RunError {
-        let RunError::Processes { process, why } = self.refusal(line, "its figures") else {
-            unreachable!("a refusal is a process's")
-        };
-        RunError::Processes {
-            process,
-            why: format!(
-                "{why} (a line is started again under the arbiter's or the coordinator's \
-                 policy, not under --feeder {})",
-                policy.name()
-            ),
-        }
     }
 }
 
