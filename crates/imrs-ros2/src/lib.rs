@@ -34,15 +34,24 @@
 // The declaration macros name `serde` through this crate, by its name, here too.
 extern crate self as imrs_ros2;
 
+mod attachment;
+mod bridge;
 mod description;
+mod error;
 mod field;
+pub mod graph;
 mod message;
 pub mod msgs;
+mod node;
 mod service;
 
+pub use attachment::Attachment;
+pub use bridge::Bridge;
 pub use description::{Field, FieldType, TypeDescription, TypeHash};
+pub use error::Ros2Error;
 pub use field::{RosElement, RosField};
 pub use message::RosMessage;
+pub use node::{Node, Publisher, ServiceServer};
 pub use service::RosService;
 
 // What the declaration macros use.

@@ -97,5 +97,5 @@ pub use error::ZenohError;
 pub use export::{Export, Exported, export};
 pub use host::{Host, HostBuilder};
 pub use import::{Import, Imported, import};
-pub use message::{MAX_MESSAGE, Message};
+pub use message::{MAX_MESSAGE, Message, decode, encode};
 pub use user_watch::UserWatch;

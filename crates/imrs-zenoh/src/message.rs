@@ -24,8 +24,9 @@ impl<T: Serialize + DeserializeOwned + Send + 'static> Message for T {}
 const CDR_LE: [u8; 4] = [0, 1, 0, 0];
 const CDR_BE: [u8; 4] = [0, 0, 0, 0];
 
-/// `message` in CDR, for `port`.
-pub(crate) fn encode<T: Serialize>(port: &str, message: &T) -> Result<Vec<u8>, ZenohError> {
+/// `message` in CDR, as a port writes it; `port` (what it is a message of) is named in an
+/// error. Encodings built on this transport use it too (ROS 2's, in `imrs-ros2`).
+pub fn encode<T: Serialize>(port: &str, message: &T) -> Result<Vec<u8>, ZenohError> {
     let body =
         cdr_encoding::to_vec::<_, LittleEndian>(message).map_err(|error| ZenohError::Encoding {
             port: port.to_owned(),
@@ -42,7 +43,7 @@ pub(crate) fn encode<T: Serialize>(port: &str, message: &T) -> Result<Vec<u8>, Z
 ///
 /// Read in place: a length a peer wrote is checked against the bytes that are there before
 /// anything is made of it, so a message claiming more than it carries allocates nothing.
-pub(crate) fn decode<T: DeserializeOwned>(port: &str, bytes: &[u8]) -> Result<T, ZenohError> {
+pub fn decode<T: DeserializeOwned>(port: &str, bytes: &[u8]) -> Result<T, ZenohError> {
     let refused = |reason: String| ZenohError::Encoding {
         port: port.to_owned(),
         reason,
