@@ -68,7 +68,7 @@ def main():
     for _ in range(100):
         tokens = graph(session)
         kinds = {token[5] for token in tokens}
-        if {"NN", "MP", "SS"} <= kinds:
+        if {"NN", "MP"} <= kinds and any(t[9:10] == ["%status"] for t in tokens):
             break
         time.sleep(0.1)
     else:
@@ -76,7 +76,7 @@ def main():
     node = next(t for t in tokens if t[5] == "NN")
     print(f"node {node[7].replace('%', '/')}{node[8]}")
     publisher = next(t for t in tokens if t[5] == "MP")
-    server = next(t for t in tokens if t[5] == "SS")
+    server = next(t for t in tokens if t[5] == "SS" and t[9] == "%status")
     for token in (publisher, server):
         assert token[2] == node[2] and token[3] == node[3], "an endpoint of another node"
         print(f"{token[5]} {token[9].replace('%', '/')} {token[10]} {token[11]}")

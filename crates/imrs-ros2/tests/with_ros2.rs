@@ -1,36 +1,40 @@
-//! A client that is not ours — Python's `eclipse-zenoh`, written only from `rmw_zenoh`'s
-//! conventions — sees the cell in the ROS 2 graph, receives its joint states from a
-//! `SENDALL` port published as a topic, and calls a `RESPONSE` port served as a service.
+//! Clients that are not ours see the cell in the ROS 2 graph, receive its joint states from
+//! a `SENDALL` port published as a topic, and call a `RESPONSE` port served as a service:
+//! a Python client written only from `rmw_zenoh`'s conventions, on `eclipse-zenoh`, and
+//! `zenoh-ros2-sdk`, a ROS 2 client on those conventions from PyPI that computes the type
+//! hashes and keys itself.
 
 use std::net::TcpListener;
 use std::process::Command;
 use std::time::Duration;
 
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
-use imrs_ros2::Node;
 use imrs_ros2::graph::NodeName;
 use imrs_ros2::msgs::sensor_msgs::JointState;
 use imrs_ros2::msgs::std_msgs::Header;
 use imrs_ros2::msgs::std_srvs::{Trigger, TriggerRequest, TriggerResponse};
+use imrs_ros2::{Bridge, Node, ros_message, ros_service};
 use imrs_zenoh::Host;
 
-/// The Python package the test drives, at the version of the zenoh crate.
-const CLIENT: &str = "eclipse-zenoh==1.10.2";
+/// The Python packages the tests drive: zenoh at the version of the zenoh crate, and the
+/// ROS 2 client on it.
+const ZENOH: &str = "eclipse-zenoh==1.10.2";
+const ROS2_CLIENT: &str = "zenoh-ros2-sdk==0.1.8";
 
-/// Python 3 with `zenoh` importable, installed with pip where it is missing.
-fn python_with_zenoh() -> &'static str {
-    let has_zenoh = || {
+/// Python 3 with `module` importable, `package` installed with pip where it is missing.
+fn python_with(module: &str, package: &str) -> &'static str {
+    let importable = || {
         Command::new("python3")
-            .args(["-c", "import zenoh"])
+            .args(["-c", &format!("import {module}")])
             .status()
             .is_ok_and(|status| status.success())
     };
-    if !has_zenoh() {
+    if !importable() {
         let installed = Command::new("python3")
-            .args(["-m", "pip", "install", "--quiet", CLIENT])
+            .args(["-m", "pip", "install", "--quiet", package])
             .status()
             .expect("python3 runs");
-        assert!(installed.success(), "pip could not install {CLIENT}");
+        assert!(installed.success(), "pip could not install {package}");
     }
     "python3"
 }
@@ -40,12 +44,43 @@ fn free_endpoint() -> String {
     format!("tcp/{}", listener.local_addr().expect("its address"))
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_ros_2_client_lists_the_cell_receives_its_joints_and_calls_its_status() {
-    let python = python_with_zenoh();
-    let endpoint = free_endpoint();
+/// What the cell holds while a client looks at it.
+struct RosCell {
+    _host: Host,
+    _node: Node,
+    _bridges: [Bridge; 3],
+}
+
+ros_message! {
+    /// `example_interfaces/srv/AddTwoInts`'s request, declared here as a cell declares its own.
+    struct AddTwoIntsRequest = "example_interfaces/srv/AddTwoInts_Request" {
+        a: i64,
+        b: i64,
+    }
+}
+
+ros_message! {
+    /// Its response.
+    struct AddTwoIntsResponse = "example_interfaces/srv/AddTwoInts_Response" {
+        sum: i64,
+    }
+}
+
+ros_service! {
+    /// `example_interfaces/srv/AddTwoInts`: its hash computed here from these declarations.
+    service AddTwoInts = "example_interfaces/srv/AddTwoInts" {
+        request: AddTwoIntsRequest,
+        response: AddTwoIntsResponse,
+    }
+}
+
+/// A cell on `endpoint` with node /chip_cell: CHIP_IT's joints broadcast at 50 Hz on a
+/// SENDALL port published as /joint_states, and the cell's status, a RESPONSE port answered
+/// at CELL's order, served as /status (std_srvs/Trigger); and /add_two_ints, a service of
+/// the cell's own declaring.
+async fn ros_cell(endpoint: &str) -> RosCell {
     let host = Host::builder("ros_cell")
-        .listen(&endpoint)
+        .listen(endpoint)
         .open()
         .await
         .unwrap();
@@ -56,7 +91,7 @@ async fn a_ros_2_client_lists_the_cell_receives_its_joints_and_calls_its_status(
     // A robot's joints, broadcast on a SENDALL port, published as /joint_states.
     let joints: Port<JointState, (), usage::SendAll, AnyUser, 1> =
         Port::new(PortSpec::new("JOINTS", "CHIP_IT"));
-    let _joint_states = node
+    let joint_states = node
         .publish_port(&joints, "ROS2", "joint_states")
         .await
         .unwrap();
@@ -93,16 +128,40 @@ async fn a_ros_2_client_lists_the_cell_receives_its_joints_and_calls_its_status(
         })
         .unwrap();
     tokio::spawn(async move { while handler.serve(&12).await.is_ok() {} });
-    let _status = node
+    let served = node
         .serve_port::<Trigger, _, 1>(&status, "ROS2", "status")
         .await
         .unwrap();
+    // A service of the cell's own declaring, its hash computed from its fields.
+    let adding: Port<AddTwoIntsRequest, AddTwoIntsResponse, usage::Response, AnyUser, 1> =
+        Port::new(PortSpec::new("ADD", "CALCULATOR"));
+    let mut calculator = adding
+        .answer("CALCULATOR", |(): &(), asked: AddTwoIntsRequest| {
+            AddTwoIntsResponse {
+                sum: asked.a + asked.b,
+            }
+        })
+        .unwrap();
+    tokio::spawn(async move { while calculator.serve(&()).await.is_ok() {} });
+    let add = node
+        .serve_port::<AddTwoInts, _, 1>(&adding, "ROS2", "add_two_ints")
+        .await
+        .unwrap();
+    RosCell {
+        _host: host,
+        _node: node,
+        _bridges: [joint_states, served, add],
+    }
+}
 
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ros2_client.py");
-    let client = tokio::process::Command::new(python)
-        .args([script, &endpoint])
+/// Runs `script` with `args` to its end (60 s at most): what it printed, once it succeeded.
+async fn client(python: &str, script: &str, args: &[&str]) -> String {
+    let script = format!("{}/tests/{script}", env!("CARGO_MANIFEST_DIR"));
+    let run = tokio::process::Command::new(python)
+        .arg(script)
+        .args(args)
         .output();
-    let output = tokio::time::timeout(Duration::from_secs(60), client)
+    let output = tokio::time::timeout(Duration::from_secs(60), run)
         .await
         .expect("the Python client ended")
         .unwrap();
@@ -111,6 +170,15 @@ async fn a_ros_2_client_lists_the_cell_receives_its_joints_and_calls_its_status(
         String::from_utf8_lossy(&output.stderr),
     );
     assert!(output.status.success(), "{stdout}\n{stderr}");
+    stdout.into_owned()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_on_rmw_zenohs_conventions_lists_the_cell_receives_its_joints_and_calls_it() {
+    let python = python_with("zenoh", ZENOH);
+    let endpoint = free_endpoint();
+    let _cell = ros_cell(&endpoint).await;
+    let stdout = client(python, "ros2_client.py", &[&endpoint]).await;
     let said: Vec<&str> = stdout.lines().collect();
     assert_eq!(said[0], "node /chip_cell", "{stdout}");
     assert_eq!(
@@ -130,4 +198,25 @@ async fn a_ros_2_client_lists_the_cell_receives_its_joints_and_calls_its_status(
         "{stdout}"
     );
     assert_eq!(said[4], "status True 12 pallets done", "{stdout}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn zenoh_ros2_sdk_lists_the_cell_receives_its_joints_and_calls_its_status() {
+    let python = python_with("zenoh_ros2_sdk", ROS2_CLIENT);
+    let endpoint = free_endpoint();
+    let _cell = ros_cell(&endpoint).await;
+    let messages = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ros2_msgs");
+    let stdout = client(python, "ros2_sdk_client.py", &[&endpoint, messages]).await;
+    let said: Vec<&str> = stdout.lines().collect();
+    assert_eq!(
+        said,
+        [
+            "topic /joint_states ['sensor_msgs/msg/JointState']",
+            "service /status ['std_srvs/srv/Trigger']",
+            "joint_states chip_it_base ['shoulder', 'elbow']",
+            "status True 12 pallets done",
+            "add_two_ints 2 + 40 = 42",
+        ],
+        "{stdout}"
+    );
 }
