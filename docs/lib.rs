@@ -27,6 +27,10 @@ pub mod across_processes {}
 #[doc = include_str!("across-hosts.md")]
 pub mod across_hosts {}
 
+/// ROS 2 over rmw_zenoh.
+#[doc = include_str!("with-ros2.md")]
+pub mod with_ros2 {}
+
 /// Recordings, Foxglove and the timeline.
 #[doc = include_str!("recording.md")]
 pub mod recording {}

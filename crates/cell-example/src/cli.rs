@@ -53,6 +53,12 @@ struct Flags {
     /// How long the timeline's window is, in simulated seconds.
     #[arg(long, value_name = "SECONDS", default_value_t = 300.0, value_parser = seconds, allow_negative_numbers = true)]
     timeline_span: f64,
+    /// Be seen from ROS 2 (rmw_zenoh) as node /chip_cell: the robots' joints on
+    /// /joint_states, the alarms on /alarms, and the status service /status
+    /// (std_srvs/Trigger). A zenoh peer listening on ENDPOINT, where ROS 2 nodes connect
+    /// (rmw_zenoh's default router is tcp/localhost:7447). Runs on the wall clock.
+    #[arg(long, value_name = "ENDPOINT", conflicts_with = "processes")]
+    ros2: Option<String>,
     /// Show no progress bar (it is shown only on a terminal anyway).
     #[arg(long)]
     no_progress: bool,
@@ -187,6 +193,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         speed: flags.speed,
         transport: flags.transport,
         line_process,
+        ros2: flags.ros2,
         ..CellConfig::default()
     })
 }

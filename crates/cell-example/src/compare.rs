@@ -31,7 +31,7 @@ pub struct Comparison {
 
 /// Runs `config` under every policy of [`POLICIES`] at once. The run under `config`'s own
 /// policy is `config` as it is; the others only make their report: no progress bar,
-/// recording or timeline. Not for a run across processes ([`CellConfig::processes`]), which
+/// recording, timeline or ROS 2 node. Not for a run across processes ([`CellConfig::processes`]), which
 /// needs the machine's cores to itself: [`run`] it alone.
 pub fn compare(config: &CellConfig) -> Comparison {
     if let Some(refused) = refused(config).or_else(|| unwritable_record(config)) {
@@ -49,6 +49,7 @@ pub fn compare(config: &CellConfig) -> Comparison {
                 progress: false,
                 record: None,
                 timeline: None,
+                ros2: None,
                 ..config.clone()
             }
         }

@@ -31,6 +31,7 @@ pub mod ports;
 pub mod processes;
 pub mod report;
 pub mod reservation;
+pub mod ros2;
 pub mod run;
 pub mod tally;
 pub mod zone_asker;

@@ -24,6 +24,7 @@ use crate::load::{load_card, load_it, screw_in_card};
 use crate::outage::Outage;
 use crate::ports::CellPorts;
 use crate::processes::{self, DEFAULT_SPEED, LineProcess, Transport};
+use crate::ros2;
 use crate::tally::Tally;
 
 /// How a run is made.
@@ -59,6 +60,9 @@ pub struct CellConfig {
     pub transport: Transport,
     /// Set in a line's process, which the world started.
     pub line_process: Option<LineProcess>,
+    /// Be seen from ROS 2, a zenoh peer listening on this endpoint (see [`crate::ros2`]);
+    /// on the wall clock.
+    pub ros2: Option<String>,
 }
 
 /// Where to draw a timeline, and of which window of the run.
@@ -89,6 +93,7 @@ impl Default for CellConfig {
             speed: DEFAULT_SPEED,
             transport: Transport::Ipc,
             line_process: None,
+            ros2: None,
         }
     }
 }
@@ -156,6 +161,8 @@ pub enum RunError {
         /// What went wrong.
         why: String,
     },
+    /// The cell could not be made visible to ROS 2 (`--ros2`): why.
+    Ros2(String),
     /// A fault is set for after the run's end, so it would never fire.
     FaultAfterEnd {
         /// The fault, as `--fault` writes it.
@@ -179,6 +186,7 @@ impl std::fmt::Display for RunError {
                 write!(f, "{}: cannot be written: {error}", path.display())
             }
             Self::Processes { process, why } => write!(f, "across processes, {process}: {why}"),
+            Self::Ros2(why) => write!(f, "--ros2: {why}"),
             Self::FaultAfterEnd { fault, hours } => write!(
                 f,
                 "--fault {fault}: set for after the run's end ({hours} h), so it would never fire; \
@@ -235,7 +243,8 @@ pub fn run(config: &CellConfig) -> Result<RunRecord, RunError> {
         return processes::run_world(config);
     }
     let wall = std::time::Instant::now();
-    let mut record = if config.realtime {
+    // ROS 2 sees the cell live: on the wall clock.
+    let mut record = if config.realtime || config.ros2.is_some() {
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .enable_all()
             .build()
@@ -320,6 +329,10 @@ async fn simulate(
     cell.check(&declarations)?;
 
     sim.spawn();
+    let _ros2 = match &config.ros2 {
+        Some(endpoint) => Some(ros2::serve(endpoint, &sim, &cell, Arc::clone(&tally)).await?),
+        None => None,
+    };
     match config.feeder {
         FeederPolicy::Arbiter => {
             cell.start(feeder_monitor(&ports))?;

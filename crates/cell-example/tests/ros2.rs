@@ -1,0 +1,101 @@
+//! `chip_cell --ros2`: a ROS 2 user sees the cell live. zenoh-ros2-sdk (PyPI, a ROS 2 client
+//! on `rmw_zenoh`'s conventions, not ours) lists the cell's topics and service, reads the
+//! robots' joints, receives the alarm a robot fault raises, and asks the status.
+
+use std::net::TcpListener;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+use cell_example::alarms::AlarmKind;
+
+/// The example binary, built beside this test by `cargo test`.
+fn chip_cell() -> PathBuf {
+    let test = std::env::current_exe().unwrap();
+    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
+    profile_dir.join("examples").join("chip_cell")
+}
+
+/// Python 3 with zenoh-ros2-sdk, installed with pip where it is missing.
+fn python_with_ros2_client() -> &'static str {
+    let importable = || {
+        Command::new("python3")
+            .args(["-c", "import zenoh_ros2_sdk"])
+            .status()
+            .is_ok_and(|status| status.success())
+    };
+    if !importable() {
+        let installed = Command::new("python3")
+            .args(["-m", "pip", "install", "--quiet", "zenoh-ros2-sdk==0.1.8"])
+            .status()
+            .expect("python3 runs");
+        assert!(installed.success(), "pip could not install zenoh-ros2-sdk");
+    }
+    "python3"
+}
+
+#[test]
+fn a_ros_2_client_lists_the_cell_reads_its_joints_and_alarms_and_asks_its_status() {
+    let python = python_with_ros2_client();
+    let endpoint = {
+        let listener = TcpListener::bind("127.0.0.1:0").expect("a free port on loopback");
+        format!("tcp/{}", listener.local_addr().expect("its address"))
+    };
+    // Twenty seconds on the wall clock, line A's RELEASE dying at 10 s: an alarm.
+    let cell = Command::new(chip_cell())
+        .args([
+            "--ros2",
+            &endpoint,
+            "--hours",
+            "0.0056",
+            "--fault",
+            "release:A@10s",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the example is built with the tests");
+    let messages = concat!(env!("CARGO_MANIFEST_DIR"), "/../imrs-ros2/tests/ros2_msgs");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/ros2_view.py");
+    // Ended by `timeout` if it hangs: a test never waits for ever.
+    let viewer = Command::new("timeout")
+        .args(["60", python, script, &endpoint, messages])
+        .output()
+        .expect("the client runs");
+    let ended = cell.wait_with_output().expect("the cell ends");
+    let (said, why) = (
+        String::from_utf8_lossy(&viewer.stdout),
+        String::from_utf8_lossy(&viewer.stderr),
+    );
+    let report = String::from_utf8_lossy(&ended.stdout);
+    assert!(
+        viewer.status.success(),
+        "{said}\n{why}\nthe cell's report:\n{report}"
+    );
+    assert!(
+        ended.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ended.stderr)
+    );
+    let said: Vec<&str> = said.lines().collect();
+    assert_eq!(said[0], "topic /alarms ['std_msgs/msg/String']");
+    assert_eq!(
+        said[1],
+        "topic /joint_states ['sensor_msgs/msg/JointState']"
+    );
+    assert_eq!(said[2], "service /status ['std_srvs/srv/Trigger']");
+    // Three robots on each line, a shoulder and an elbow each.
+    assert_eq!(
+        said[3],
+        "joints 12 ['chip_robot_a_elbow', 'chip_robot_a_shoulder']"
+    );
+    // "MODULE: [kind] what", as a module raised it.
+    let alarm = said[4].strip_prefix("alarm ").unwrap();
+    let (module, message) = alarm.split_once(": ").unwrap();
+    assert!(!module.is_empty(), "{alarm}");
+    assert!(AlarmKind::of(message).is_some(), "{alarm}");
+    assert!(
+        said[5].starts_with("status True pallets completed: line A "),
+        "{}",
+        said[5]
+    );
+}
