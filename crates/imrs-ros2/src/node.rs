@@ -49,8 +49,13 @@ impl Node {
         &self.name
     }
 
+    /// The host it is on.
+    pub(crate) fn host(&self) -> &Host {
+        &self.host
+    }
+
     /// An endpoint's name, key, token and GID.
-    fn endpoint(
+    pub(crate) fn endpoint(
         &self,
         kind: EntityKind,
         name: &str,
@@ -143,17 +148,21 @@ impl Node {
 }
 
 /// One endpoint of a node.
-struct Endpoint {
+pub(crate) struct Endpoint {
     /// Its fully qualified name.
-    name: String,
+    pub(crate) name: String,
     /// The key expression of its data.
-    key: String,
+    pub(crate) key: String,
     /// Its liveliness token.
-    token: String,
-    gid: [u8; 16],
+    pub(crate) token: String,
+    pub(crate) gid: [u8; 16],
 }
 
-async fn declare_token(host: &Host, key: &str, what: &str) -> Result<LivelinessToken, Ros2Error> {
+pub(crate) async fn declare_token(
+    host: &Host,
+    key: &str,
+    what: &str,
+) -> Result<LivelinessToken, Ros2Error> {
     host.session()
         .liveliness()
         .declare_token(key.to_owned())

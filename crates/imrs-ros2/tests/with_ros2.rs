@@ -11,7 +11,7 @@ use std::time::Duration;
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
 use imrs_ros2::graph::NodeName;
 use imrs_ros2::msgs::sensor_msgs::JointState;
-use imrs_ros2::msgs::std_msgs::Header;
+use imrs_ros2::msgs::std_msgs::{self, Header};
 use imrs_ros2::msgs::std_srvs::{Trigger, TriggerRequest, TriggerResponse};
 use imrs_ros2::{Bridge, Node, ros_message, ros_service};
 use imrs_zenoh::Host;
@@ -219,4 +219,67 @@ async fn zenoh_ros2_sdk_lists_the_cell_receives_its_joints_and_calls_its_status(
         ],
         "{stdout}"
     );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_module_hears_a_ros_2_topic_and_calls_a_ros_2_service_through_its_ports() {
+    let python = python_with("zenoh", ZENOH);
+    let endpoint = free_endpoint();
+    let host = Host::builder("ros_peer_cell")
+        .listen(endpoint.as_str())
+        .open()
+        .await
+        .unwrap();
+    let node = Node::new(&host, NodeName::new(0, "/", "chip_cell").unwrap())
+        .await
+        .unwrap();
+    // OPERATOR_DESK receives /commands on a port of its own.
+    let commands: Port<std_msgs::String, (), usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("COMMANDS", "OPERATOR_DESK"));
+    let _commands = node
+        .subscribe_port(&commands, "ROS2", "commands")
+        .await
+        .unwrap();
+    let mut desk = commands.owner().unwrap();
+    // CALCULATOR calls /add_two_ints by sending on ADDER, which the bridge owns.
+    let adder: Port<AddTwoIntsRequest, AddTwoIntsResponse, usage::Receive, AnyUser, 1> =
+        Port::new(PortSpec::new("ADDER", "ROS2"));
+    let _adder = node
+        .call_port::<AddTwoInts, _, 1>(&adder, "add_two_ints")
+        .await
+        .unwrap();
+    let mut calculator = adder.user_named("CALCULATOR").unwrap();
+
+    let script = format!("{}/tests/ros2_peer.py", env!("CARGO_MANIFEST_DIR"));
+    let mut peer = tokio::process::Command::new(python)
+        .args([script.as_str(), endpoint.as_str()])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .kill_on_drop(true)
+        .spawn()
+        .unwrap();
+    let (command, reply) = tokio::time::timeout(Duration::from_secs(30), desk.receive())
+        .await
+        .expect("a command within 30 s")
+        .unwrap();
+    reply.reply(());
+    assert!(command.data.starts_with("start "), "{command:?}");
+    let sum = tokio::time::timeout(
+        Duration::from_secs(30),
+        calculator.send(AddTwoIntsRequest { a: 2, b: 40 }),
+    )
+    .await
+    .expect("an answer within 30 s");
+    assert_eq!(sum.map(|response| response.sum).ok(), Some(42));
+
+    // The peer is gone: a call has no server, and its sender's wait ends.
+    drop(peer.stdin.take());
+    peer.wait().await.unwrap();
+    let unanswered = tokio::time::timeout(
+        Duration::from_secs(30),
+        calculator.send(AddTwoIntsRequest { a: 1, b: 1 }),
+    )
+    .await
+    .expect("the call ends");
+    assert!(unanswered.is_err(), "{:?}", unanswered.map(|r| r.sum));
 }
