@@ -44,6 +44,19 @@ fn free_endpoint() -> String {
     format!("tcp/{}", listener.local_addr().expect("its address"))
 }
 
+/// A host listening on `endpoint`, with node /chip_cell on it.
+async fn chip_cell_node(endpoint: &str) -> (Host, Node) {
+    let host = Host::builder("ros_cell")
+        .listen(endpoint)
+        .open()
+        .await
+        .unwrap();
+    let node = Node::new(&host, NodeName::new(0, "/", "chip_cell").unwrap())
+        .await
+        .unwrap();
+    (host, node)
+}
+
 /// What the cell holds while a client looks at it.
 struct RosCell {
     _host: Host,
@@ -79,14 +92,7 @@ ros_service! {
 /// at CELL's order, served as /status (std_srvs/Trigger); and /add_two_ints, a service of
 /// the cell's own declaring.
 async fn ros_cell(endpoint: &str) -> RosCell {
-    let host = Host::builder("ros_cell")
-        .listen(endpoint)
-        .open()
-        .await
-        .unwrap();
-    let node = Node::new(&host, NodeName::new(0, "/", "chip_cell").unwrap())
-        .await
-        .unwrap();
+    let (host, node) = chip_cell_node(endpoint).await;
 
     // A robot's joints, broadcast on a SENDALL port, published as /joint_states.
     let joints: Port<JointState, (), usage::SendAll, AnyUser, 1> =
@@ -225,14 +231,7 @@ async fn zenoh_ros2_sdk_lists_the_cell_receives_its_joints_and_calls_its_status(
 async fn a_module_hears_a_ros_2_topic_and_calls_a_ros_2_service_through_its_ports() {
     let python = python_with("zenoh", ZENOH);
     let endpoint = free_endpoint();
-    let host = Host::builder("ros_peer_cell")
-        .listen(endpoint.as_str())
-        .open()
-        .await
-        .unwrap();
-    let node = Node::new(&host, NodeName::new(0, "/", "chip_cell").unwrap())
-        .await
-        .unwrap();
+    let (_host, node) = chip_cell_node(&endpoint).await;
     // OPERATOR_DESK receives /commands on a port of its own.
     let commands: Port<std_msgs::String, (), usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("COMMANDS", "OPERATOR_DESK"));
