@@ -16,7 +16,7 @@ fuzz_target!(|header: &[u8]| {
     if let Some(Some(module)) = request_module(header) {
         assert!(module.len() <= 64);
         match port.claim(&module) {
-            Ok(()) => assert_eq!(module, "ROBOT_1"),
+            Ok(_) => assert_eq!(module, "ROBOT_1"),
             Err(refused) => {
                 assert!(refused.to_string().contains("DOUBLE"), "{refused}");
                 if !["DOUBLE", "OWNER", "ROBOT_1"].contains(&module.as_str()) {

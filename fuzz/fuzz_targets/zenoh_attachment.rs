@@ -15,7 +15,7 @@ fn claimed(name: &str) {
     let port: Port<u64, u64, usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("DOUBLE", "OWNER").user_list(["ROBOT_1"]));
     match port.claim(name) {
-        Ok(()) => assert_eq!(name, "ROBOT_1"),
+        Ok(_) => assert_eq!(name, "ROBOT_1"),
         Err(refused) => {
             assert!(refused.to_string().contains("DOUBLE"), "{refused}");
             if !["DOUBLE", "OWNER", "ROBOT_1"].contains(&name) {

@@ -8,7 +8,7 @@
 //! `SENDALL` ports, STATUS a `RESPONSE` port answered by CELL_STATUS.
 
 use std::sync::{Arc, Mutex, PoisonError};
-use std::time::Duration;
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use imrs_core::EventKind;
 use imrs_core::prelude::*;
@@ -143,14 +143,17 @@ pub async fn serve(
 }
 
 /// Every arm's shoulder and elbow, from its links as rapier places them: the shoulder
-/// turned as the first link, the elbow as the second against the first.
+/// turned as the first link, the elbow as the second against the first. Stamped with the
+/// wall clock, as ROS 2 stamps (the cell runs on it under `--ros2`).
 fn joint_state(scene: &Scene) -> JointState {
-    let since = scene.at.since_start();
+    let now = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap_or_default();
     let mut state = JointState {
         header: Header {
             stamp: Time {
-                sec: i32::try_from(since.as_secs()).unwrap_or(i32::MAX),
-                nanosec: since.subsec_nanos(),
+                sec: i32::try_from(now.as_secs()).unwrap_or(i32::MAX),
+                nanosec: now.subsec_nanos(),
             },
             frame_id: "cell".into(),
         },

@@ -165,8 +165,14 @@ impl Node {
         let token = declare_token(self.host(), &endpoint.token, &endpoint.name).await?;
         let task = tokio::spawn(async move {
             while let Some(message) = hearing.recv().await {
-                if let Err(error) = sender.send(message).await {
-                    tracing::warn!(%error, "a message of a ROS 2 topic was not taken");
+                match sender.send(message).await {
+                    Ok(()) => {}
+                    // The owner was late for this one: the next may be taken.
+                    Err(error) if error.is_timeout() => {
+                        tracing::warn!(%error, "a message of a ROS 2 topic was not taken");
+                    }
+                    // The port's owner is gone for good: nothing more is taken.
+                    Err(_) => break,
                 }
             }
         });

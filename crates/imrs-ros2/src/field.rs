@@ -6,7 +6,7 @@ use crate::{Field, FieldType};
 
 /// A Rust type a field of a ROS 2 message can have: a primitive, `String`, a message
 /// declared with [`ros_message!`](crate::ros_message), a `Vec` of one of those (an unbounded
-/// sequence) or an array of one (a fixed-size array).
+/// sequence) or an array of one (a fixed-size array, of at most 32, as far as `serde` goes).
 #[diagnostic::on_unimplemented(
     message = "`{Self}` has no ROS 2 type",
     label = "not a type a ROS 2 field can have",

@@ -28,8 +28,8 @@
 //! assert!(PalletSeen::type_hash().to_string().starts_with("RIHS01_"));
 //! ```
 //!
-//! A name that is not `package/msg/Name` fails when the hash is first computed, naming the
-//! type; field types that ROS 2 has no name for do not compile (see [`RosField`]).
+//! A name that is not `package/msg/Name`, and a field of a type ROS 2 has no name for (see
+//! [`RosField`]), do not compile.
 
 // The declaration macros name `serde` through this crate, by its name, here too.
 extern crate self as imrs_ros2;

@@ -75,6 +75,14 @@ pub(crate) fn dds_type_name(type_name: &str) -> String {
 /// }
 /// ```
 ///
+/// Nor does a message without fields (ROS 2 gives it one `uint8`, which must be declared):
+///
+/// ```compile_fail
+/// imrs_ros2::ros_message! {
+///     pub struct Empty = "cell_msgs/msg/Empty" {}
+/// }
+/// ```
+///
 /// Nor does a field of a type ROS 2 has no name for:
 ///
 /// ```compile_fail,E0277
@@ -88,6 +96,17 @@ pub(crate) fn dds_type_name(type_name: &str) -> String {
 macro_rules! ros_message {
     (@default) => { ::std::default::Default::default() };
     (@default $default:expr) => { $default };
+    // ROS 2 gives a message without fields one `uint8`, which CDR carries: say it.
+    (
+        $(#[$meta:meta])*
+        $vis:vis struct $name:ident = $ros_name:literal {}
+    ) => {
+        compile_error!(concat!(
+            $ros_name,
+            " has no fields: ROS 2 gives such a message one, as it must be declared here too: \
+             `pub structure_needs_at_least_one_member: u8`"
+        ));
+    };
     (
         $(#[$meta:meta])*
         $vis:vis struct $name:ident = $ros_name:literal {

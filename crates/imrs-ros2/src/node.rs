@@ -127,15 +127,16 @@ impl Node {
         )?;
         let runtime = tokio::runtime::Handle::current();
         let handler = Arc::new(handler);
-        let name = endpoint.name.clone();
+        let (name, key) = (endpoint.name.clone(), endpoint.key.clone());
         let queryable = self
             .host
             .session()
             .declare_queryable(endpoint.key.clone())
             .complete(true)
             .callback(move |query| {
-                let (handler, name) = (Arc::clone(&handler), name.clone());
-                runtime.spawn(async move { answer::<S, _, _>(&query, &name, &*handler).await });
+                let (handler, name, key) = (Arc::clone(&handler), name.clone(), key.clone());
+                runtime
+                    .spawn(async move { answer::<S, _, _>(&query, &name, &key, &*handler).await });
             })
             .await
             .map_err(|error| Ros2Error::zenoh(&endpoint.name, error))?;
@@ -170,9 +171,10 @@ pub(crate) async fn declare_token(
         .map_err(|error| Ros2Error::zenoh(what, error))
 }
 
-/// Answers one request of service `name`: the response with the request's sequence
-/// number and its client's GID, as `rmw_zenoh`'s client matches them.
-async fn answer<S, F, Fut>(query: &Query, name: &str, handler: &F)
+/// Answers one request of service `name`: the response, on the service's own `key` as
+/// `rmw_zenoh` replies, with the request's sequence number and its client's GID, as
+/// `rmw_zenoh`'s client matches them.
+async fn answer<S, F, Fut>(query: &Query, name: &str, key: &str, handler: &F)
 where
     S: RosService,
     F: Fn(S::Request) -> Fut,
@@ -201,7 +203,7 @@ where
         Ok(bytes) => {
             let attachment = Attachment::now(asked.sequence_number, asked.source_gid);
             query
-                .reply(query.key_expr().clone(), bytes)
+                .reply(key.to_owned(), bytes)
                 .attachment(attachment.to_bytes().to_vec())
                 .await
         }

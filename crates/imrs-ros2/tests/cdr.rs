@@ -1,24 +1,20 @@
-//! The messages' `serde` shape gives the CDR bytes ROS 2 writes: the payloads below were
-//! written by an independent CDR implementation (pycdr2) from the same ROS 2 definitions.
-//! imrs-zenoh writes a message as the encapsulation header, then this body.
+//! The messages, written and read as the ports write and read them (`imrs_zenoh::encode`
+//! and `decode`), are the CDR ROS 2 writes: the payloads below were written by an
+//! independent CDR implementation (pycdr2) from the same ROS 2 definitions.
 
-use byteorder::LittleEndian;
 use imrs_ros2::RosMessage;
 use imrs_ros2::msgs::builtin_interfaces::Time;
 use imrs_ros2::msgs::sensor_msgs::JointState;
 use imrs_ros2::msgs::std_msgs::{self, Header};
 use imrs_ros2::msgs::std_srvs::{TriggerRequest, TriggerResponse};
 
-/// `message` as a ROS 2 payload: little-endian plain CDR after its header.
-fn payload<M: RosMessage>(message: &M) -> Vec<u8> {
-    let mut bytes = vec![0, 1, 0, 0];
-    bytes.extend(cdr_encoding::to_vec::<_, LittleEndian>(message).unwrap());
-    bytes
-}
-
 fn round_trip<M: RosMessage + PartialEq + std::fmt::Debug>(message: &M, bytes: &[u8]) {
-    assert_eq!(payload(message), bytes, "{message:?}");
-    let (back, _) = cdr_encoding::from_bytes::<M, LittleEndian>(&bytes[4..]).unwrap();
+    assert_eq!(
+        imrs_zenoh::encode("TOPIC", message).unwrap(),
+        bytes,
+        "{message:?}"
+    );
+    let back: M = imrs_zenoh::decode("TOPIC", bytes).unwrap();
     assert_eq!(&back, message);
 }
 
