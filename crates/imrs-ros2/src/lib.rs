@@ -51,7 +51,7 @@ pub use description::{Field, FieldType, TypeDescription, TypeHash};
 pub use error::Ros2Error;
 pub use field::{RosElement, RosField};
 pub use message::RosMessage;
-pub use node::{Node, Publisher, ServiceServer};
+pub use node::{MOST_WAITING, Node, Publisher, ServiceServer};
 pub use service::RosService;
 
 // What the declaration macros use.

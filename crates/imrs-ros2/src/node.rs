@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 
 use imrs_zenoh::Host;
+use tokio::sync::Semaphore;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Publisher as ZenohPublisher;
 use zenoh::query::{Query, Queryable};
@@ -14,6 +15,10 @@ use zenoh::query::{Query, Queryable};
 use crate::attachment::Attachment;
 use crate::graph::{EntityKind, NodeName, Qos};
 use crate::{Ros2Error, RosMessage, RosService, TypeHash};
+
+/// How many requests of one service wait for their answers at most; past them a request
+/// is refused at once, so that a flood of requests grows nothing.
+pub const MOST_WAITING: usize = 16;
 
 /// Node and entity ids: unique within a zenoh session, as `rmw_zenoh` makes them (one
 /// counter for the context); unique within the process here, which is as good.
@@ -107,7 +112,8 @@ impl Node {
     /// A server of service `service` of type `S`: `handler` answers each request, in a
     /// task of the runtime this is called in, with a response or why there is none (sent
     /// as an error reply). A request that is not an `S::Request` is answered with an error
-    /// reply that says so.
+    /// reply that says so; past [`MOST_WAITING`] requests waiting, a request is refused
+    /// at once.
     pub async fn service<S, F, Fut>(
         &self,
         service: &str,
@@ -127,6 +133,7 @@ impl Node {
         )?;
         let runtime = tokio::runtime::Handle::current();
         let handler = Arc::new(handler);
+        let room = Arc::new(Semaphore::new(MOST_WAITING));
         let (name, key) = (endpoint.name.clone(), endpoint.key.clone());
         let queryable = self
             .host
@@ -135,8 +142,16 @@ impl Node {
             .complete(true)
             .callback(move |query| {
                 let (handler, name, key) = (Arc::clone(&handler), name.clone(), key.clone());
-                runtime
-                    .spawn(async move { answer::<S, _, _>(&query, &name, &key, &*handler).await });
+                match Arc::clone(&room).try_acquire_owned() {
+                    Ok(place) => runtime.spawn(async move {
+                        answer::<S, _, _>(&query, &name, &key, &*handler).await;
+                        drop(place);
+                    }),
+                    Err(_) => runtime.spawn(async move {
+                        let why = format!("{name}: {MOST_WAITING} requests wait already");
+                        refuse(&query, why).await;
+                    }),
+                };
             })
             .await
             .map_err(|error| Ros2Error::zenoh(&endpoint.name, error))?;

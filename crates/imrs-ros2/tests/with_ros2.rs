@@ -282,3 +282,69 @@ async fn a_module_hears_a_ros_2_topic_and_calls_a_ros_2_service_through_its_port
     .expect("the call ends");
     assert!(unanswered.is_err(), "{:?}", unanswered.map(|r| r.sum));
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_flood_of_requests_is_refused_past_the_room_and_grows_nothing() {
+    let endpoint = free_endpoint();
+    let (host, node) = chip_cell_node(&endpoint).await;
+    // A status nobody answers yet: every request waits.
+    let status: Port<TriggerRequest, TriggerResponse, usage::Response, AnyUser, 1> =
+        Port::new(PortSpec::new("STATUS", "CELL"));
+    let _handler = status
+        .answer("CELL", |(): &(), _: TriggerRequest| {
+            TriggerResponse::default()
+        })
+        .unwrap();
+    let _status = node
+        .serve_port::<Trigger, _, 1>(&status, "ROS2", "status")
+        .await
+        .unwrap();
+    let flooder = Host::builder("ros_cell")
+        .connect(endpoint.as_str())
+        .open()
+        .await
+        .unwrap();
+    let key = format!(
+        "0/status/{}/{}",
+        <Trigger as imrs_ros2::RosService>::dds_type_name(),
+        <Trigger as imrs_ros2::RosService>::type_hash()
+    );
+    let request = imrs_zenoh::encode("status", &TriggerRequest::default()).unwrap();
+    let mut asked = Vec::new();
+    for n in 0..100 {
+        let attachment = imrs_ros2::Attachment::now(n + 1, [9; 16])
+            .to_bytes()
+            .to_vec();
+        let replies = flooder
+            .session()
+            .get(key.as_str())
+            .payload(request.clone())
+            .attachment(attachment)
+            .timeout(Duration::from_secs(5))
+            .await
+            .unwrap();
+        asked.push(replies);
+    }
+    // A refusal comes at once; a request that waits ends with zenoh's 5 s timeout.
+    let refusal = format!("/status: {} requests wait already", imrs_ros2::MOST_WAITING);
+    let (mut refused, mut waited) = (0, 0);
+    for replies in &asked {
+        let reply = replies.recv_async().await.unwrap();
+        let why = reply
+            .result()
+            .unwrap_err()
+            .payload()
+            .to_bytes()
+            .into_owned();
+        match String::from_utf8(why).unwrap() {
+            why if why == refusal => refused += 1,
+            why if why == "Timeout" => waited += 1,
+            why => panic!("{why}"),
+        }
+    }
+    assert_eq!(
+        (refused, waited),
+        (100 - imrs_ros2::MOST_WAITING, imrs_ros2::MOST_WAITING)
+    );
+    drop(host);
+}
