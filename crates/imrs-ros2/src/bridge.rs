@@ -3,8 +3,9 @@
 //! topic's messages sent to a module's `RECEIVE` port, and a module's sends on a port of
 //! its own made calls of a ROS 2 service. The bridge is a user of the
 //! port like any module, under a name of its own, so the port's user list, number of users
-//! and TIMEOUT hold for it, and the dead-peer rule: a port whose owner is gone ends its
-//! topic, and a service whose handler is gone answers with an error that names the port.
+//! and TIMEOUT hold for it, and the dead-peer rule: a port closed for good ends its topic
+//! (a restarted owner is waited for), and a service whose handler is gone answers with an
+//! error that names the port.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicI64, Ordering};
@@ -13,13 +14,12 @@ use std::time::Duration;
 use imrs_ports::{Port, UserList, usage};
 use tokio::sync::Mutex;
 use tokio::task::JoinHandle;
-use zenoh::liveliness::LivelinessToken;
 use zenoh::query::{ConsolidationMode, QueryTarget};
 
 use crate::attachment::Attachment;
 use crate::graph::{EntityKind, Qos};
 use crate::node::declare_token;
-use crate::{Node, Publisher, Ros2Error, RosMessage, RosService, ServiceServer};
+use crate::{Node, Publisher, Ros2Error, RosMessage, RosService};
 
 /// How many messages of a subscribed topic wait for the module at most (the depth the
 /// subscription's token says); more are dropped, newest first.
@@ -32,9 +32,17 @@ const CALL_PATIENCE: Duration = Duration::from_secs(10);
 /// A port bridged to ROS 2: bridged while it lives.
 pub struct Bridge {
     task: Option<JoinHandle<()>>,
-    _server: Option<ServiceServer>,
-    _token: Option<LivelinessToken>,
-    _subscriber: Option<zenoh::pubsub::Subscriber<()>>,
+    /// What keeps its endpoint in zenoh and the graph: a server, a token, a subscriber.
+    _keep: Box<dyn Send + Sync>,
+}
+
+impl Bridge {
+    fn new(task: Option<JoinHandle<()>>, keep: impl Send + Sync + 'static) -> Self {
+        Self {
+            task,
+            _keep: Box::new(keep),
+        }
+    }
 }
 
 impl Drop for Bridge {
@@ -64,7 +72,7 @@ impl Node {
             .map_err(|error| Ros2Error::wiring(port.name(), error))?;
         let publisher: Publisher<M> = self.publisher(topic).await?;
         let task = tokio::spawn(async move {
-            // Until the port's owner is gone for good: then nothing more comes.
+            // Until the port is closed for good: then nothing more comes.
             while let Ok((message, heard)) = listener.receive().await {
                 heard.reply(());
                 if let Err(error) = publisher.publish(&message).await {
@@ -72,12 +80,7 @@ impl Node {
                 }
             }
         });
-        Ok(Bridge {
-            task: Some(task),
-            _server: None,
-            _token: None,
-            _subscriber: None,
-        })
+        Ok(Bridge::new(Some(task), ()))
     }
 
     /// Serves ROS 2 service `service` with the response handler of `RESPONSE` port
@@ -113,12 +116,7 @@ impl Node {
                 }
             })
             .await?;
-        Ok(Bridge {
-            task: None,
-            _server: Some(server),
-            _token: None,
-            _subscriber: None,
-        })
+        Ok(Bridge::new(None, server))
     }
 
     /// Sends each message of ROS 2 topic `topic` on `RECEIVE` port `port`, as module
@@ -171,17 +169,12 @@ impl Node {
                     Err(error) if error.is_timeout() => {
                         tracing::warn!(%error, "a message of a ROS 2 topic was not taken");
                     }
-                    // The port's owner is gone for good: nothing more is taken.
+                    // The port is closed for good: nothing more is taken.
                     Err(_) => break,
                 }
             }
         });
-        Ok(Bridge {
-            task: Some(task),
-            _server: None,
-            _token: Some(token),
-            _subscriber: Some(subscriber),
-        })
+        Ok(Bridge::new(Some(task), (token, subscriber)))
     }
 
     /// Calls ROS 2 service `service` for each request a module sends on `port`, whose
@@ -222,12 +215,7 @@ impl Node {
                 }
             }
         });
-        Ok(Bridge {
-            task: Some(task),
-            _server: None,
-            _token: Some(token),
-            _subscriber: None,
-        })
+        Ok(Bridge::new(Some(task), token))
     }
 }
 

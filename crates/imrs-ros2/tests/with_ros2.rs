@@ -348,3 +348,45 @@ async fn a_flood_of_requests_is_refused_past_the_room_and_grows_nothing() {
     );
     drop(host);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_topic_whose_port_is_closed_for_good_leaves_the_graph() {
+    let endpoint = free_endpoint();
+    let (host, node) = chip_cell_node(&endpoint).await;
+    let joints: Port<JointState, (), usage::SendAll, AnyUser, 1> =
+        Port::new(PortSpec::new("JOINTS", "CHIP_IT"));
+    let _topic = node
+        .publish_port(&joints, "ROS2", "joint_states")
+        .await
+        .unwrap();
+    let publishers = || async {
+        let replies = host
+            .session()
+            .liveliness()
+            .get("@ros2_lv/0/**")
+            .await
+            .unwrap();
+        let mut found = 0;
+        while let Ok(reply) = replies.recv_async().await {
+            found += usize::from(
+                reply
+                    .result()
+                    .is_ok_and(|token| token.key_expr().as_str().contains("/MP/")),
+            );
+        }
+        found
+    };
+    let robot = joints.owner().unwrap();
+    assert_eq!(publishers().await, 1);
+    // The port is closed for good: its owner's end and every handle to it dropped (while
+    // a handle is left, a restarted owner may attach again, and the topic waits for it).
+    drop(robot);
+    drop(joints);
+    let gone = tokio::time::timeout(Duration::from_secs(30), async {
+        while publishers().await > 0 {
+            tokio::task::yield_now().await;
+        }
+    })
+    .await;
+    assert!(gone.is_ok(), "the topic stayed in the graph");
+}
