@@ -99,10 +99,17 @@ pub struct Cell {
 impl Cell {
     /// A cell on `clock`.
     pub fn new(clock: SharedClock) -> Self {
-        Self {
-            shared: Arc::new(CellShared::new(clock)),
-        }
+        let shared = Arc::new(CellShared::new(clock));
+        // On virtual time, at once; on another clock, once a runtime runs the first module.
+        crate::watchdog::watch(&shared);
+        Self { shared }
     }
+
+    /// How long a deadlock cycle may stand before it is named, on a clock other than a
+    /// virtual one (on virtual time it is named at the instant it closed, before the clock
+    /// moves on): a [`EventKind::Deadlock`](crate::EventKind::Deadlock) event, from the wait
+    /// that closed it. A send or a query answered without waiting is never looked at.
+    pub const DEADLOCK_BOUND: std::time::Duration = crate::watchdog::BOUND;
 
     /// A cell on a new virtual clock, and that clock, to drive it.
     pub fn virtual_clock() -> (Self, VirtualClock) {

@@ -1,256 +1,295 @@
-//! Deadlock diagnosis: a graph of which module waits on which, through which port.
+//! Deadlock diagnosis, off the message path: which module waits on which, through which
+//! port, found once a wait has lasted.
 //!
-//! When a task starts a send, a query or a waitfor, its module waits on the modules at the
-//! other end. If that closes a cycle — every module in it waiting on the next — the cycle is
-//! reported by module and port names. It is a diagnosis, checked when a wait begins: the
-//! cycle may still be broken, by a timeout or by a handler whose rank lets it run.
+//! A send or a query that has to wait notes its port and peer in its thread's
+//! [`WaitRecord`](crate::wait_record::WaitRecord), which no other module writes; a rendezvous
+//! that completes at once notes nothing. The graph is built only when waits have lasted:
+//! on virtual time, each time the clock is about to move (every task that could run at this
+//! instant has run, so the cycle is stamped with the instant it closed); on any other clock,
+//! at each tick of the cell's watchdog. A cycle — every module in it waiting on the next — is
+//! reported once by module and port names, from the wait that closed it (the last to begin).
+//! It is a diagnosis: the cycle may still be broken, by a timeout or by a handler whose rank
+//! lets it run.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hash, Hasher};
+use std::cmp::Reverse;
+use std::collections::HashSet;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::Name;
 
-/// One wait of a module, or a free entry kept for the next (`id` 0; `port` then names the
-/// last wait's port and means nothing), so that a module's waits in steady state allocate
-/// nothing: `on` keeps its capacity.
-#[derive(Debug)]
-struct Wait {
-    id: u64,
+use crate::module::thread::Thread;
+use crate::wait_record::Wait;
+
+/// The threads of a module's running copy, for the diagnosis to read their waits.
+#[derive(Debug, Default)]
+pub(crate) struct ModuleThreads(Mutex<Vec<Arc<Thread>>>);
+
+impl ModuleThreads {
+    pub(crate) fn add(&self, thread: &Arc<Thread>) {
+        self.lock().push(Arc::clone(thread));
+    }
+
+    pub(crate) fn remove(&self, thread: &Arc<Thread>) {
+        self.lock().retain(|known| !Arc::ptr_eq(known, thread));
+    }
+
+    /// The copy has ended: none of its threads waits any more.
+    pub(crate) fn clear(&self) {
+        self.lock().clear();
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Vec<Arc<Thread>>> {
+        // One push, retain, clear or read: never left half-done.
+        self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// A cycle found: the module and task whose wait closed it, and the cycle as
+/// `(module, port)` steps starting there.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Found {
+    pub(crate) module: Name,
+    pub(crate) task: Name,
+    pub(crate) cycle: Vec<(Name, Name)>,
+}
+
+/// One wait in progress, as the graph sees it.
+struct LiveWait {
+    module: Name,
+    task: Name,
     port: Name,
     on: Vec<Name>,
+    seq: u64,
+    /// The thread and wait number: the wait's identity while it lasts.
+    key: (usize, u64),
 }
 
-impl Wait {
-    fn is_live(&self) -> bool {
-        self.id != 0
-    }
-}
-
-/// A module's name as the graph's key: hashed by address, which interned names make unique
-/// per text, so that a lookup neither reads nor hashes the text (a cell of a thousand
-/// modules looks up two or three of them per message). The map is never iterated, so its
-/// order, which varies from run to run, shows nowhere.
-#[derive(Debug, Clone, PartialEq, Eq)]
-struct Key(Name);
-
-impl Hash for Key {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        state.write_usize(self.0.as_str().as_ptr() as usize);
-    }
-}
-
-/// Spreads an address over the hash's bits (Fibonacci hashing): addresses differ mostly in
-/// their middle bits, which the table's low bits must see.
-#[derive(Default)]
-struct AddressHasher(u64);
-
-impl Hasher for AddressHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &byte in bytes {
-            self.0 = (self.0.rotate_left(8) ^ u64::from(byte)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        }
-    }
-
-    fn write_usize(&mut self, n: usize) {
-        self.0 = (n as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
+/// The state the diagnosis keeps between two looks.
 #[derive(Debug, Default)]
-pub(crate) struct WaitGraph {
-    next_id: u64,
-    /// Each module's waits, live and free. A module's entry stays until the module ends
-    /// ([`WaitGraph::forget`]), so that a wait allocates only when a module has more waits
-    /// at once than it ever had.
-    waits: HashMap<Key, Vec<Wait>, BuildHasherDefault<AddressHasher>>,
-    /// The path of the search in progress, reused from one search to the next.
-    path: Vec<(Name, Name)>,
+pub(crate) struct Diagnosis {
+    /// The waits that closed a cycle already reported, kept while they last, so that a
+    /// cycle that stands is named once.
+    reported: HashSet<(usize, u64)>,
 }
 
-impl WaitGraph {
-    /// Module `module` starts waiting through `port` on the modules that `peers` puts in the
-    /// list it is given. Returns the wait's id, and the cycle it closes, if any, as
-    /// `(module, port)` pairs starting at `module`.
-    pub(crate) fn begin(
+impl Diagnosis {
+    /// Looks at every wait of `modules` in progress and returns the cycles not reported
+    /// before. `users_of` names the running users of a port, whom its owner's post waits on.
+    pub(crate) fn look<'m>(
         &mut self,
-        module: &Name,
-        port: &Name,
-        peers: impl FnOnce(&mut Vec<Name>),
-    ) -> (u64, Option<Vec<(Name, Name)>>) {
-        self.next_id += 1;
-        let id = self.next_id;
-        let waits = self.waits.entry(Key(module.clone())).or_default();
-        let at = match waits.iter().position(|wait| !wait.is_live()) {
-            Some(free) => free,
-            None => {
-                waits.push(Wait {
-                    id: 0,
-                    port: port.clone(),
-                    on: Vec::new(),
+        modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)>,
+        users_of: impl Fn(&Name) -> &'m [Name],
+    ) -> Vec<Found> {
+        let waits = live_waits(modules, users_of);
+        self.reported
+            .retain(|key| waits.iter().any(|wait| wait.key == *key));
+        let mut newest_first: Vec<usize> = (0..waits.len()).collect();
+        newest_first.sort_by_key(|&index| Reverse(waits[index].seq));
+        let mut found = Vec::new();
+        for index in newest_first {
+            let wait = &waits[index];
+            if self.reported.contains(&wait.key) {
+                continue;
+            }
+            let Some(path) = cycle_from(&waits, index) else {
+                continue;
+            };
+            // A cycle is reported from its newest wait, once.
+            if path.iter().any(|&step| waits[step].seq > wait.seq) {
+                continue;
+            }
+            self.reported.insert(wait.key);
+            found.push(Found {
+                module: wait.module.clone(),
+                task: wait.task.clone(),
+                cycle: path
+                    .iter()
+                    .map(|&step| (waits[step].module.clone(), waits[step].port.clone()))
+                    .collect(),
+            });
+        }
+        found
+    }
+}
+
+fn live_waits<'m>(
+    modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)>,
+    users_of: impl Fn(&Name) -> &'m [Name],
+) -> Vec<LiveWait> {
+    let mut waits = Vec::new();
+    let mut read: Vec<Wait> = Vec::new();
+    for (module, threads) in modules {
+        for thread in threads.lock().iter() {
+            read.clear();
+            thread.waits.live(&mut read);
+            for wait in &read {
+                let Some(port) = Name::from_token(wait.port) else {
+                    continue;
+                };
+                let mut on: Vec<Name> = match wait.peer {
+                    0 => users_of(&port).to_vec(),
+                    peer => Name::from_token(peer).into_iter().collect(),
+                };
+                // A wait on the module's own port is served by another thread of the
+                // module, which keeps running whatever the ranks (the scheduler's
+                // priority-inversion rule).
+                on.retain(|peer| peer != module);
+                if on.is_empty() {
+                    continue;
+                }
+                waits.push(LiveWait {
+                    module: module.clone(),
+                    task: thread.task.clone(),
+                    port,
+                    on,
+                    seq: wait.seq,
+                    key: (Arc::as_ptr(thread) as usize, wait.seq),
                 });
-                waits.len() - 1
-            }
-        };
-        let wait = &mut waits[at];
-        wait.id = id;
-        wait.port = port.clone();
-        peers(&mut wait.on);
-        // A wait on the module's own port is served by another thread of the module, which
-        // keeps running whatever the ranks (the scheduler's priority-inversion rule).
-        wait.on.retain(|peer| peer != module);
-        // A cycle needs a peer that waits itself; in the usual case none does, and the
-        // search (which clones names into its path) is skipped.
-        let waits = &self.waits[&Key(module.clone())];
-        if !waits[at].on.iter().any(|peer| self.is_waiting(peer)) {
-            return (id, None);
-        }
-        let mut path = std::mem::take(&mut self.path);
-        let mut cycle = None;
-        for next in &waits[at].on {
-            path.clear();
-            path.push((module.clone(), port.clone()));
-            if self.path_to(next, module, &mut path) {
-                cycle = Some(path.clone());
-                break;
             }
         }
-        path.clear();
-        self.path = path;
-        (id, cycle)
     }
+    waits
+}
 
-    /// Whether `module` has a wait in progress.
-    fn is_waiting(&self, module: &Name) -> bool {
-        self.waits
-            .get(&Key(module.clone()))
-            .is_some_and(|waits| waits.iter().any(Wait::is_live))
-    }
-
-    /// The wait `id` of `module` has ended.
-    pub(crate) fn end(&mut self, module: &Name, id: u64) {
-        if let Some(wait) = self
-            .waits
-            .get_mut(&Key(module.clone()))
-            .and_then(|waits| waits.iter_mut().find(|wait| wait.id == id))
-        {
-            wait.id = 0;
-            wait.on.clear();
+/// The waits of a cycle through wait `start`, beginning with it, if one leads back to its
+/// module: depth-first, each module at most once.
+fn cycle_from(waits: &[LiveWait], start: usize) -> Option<Vec<usize>> {
+    let mut path = vec![start];
+    for next in &waits[start].on {
+        if path_to(waits, next, &waits[start].module, &mut path) {
+            return Some(path);
         }
     }
+    None
+}
 
-    /// `module` has ended for good: its entries go.
-    pub(crate) fn forget(&mut self, module: &Name) {
-        let key = Key(module.clone());
-        if self
-            .waits
-            .get(&key)
-            .is_some_and(|waits| !waits.iter().any(Wait::is_live))
-        {
-            self.waits.remove(&key);
-        }
+/// Does a chain of waits lead from module `from` to `target`? Extends `path` with the waits
+/// taken when it does.
+fn path_to(waits: &[LiveWait], from: &Name, target: &Name, path: &mut Vec<usize>) -> bool {
+    if from == target {
+        return true;
     }
-
-    /// Depth-first: does a chain of waits lead from `from` to `target`? Extends `path` with
-    /// the steps taken when it does.
-    fn path_to(&self, from: &Name, target: &Name, path: &mut Vec<(Name, Name)>) -> bool {
-        if from == target {
+    if path.iter().any(|&step| &waits[step].module == from) {
+        return false;
+    }
+    for (index, wait) in waits.iter().enumerate() {
+        if &wait.module != from {
+            continue;
+        }
+        path.push(index);
+        if wait
+            .on
+            .iter()
+            .any(|next| path_to(waits, next, target, path))
+        {
             return true;
         }
-        if path.iter().any(|(module, _)| module == from) {
-            return false;
-        }
-        let Some(waits) = self.waits.get(&Key(from.clone())) else {
-            return false;
-        };
-        for wait in waits.iter().filter(|wait| wait.is_live()) {
-            for next in &wait.on {
-                path.push((from.clone(), wait.port.clone()));
-                if self.path_to(next, target, path) {
-                    return true;
-                }
-                path.pop();
-            }
-        }
-        false
+        path.pop();
     }
+    false
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::order::Rank;
+    use crate::wait_record::WaitId;
 
     fn name(text: &str) -> Name {
         text.into()
     }
 
+    /// A module of one thread, waiting as `waits` says: (port, peer).
+    fn module(thread: &str, waits: &[(&str, Option<&str>)]) -> (ModuleThreads, Vec<WaitId>) {
+        let threads = ModuleThreads::default();
+        let thread = Arc::new(Thread::new(name(thread), Rank::from_raw(0)));
+        let ids = waits
+            .iter()
+            .map(|(port, peer)| thread.waits.begin(&name(port), peer.map(name).as_ref()))
+            .collect();
+        threads.add(&thread);
+        (threads, ids)
+    }
+
+    fn look(diagnosis: &mut Diagnosis, modules: &[(Name, &ModuleThreads)]) -> Vec<Found> {
+        diagnosis.look(
+            modules.iter().map(|(module, threads)| (module, *threads)),
+            |_| &[],
+        )
+    }
+
     #[test]
-    fn a_two_module_cycle_is_found_when_it_closes() {
-        let mut graph = WaitGraph::default();
-        let (_, none) = graph.begin(&name("CHIP_IT"), &name("SHARE_FEEDER"), |on| {
-            on.push(name("CHIP_IT2"))
-        });
-        assert_eq!(none, None);
-        let (_, cycle) = graph.begin(&name("CHIP_IT2"), &name("SHARE_FEEDER1"), |on| {
-            on.push(name("CHIP_IT"))
-        });
+    fn a_two_module_cycle_is_named_from_the_wait_that_closed_it_and_only_once() {
+        let (chip_it, _) = module("CHIP_IT", &[("SHARE_FEEDER1", Some("CHIP_IT2"))]);
+        let (chip_it2, _) = module("CHIP_IT2", &[("SHARE_FEEDER", Some("CHIP_IT"))]);
+        let modules = [(name("CHIP_IT"), &chip_it), (name("CHIP_IT2"), &chip_it2)];
+        let mut diagnosis = Diagnosis::default();
+        let found = look(&mut diagnosis, &modules);
         assert_eq!(
-            cycle,
-            Some(vec![
-                (name("CHIP_IT2"), name("SHARE_FEEDER1")),
-                (name("CHIP_IT"), name("SHARE_FEEDER")),
-            ])
+            found,
+            [Found {
+                module: name("CHIP_IT2"),
+                task: name("CHIP_IT2"),
+                cycle: vec![
+                    (name("CHIP_IT2"), name("SHARE_FEEDER")),
+                    (name("CHIP_IT"), name("SHARE_FEEDER1")),
+                ],
+            }]
+        );
+        assert_eq!(
+            look(&mut diagnosis, &modules),
+            [],
+            "a standing cycle is named once"
         );
     }
 
     #[test]
     fn a_wait_on_the_modules_own_port_is_no_cycle() {
-        let mut graph = WaitGraph::default();
-        let (_, cycle) = graph.begin(&name("CHIP_IT"), &name("READY_TO_CHIP"), |on| {
-            on.push(name("CHIP_IT"))
-        });
-        assert_eq!(cycle, None);
+        let (chip_it, _) = module("CHIP_IT", &[("READY_TO_CHIP", Some("CHIP_IT"))]);
+        let modules = [(name("CHIP_IT"), &chip_it)];
+        assert_eq!(look(&mut Diagnosis::default(), &modules), []);
+    }
+
+    #[test]
+    fn a_chain_without_a_cycle_is_not_reported_and_its_closing_is() {
+        let (a, _) = module("A", &[("P", Some("B"))]);
+        let (b, _) = module("B", &[("Q", Some("C"))]);
+        let (c, _) = module("C", &[("R", Some("D"))]);
+        let mut diagnosis = Diagnosis::default();
+        let chain = [(name("A"), &a), (name("B"), &b), (name("C"), &c)];
+        assert_eq!(look(&mut diagnosis, &chain), []);
+        let (d, _) = module("D", &[("S", Some("B"))]);
+        let closed = [
+            (name("A"), &a),
+            (name("B"), &b),
+            (name("C"), &c),
+            (name("D"), &d),
+        ];
+        let found = look(&mut diagnosis, &closed);
+        assert_eq!(found.len(), 1);
+        assert_eq!(found[0].module, name("D"));
+        assert_eq!(found[0].cycle.len(), 3, "{found:?}");
     }
 
     #[test]
     fn an_ended_wait_breaks_the_cycle() {
-        let mut graph = WaitGraph::default();
-        let (first, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
-        graph.end(&name("A"), first);
-        let (_, cycle) = graph.begin(&name("B"), &name("Q"), |on| on.push(name("A")));
-        assert_eq!(cycle, None);
+        let (a, ids) = module("A", &[("P", Some("B"))]);
+        let (b, _) = module("B", &[("Q", Some("A"))]);
+        a.lock()[0].waits.end(ids[0]);
+        let modules = [(name("A"), &a), (name("B"), &b)];
+        assert_eq!(look(&mut Diagnosis::default(), &modules), []);
     }
 
     #[test]
-    fn a_chain_without_a_cycle_is_not_reported() {
-        let mut graph = WaitGraph::default();
-        graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
-        graph.begin(&name("B"), &name("Q"), |on| on.push(name("C")));
-        let (_, cycle) = graph.begin(&name("C"), &name("R"), |on| on.push(name("D")));
-        assert_eq!(cycle, None);
-        let (_, cycle) = graph.begin(&name("D"), &name("S"), |on| on.push(name("B")));
-        assert_eq!(cycle.map(|c| c.len()), Some(3));
-    }
-
-    #[test]
-    fn an_ended_wait_is_reused_and_a_forgotten_module_leaves_nothing() {
-        let mut graph = WaitGraph::default();
-        for _ in 0..3 {
-            let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
-            graph.end(&name("A"), id);
-        }
-        assert_eq!(graph.waits[&Key(name("A"))].len(), 1, "one entry, reused");
-        let (id, _) = graph.begin(&name("A"), &name("P"), |on| on.push(name("B")));
-        graph.forget(&name("A"));
-        assert!(
-            graph.waits.contains_key(&Key(name("A"))),
-            "a live wait is kept"
+    fn an_owners_post_waits_on_the_ports_running_users() {
+        let (owner, _) = module("OWNER", &[("BROADCAST", None)]);
+        let (user, _) = module("USER", &[("BACK", Some("OWNER"))]);
+        let modules = [(name("OWNER"), &owner), (name("USER"), &user)];
+        let users = [name("USER")];
+        let found = Diagnosis::default().look(
+            modules.iter().map(|(module, threads)| (module, *threads)),
+            |port| if port == "BROADCAST" { &users } else { &[] },
         );
-        graph.end(&name("A"), id);
-        graph.forget(&name("A"));
-        assert!(graph.waits.is_empty());
+        assert_eq!(found.len(), 1, "{found:?}");
     }
 }

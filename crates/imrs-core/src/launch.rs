@@ -9,6 +9,7 @@ use imrs_ports::transport::Presence;
 use imrs_ports::{Name, Wiring};
 
 use crate::check::{CellError, CellErrors, check_module};
+use crate::deadlock::ModuleThreads;
 use crate::event::EventKind;
 use crate::kill::KillSwitch;
 use crate::module::ctx::Ctx;
@@ -46,6 +47,8 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
 ) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellErrors> {
     let name = first.name.clone();
     let kill = Arc::new(KillSwitch::default());
+    let threads = Arc::new(ModuleThreads::default());
+    crate::watchdog::watch(&cell);
     {
         // The modules, then the wiring: the order every path that takes both keeps.
         let mut modules = lock(&cell.modules);
@@ -68,6 +71,7 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
             Member {
                 switch: Arc::clone(&kill),
                 placement,
+                threads: Arc::clone(&threads),
             },
         );
     }
@@ -101,7 +105,7 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
                 parent.clone(),
                 Arc::clone(&kill),
                 children.clone(),
-                Arc::clone(&presence),
+                (Arc::clone(&presence), Arc::clone(&threads)),
             );
             let exit = copy.await;
             // The kill that ended this copy is spent; one that comes later is for the next.
@@ -158,7 +162,6 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
             cell.record(&name, EventKind::ModuleRestarted { attempt });
         };
         lock(&cell.modules).remove(&name);
-        cell.waits().forget(&name);
         // Gone for good: whoever waits on a port the module held fails now (PeerGone).
         presence.set_gone();
         report.tell(outcome);

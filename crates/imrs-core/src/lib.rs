@@ -158,7 +158,9 @@ mod shared;
 mod supervision;
 pub mod time;
 mod tree;
+mod wait_record;
 mod waitfor;
+mod watchdog;
 mod work;
 
 pub use cell::{Cell, Declare};

@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use imrs_ports::{Name, SharedClock, Wiring};
 
-use crate::deadlock::WaitGraph;
+use crate::deadlock::{Diagnosis, ModuleThreads};
 use crate::event::{Event, EventKind, EventLog};
 use crate::kill::KillSwitch;
 use crate::outcome::{ModuleOutcome, Outcome};
@@ -20,7 +20,13 @@ pub(crate) struct CellShared {
     /// Whether the primitives that succeed are logged, each saying how long it waited and
     /// carrying the text of the values of the ports that show them.
     pub(crate) observe: AtomicBool,
-    pub(crate) waits: Mutex<WaitGraph>,
+    /// Set by a wait that begins, cleared by the diagnosis that looks at it: while no wait
+    /// has begun since the last look, no new cycle can have closed. Shared with what calls
+    /// the diagnosis (the virtual clock's watcher), which must not keep the cell alive.
+    pub(crate) armed: Arc<AtomicBool>,
+    pub(crate) diagnosis: Mutex<Diagnosis>,
+    /// Whether the diagnosis has been set going (a watcher of the clock, or a watchdog).
+    pub(crate) watched: AtomicBool,
     pub(crate) wiring: Mutex<Wiring>,
     pub(crate) modules: Mutex<Members>,
 }
@@ -85,6 +91,8 @@ impl Members {
 pub(crate) struct Member {
     pub(crate) switch: Arc<KillSwitch>,
     pub(crate) placement: Placement,
+    /// The threads of its running copy, whose waits the deadlock diagnosis reads.
+    pub(crate) threads: Arc<ModuleThreads>,
 }
 
 impl CellShared {
@@ -93,7 +101,9 @@ impl CellShared {
             clock,
             events: EventLog::new(),
             observe: AtomicBool::new(false),
-            waits: Mutex::default(),
+            armed: Arc::default(),
+            diagnosis: Mutex::default(),
+            watched: AtomicBool::new(false),
             wiring: Mutex::default(),
             modules: Mutex::default(),
         }
@@ -115,8 +125,44 @@ impl CellShared {
         self.observe.load(Ordering::Relaxed)
     }
 
-    pub(crate) fn waits(&self) -> MutexGuard<'_, WaitGraph> {
-        lock(&self.waits)
+    /// A wait has begun: the next look of the diagnosis is worth making. A load, and a
+    /// store only for the first wait since the last look.
+    #[inline]
+    pub(crate) fn arm_diagnosis(&self) {
+        if !self.armed.load(Ordering::Relaxed) {
+            self.armed.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Looks for deadlock cycles among the waits in progress, if any wait began since the
+    /// last look, and logs each new one from the wait that closed it.
+    pub(crate) fn diagnose(&self) {
+        if !self.armed.swap(false, Ordering::AcqRel) {
+            return;
+        }
+        let found = {
+            let mut diagnosis = lock(&self.diagnosis);
+            let modules = lock(&self.modules);
+            diagnosis.look(
+                modules
+                    .by_name
+                    .iter()
+                    .map(|(name, member)| (name, &*member.threads)),
+                |port| modules.users_of(port),
+            )
+        };
+        if found.is_empty() || !(self.events.is_wanted() || crate::event::traced()) {
+            return;
+        }
+        let at = self.clock.now();
+        for found in found {
+            self.events.record(Event {
+                at,
+                module: found.module,
+                task: Some(found.task),
+                kind: EventKind::Deadlock { cycle: found.cycle },
+            });
+        }
     }
 
     pub(crate) fn record(&self, module: &Name, kind: EventKind) {

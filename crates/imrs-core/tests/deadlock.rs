@@ -122,3 +122,106 @@ fn the_chip_robots_deadlock_is_reported_and_broken_by_asymmetric_timeouts() {
         assert_eq!(turns, [("CHIP_IT2".to_string(), 3), ("CHIP_IT".to_string(), 5)]);
     });
 }
+
+/// A clock that runs on virtual time but does not say so, as a clock of a user's own would:
+/// the cell then finds cycles with its watchdog, as on the real clock, not at each move.
+#[derive(Debug)]
+struct OwnClock(imrs_ports::VirtualClock);
+
+impl Clock for OwnClock {
+    fn now(&self) -> Instant {
+        self.0.now()
+    }
+
+    fn sleep_until(&self, deadline: Instant) -> imrs_ports::clock::Sleep {
+        self.0.sleep_until(deadline)
+    }
+}
+
+#[test]
+fn on_a_clock_of_its_own_the_watchdog_names_the_cycle_within_its_bound() {
+    paused_runtime().block_on(async {
+        let virtual_time = imrs_ports::VirtualClock::new();
+        let cell = Cell::new(Arc::new(OwnClock(virtual_time.clone())));
+        // No timeouts: nothing breaks this cycle, which closes at 2 s.
+        let share_feeder: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]))
+            .unwrap();
+        let share_feeder1: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT2").user_list(["CHIP_IT"]))
+            .unwrap();
+        let log: Log = Arc::default();
+        let chip_it = chip_robot("CHIP_IT", share_feeder.clone(), &share_feeder1, Arc::clone(&log));
+        let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+        let chip_it = cell.start(chip_it).unwrap();
+        drive(&virtual_time, at(2)).await;
+        let chip_it2 = cell.start(chip_it2).unwrap();
+        drive(&virtual_time, at(10)).await;
+
+        let deadlocks: Vec<_> = cell
+            .events()
+            .snapshot()
+            .into_iter()
+            .filter(|event| matches!(event.kind, EventKind::Deadlock { .. }))
+            .collect();
+        assert_eq!(deadlocks.len(), 1, "a standing cycle is named once: {deadlocks:?}");
+        let found = &deadlocks[0];
+        let closed = at(2);
+        assert!(
+            found.at > closed && found.at <= closed + Cell::DEADLOCK_BOUND,
+            "named at {:?}, the cycle closed at 2 s",
+            found.at
+        );
+        assert_eq!(
+            found.to_string().split_once("] ").map(|(_, rest)| rest),
+            Some("CHIP_IT2/CHIP_IT2: deadlock: CHIP_IT2 -[SHARE_FEEDER1]-> CHIP_IT -[SHARE_FEEDER]-> CHIP_IT2")
+        );
+        assert!(log.lock().unwrap().is_empty(), "neither got its answer");
+        chip_it.stop();
+        chip_it2.stop();
+    });
+}
+
+#[test]
+fn a_cycle_that_closes_later_is_named_at_the_instant_it_closed() {
+    paused_runtime().block_on(async {
+        let (cell, clock) = Cell::virtual_clock();
+        let share_feeder: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]))
+            .unwrap();
+        let share_feeder1: Port<(), i32, usage::Query> = cell
+            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT2").user_list(["CHIP_IT"]))
+            .unwrap();
+        let log: Log = Arc::default();
+        let chip_it = chip_robot(
+            "CHIP_IT",
+            share_feeder.clone(),
+            &share_feeder1,
+            Arc::clone(&log),
+        );
+        let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+        let chip_it = cell.start(chip_it).unwrap();
+        // CHIP_IT waits alone for 7 s: a wait that lasts is no cycle.
+        drive(&clock, at(7)).await;
+        assert!(
+            !cell
+                .events()
+                .snapshot()
+                .iter()
+                .any(|e| matches!(e.kind, EventKind::Deadlock { .. })),
+            "one module waiting is no deadlock"
+        );
+        let chip_it2 = cell.start(chip_it2).unwrap();
+        drive(&clock, at(20)).await;
+        let deadlocks: Vec<_> = cell
+            .events()
+            .snapshot()
+            .into_iter()
+            .filter(|event| matches!(event.kind, EventKind::Deadlock { .. }))
+            .map(|event| (event.at, event.module.clone()))
+            .collect();
+        assert_eq!(deadlocks, [(at(7), Name::from("CHIP_IT2"))]);
+        chip_it.stop();
+        chip_it2.stop();
+    });
+}

@@ -19,7 +19,7 @@
 //! [`Port::claim`]: crate::Port::claim
 
 use std::cmp::Ordering;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::hash::{Hash, Hasher};
 use std::sync::{OnceLock, PoisonError, RwLock};
@@ -32,6 +32,8 @@ pub struct Name(&'static str);
 #[derive(Default)]
 struct Interned {
     names: HashSet<&'static str>,
+    /// The same names by [`Name::token`], for [`Name::from_token`].
+    by_token: HashMap<usize, &'static str>,
     from_peers: usize,
 }
 
@@ -74,6 +76,7 @@ impl Name {
         }
         let kept: &'static str = Box::leak(text.into());
         interned.names.insert(kept);
+        interned.by_token.insert(Self(kept).token(), kept);
         Some(Self(kept))
     }
 
@@ -91,6 +94,26 @@ impl Name {
     /// The name as text.
     pub fn as_str(&self) -> &'static str {
         self.0
+    }
+
+    /// A number that stands for this name, never 0: for a record that must be written with
+    /// one atomic store and read by another thread, such as the port a module's thread
+    /// waits on. [`Name::from_token`] gives the name back. One text, one token, for the
+    /// life of the process.
+    pub fn token(&self) -> usize {
+        // Each name is its own leaked allocation, so its address is its own; an empty
+        // text's dangling address is still not 0.
+        self.0.as_ptr() as usize
+    }
+
+    /// The name whose [`token`](Name::token) is `token`, if any name has it.
+    pub fn from_token(token: usize) -> Option<Self> {
+        interned()
+            .read()
+            .unwrap_or_else(PoisonError::into_inner)
+            .by_token
+            .get(&token)
+            .map(|known| Self(known))
     }
 }
 
@@ -175,6 +198,20 @@ mod tests {
         assert_ne!(a, Name::from("SHARE_FEEDER1"));
         let (a, b) = (Name::from("A"), Name::from("B"));
         assert_eq!(a.cmp(&b), Ordering::Less);
+    }
+
+    #[test]
+    fn a_token_gives_its_name_back() {
+        let name = Name::from("TOKEN_OF_A_PORT");
+        assert_ne!(name.token(), 0);
+        assert_eq!(Name::from_token(name.token()), Some(name.clone()));
+        assert_eq!(
+            Name::from(String::from("TOKEN_OF_A_PORT")).token(),
+            name.token()
+        );
+        assert_ne!(Name::from("TOKEN_OF_ANOTHER").token(), name.token());
+        assert_eq!(Name::from_token(0), None);
+        assert_eq!(Name::from_token(name.token() + 1), None);
     }
 
     #[test]

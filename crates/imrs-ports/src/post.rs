@@ -157,6 +157,13 @@ impl<'a, Req, Rep, O> Posting<'a, Req, Rep, O> {
     pub fn each_peer(&self, visit: impl FnMut(Name)) {
         self.attachment.each_peer(visit);
     }
+
+    /// The module this post waits on: the port's owner, for a user's post; `None` for the
+    /// owner's own post, which whichever user receives first serves. A copy of a name, for
+    /// a record kept while the post waits.
+    pub fn waits_on(&self) -> Option<&Name> {
+        (!self.attachment.is_owner()).then_some(&self.attachment.core.meta.owner)
+    }
 }
 
 impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use std::fmt;
 use std::future::Future;
 use std::pin::Pin;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::task::{Context, Poll};
 use std::time::Duration;
@@ -19,56 +19,14 @@ use imrs_ports::{
 };
 use tracing::Instrument;
 
+use super::thread::Thread;
 use crate::event::{Event, EventKind, Observed, Primitive};
 use crate::exception::Exception;
 use crate::order::{Order, Rank, Section};
 use crate::shared::{CellShared, Children};
+use crate::wait_record::{WaitId, WaitRecord};
 use crate::waitfor::{Pool, WaitFor, WaitForError};
 use crate::work::{Performed, WorkSchedule};
-
-/// The section a thread of a module is in, as a rank, and whether it is a *named* section
-/// (one the order ranks, such as `GRASP`): read by the module's scheduler at every
-/// suspension point.
-#[derive(Debug)]
-pub(crate) struct SectionCell(AtomicU32);
-
-/// The bit of a [`SectionCell`] that marks a named section; ranks use the bits below it.
-const NAMED: u32 = 1 << 31;
-
-impl SectionCell {
-    /// A thread in background code or a handler at `rank`: no named section.
-    pub(crate) fn new(rank: Rank) -> Self {
-        Self(AtomicU32::new(rank.position()))
-    }
-
-    pub(crate) fn get(&self) -> Rank {
-        Rank::from_raw(self.0.load(Ordering::Relaxed) & !NAMED)
-    }
-
-    /// The rank of the named section the thread is in, if it is in one.
-    pub(crate) fn named(&self) -> Option<Rank> {
-        let raw = self.0.load(Ordering::Relaxed);
-        (raw & NAMED != 0).then(|| Rank::from_raw(raw & !NAMED))
-    }
-
-    /// Enters a section: a named one at `rank`, or (`None`) one the order does not name,
-    /// which keeps the rank of the code around it. Returns what to restore on leaving.
-    fn enter(&self, rank: Option<Rank>) -> u32 {
-        match rank {
-            Some(rank) => self.0.swap(rank.position() | NAMED, Ordering::Relaxed),
-            None => self.0.load(Ordering::Relaxed),
-        }
-    }
-
-    fn restore(&self, raw: u32) {
-        self.0.store(raw, Ordering::Relaxed);
-    }
-
-    /// Back to background code (or a handler) at `rank`.
-    pub(crate) fn set(&self, rank: Rank) {
-        self.0.store(rank.position(), Ordering::Relaxed);
-    }
-}
 
 /// What a module's tasks and handlers share.
 pub(crate) struct ModuleShared<S> {
@@ -185,27 +143,22 @@ fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
 /// A task's (or handler's) view of its module. Cheap to clone.
 pub struct Ctx<S> {
     module: Arc<ModuleShared<S>>,
-    task: Name,
-    section: Arc<SectionCell>,
+    /// The thread: its name, section and waits.
+    thread: Arc<Thread>,
 }
 
 impl<S> Clone for Ctx<S> {
     fn clone(&self) -> Self {
         Self {
             module: Arc::clone(&self.module),
-            task: self.task.clone(),
-            section: Arc::clone(&self.section),
+            thread: Arc::clone(&self.thread),
         }
     }
 }
 
 impl<S: Send + Sync + 'static> Ctx<S> {
-    pub(crate) fn new(module: Arc<ModuleShared<S>>, task: Name, section: Arc<SectionCell>) -> Self {
-        Self {
-            module,
-            task,
-            section,
-        }
+    pub(crate) fn new(module: Arc<ModuleShared<S>>, thread: Arc<Thread>) -> Self {
+        Self { module, thread }
     }
 
     /// The module's name.
@@ -220,7 +173,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
 
     /// The task's (or handler's) name.
     pub fn task(&self) -> &Name {
-        &self.task
+        &self.thread.task
     }
 
     /// The module's state: change it with `update`, read it with `read`.
@@ -288,7 +241,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         U::Complement: Plain,
         L: UserList,
     {
-        port.user_named(self.task.clone())
+        port.user_named(self.thread.task.clone())
     }
 
     /// The cell's clock.
@@ -342,9 +295,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&message)));
         let started = Started {
-            peers: Some(|posting: &Posting<'a, Req, Rep, SendOutcome>, on| {
-                posting.each_peer(|peer| on.push(peer));
-            }),
+            waits_on: Some(Posting::waits_on),
             watch,
             primitive: Primitive::Send,
             show: ShowReply(shown.map(|shown| shown.reply)),
@@ -366,7 +317,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |_| None);
         let started = Started {
-            peers: None,
+            waits_on: None,
             watch,
             primitive: Primitive::Receive,
             show: ShowRequest(shown.map(|shown| shown.request)),
@@ -389,9 +340,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&query)));
         let started = Started {
-            peers: Some(|posting: &Posting<'a, Req, Rep, QueryOutcome>, on| {
-                posting.each_peer(|peer| on.push(peer));
-            }),
+            waits_on: Some(Posting::waits_on),
             watch,
             primitive: Primitive::Query,
             show: ShowReply(shown.map(|shown| shown.reply)),
@@ -441,7 +390,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     {
         let since = self.observing().then(|| self.now());
         let result = barrier
-            .waitfor(self.task.as_str(), message, combine, timeout)
+            .waitfor(self.thread.task.as_str(), message, combine, timeout)
             .await;
         match &result {
             // Logged, as every primitive that succeeds, only while the cell observes.
@@ -509,7 +458,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     pub fn raise(&self, name: impl Into<Name>, detail: impl Into<String>) {
         self.module.raise(Exception {
             name: name.into(),
-            task: Some(self.task.clone()),
+            task: Some(self.thread.task.clone()),
             detail: detail.into(),
         });
     }
@@ -539,7 +488,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     }
 
     pub(crate) fn event(&self, kind: EventKind) {
-        self.module.event(Some(&self.task), kind);
+        self.module.event(Some(&self.thread.task), kind);
     }
 
     fn port_failed(
@@ -559,22 +508,19 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         if timed_out {
             self.module.raise(Exception {
                 name: Exception::timeout_of(port.as_str()),
-                task: Some(self.task.clone()),
+                task: Some(self.thread.task.clone()),
                 detail: error,
             });
         }
     }
 
-    fn wait_on(&self, port: &Name, peers: impl FnOnce(&mut Vec<Name>)) -> WaitGuard<'_> {
-        let cell = &self.module.cell;
-        let (id, cycle) = cell.waits().begin(&self.module.name, port, peers);
-        if let Some(cycle) = cycle {
-            self.event(EventKind::Deadlock { cycle });
-        }
+    /// Notes, in this thread's record, a wait on `port` served by `peer` (or by any of the
+    /// port's users): the deadlock diagnosis reads it only if the wait lasts.
+    fn wait_on(&self, port: &Name, peer: Option<&Name>) -> WaitGuard<'_> {
+        self.module.cell.arm_diagnosis();
         WaitGuard {
-            cell,
-            module: self.module.name.clone(),
-            id,
+            record: &self.thread.waits,
+            id: self.thread.waits.begin(port, peer),
         }
     }
 }
@@ -583,8 +529,8 @@ impl<S> fmt::Debug for Ctx<S> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Ctx")
             .field("module", &self.module.name)
-            .field("task", &self.task)
-            .field("rank", &self.section.get())
+            .field("task", &self.thread.task)
+            .field("rank", &self.thread.section.get())
             .finish()
     }
 }
@@ -598,7 +544,7 @@ struct SectionGuard<'a, S: Send + Sync + 'static> {
 
 impl<'a, S: Send + Sync + 'static> SectionGuard<'a, S> {
     fn enter(ctx: &'a Ctx<S>, name: Name, rank: Option<Rank>) -> Self {
-        let outer = ctx.section.enter(rank);
+        let outer = ctx.thread.section.enter(rank);
         ctx.event(EventKind::SectionEntered {
             section: name.clone(),
         });
@@ -608,23 +554,22 @@ impl<'a, S: Send + Sync + 'static> SectionGuard<'a, S> {
 
 impl<S: Send + Sync + 'static> Drop for SectionGuard<'_, S> {
     fn drop(&mut self) {
-        self.ctx.section.restore(self.outer);
+        self.ctx.thread.section.restore(self.outer);
         self.ctx.event(EventKind::SectionLeft {
             section: self.name.clone(),
         });
     }
 }
 
-/// A module's wait in the deadlock graph, removed when the wait ends.
+/// A thread's wait on a peer, cleared from its record when the wait ends.
 struct WaitGuard<'a> {
-    cell: &'a CellShared,
-    module: Name,
-    id: u64,
+    record: &'a WaitRecord,
+    id: WaitId,
 }
 
 impl Drop for WaitGuard<'_> {
     fn drop(&mut self) {
-        self.cell.waits().end(&self.module, self.id);
+        self.record.end(self.id);
     }
 }
 
@@ -655,8 +600,9 @@ impl PortFailure for ReceiveError {
 pin_project_lite::pin_project! {
     /// A port operation of a task, [`Ctx::send`], [`Ctx::receive`] or [`Ctx::query`]: the
     /// end's own future, and what the module logs when it ends (the event, the timeout
-    /// exception, the end of the wait in the deadlock graph). A send or a query enters the
-    /// deadlock graph only once it has to wait: one answered at its first poll never does.
+    /// exception, the end of the wait in the thread's record of its waits). A send or a
+    /// query notes its wait only once it has to wait: one answered at its first poll never
+    /// does, and the deadlock diagnosis reads the note only if the wait lasts.
     ///
     /// A named type rather than an `async fn`, so that its type does not carry the end's
     /// usage: a misused end is reported once, where the operation is called.
@@ -665,7 +611,7 @@ pin_project_lite::pin_project! {
         ctx: &'a Ctx<S>,
         port: Option<Name>,
         // Whom a send or a query waits on, read once it has to wait; `None` for a receive.
-        peers: Option<fn(&F, &mut Vec<Name>)>,
+        waits_on: Option<fn(&F) -> Option<&Name>>,
         waiting: Option<WaitGuard<'a>>,
         // What an observing cell watches; `None` (and no clock read, no text) otherwise.
         watch: Option<Box<Watch>>,
@@ -690,7 +636,7 @@ struct Watch {
 /// while the cell observes), which primitive it is, how to show what comes back, and the
 /// event it logs when it ends.
 struct Started<F, D> {
-    peers: Option<fn(&F, &mut Vec<Name>)>,
+    waits_on: Option<fn(&F) -> Option<&Name>>,
     watch: Option<Box<Watch>>,
     primitive: Primitive,
     show: D,
@@ -703,7 +649,7 @@ impl<'a, S, F, D> PortOp<'a, S, F, D> {
         Self {
             ctx,
             port: Some(port),
-            peers: started.peers,
+            waits_on: started.waits_on,
             waiting: None,
             watch: started.watch,
             primitive: started.primitive,
@@ -756,9 +702,10 @@ where
             if let Some(watch) = this.watch {
                 watch.since.get_or_insert_with(|| clock.now());
             }
-            if let (None, Some(peers), Some(port)) = (&this.waiting, *this.peers, &this.port) {
-                let operation = this.operation.as_ref().get_ref();
-                *this.waiting = Some(this.ctx.wait_on(port, |on| peers(operation, on)));
+            if let (None, Some(waits_on), Some(port)) = (&this.waiting, *this.waits_on, &this.port)
+            {
+                let peer = waits_on(this.operation.as_ref().get_ref());
+                *this.waiting = Some(this.ctx.wait_on(port, peer));
             }
             return Poll::Pending;
         };
@@ -791,7 +738,9 @@ where
                     _ => observed.reply = shown,
                 }
                 let kind = (this.done)(port, Some(observed));
-                this.ctx.module.event_at(now, Some(&this.ctx.task), kind);
+                this.ctx
+                    .module
+                    .event_at(now, Some(&this.ctx.thread.task), kind);
             }
             Err(error) => this.ctx.port_failed(
                 port,

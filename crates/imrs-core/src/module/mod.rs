@@ -3,3 +3,4 @@
 pub(crate) mod ctx;
 pub(crate) mod run;
 pub(crate) mod spec;
+pub(crate) mod thread;

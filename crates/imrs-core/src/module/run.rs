@@ -25,8 +25,10 @@ use imrs_ports::clock::Sleep;
 use imrs_ports::transport::Presence;
 use imrs_ports::{Name, Respond, Served};
 
-use super::ctx::{Ctx, ModuleShared, SectionCell};
+use super::ctx::{Ctx, ModuleShared};
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
+use super::thread::Thread;
+use crate::deadlock::ModuleThreads;
 use crate::event::EventKind;
 use crate::exception::Exception;
 use crate::kill::KillSwitch;
@@ -56,7 +58,7 @@ struct TaskRun<S> {
     name: Name,
     factory: TaskFactory<S>,
     policy: RestartPolicy,
-    section: Arc<SectionCell>,
+    thread: Arc<Thread>,
     stage: Stage,
     restarts: u32,
 }
@@ -64,8 +66,8 @@ struct TaskRun<S> {
 struct HandlerRun {
     name: Name,
     rank: Rank,
-    /// The section the handler is in: its rank, or a section it entered.
-    section: Arc<SectionCell>,
+    /// The handler's thread: the section it is in (its rank, or a section it entered).
+    thread: Arc<Thread>,
     future: BoxFuture<()>,
 }
 
@@ -87,6 +89,8 @@ pub(crate) struct ModuleRun<S> {
     /// The module's presence, entered around every poll so that the ends its threads attach
     /// are known as the module's (taken out while it is entered).
     presence: Option<Arc<Presence>>,
+    /// The live threads of this copy, for the deadlock diagnosis to read their waits.
+    threads: Arc<ModuleThreads>,
     /// The module's span, where a subscriber wanted it when the copy started: boxed, since
     /// most cells have none and every idle module would carry its room.
     span: Option<Box<tracing::Span>>,
@@ -99,7 +103,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         parent: Option<Name>,
         kill: Arc<KillSwitch>,
         children: Children,
-        presence: Arc<Presence>,
+        (presence, threads): (Arc<Presence>, Arc<ModuleThreads>),
     ) -> Self {
         let order = Order::new(spec.name.clone(), spec.order);
         let background = order.background();
@@ -136,20 +140,17 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             .tasks
             .into_iter()
             .map(|task| {
-                let section = Arc::new(SectionCell::new(background));
+                let thread = Arc::new(Thread::new(task.name.clone(), background));
+                threads.add(&thread);
                 let mut run = TaskRun {
                     name: task.name,
                     factory: task.factory,
                     policy: task.policy,
-                    section,
+                    thread,
                     stage: Stage::Finished,
                     restarts: 0,
                 };
-                let ctx = Ctx::new(
-                    Arc::clone(&shared),
-                    run.name.clone(),
-                    Arc::clone(&run.section),
-                );
+                let ctx = Ctx::new(Arc::clone(&shared), Arc::clone(&run.thread));
                 run.stage = Stage::Running((run.factory)(ctx));
                 shared.event(Some(&run.name), EventKind::TaskStarted);
                 run
@@ -164,6 +165,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             kill,
             kill_waker: None,
             presence: entered.leave(),
+            threads,
             span,
         }
     }
@@ -177,10 +179,10 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// this is the rule "outrank the thread you interrupt and every named section occupied".
     fn host_rank(&self) -> Option<Rank> {
         let tasks = self.tasks.iter().filter_map(|task| match task.stage {
-            Stage::Running(_) => Some(&*task.section),
+            Stage::Running(_) => Some(&task.thread.section),
             _ => None,
         });
-        let handlers = self.handlers.iter().map(|handler| &*handler.section);
+        let handlers = self.handlers.iter().map(|handler| &handler.thread.section);
         let mut least_urgent = None;
         let mut named: Option<Rank> = None;
         for section in tasks.chain(handlers) {
@@ -302,8 +304,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         };
         let handler = Arc::clone(handler);
         let name = exception.name.clone();
-        let section = Arc::new(SectionCell::new(rank));
-        let ctx = Ctx::new(Arc::clone(&self.shared), name.clone(), Arc::clone(&section));
+        let thread = Arc::new(Thread::new(name.clone(), rank));
+        self.threads.add(&thread);
+        let ctx = Ctx::new(Arc::clone(&self.shared), Arc::clone(&thread));
         self.shared.event(
             Some(&name),
             EventKind::ExceptionHandled {
@@ -319,7 +322,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             HandlerRun {
                 name,
                 rank,
-                section,
+                thread,
                 future,
             },
         );
@@ -354,12 +357,8 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         let task = &mut self.tasks[index];
         task.stage = Stage::Finished;
         task.restarts += 1;
-        task.section.set(background);
-        let ctx = Ctx::new(
-            Arc::clone(&self.shared),
-            task.name.clone(),
-            Arc::clone(&task.section),
-        );
+        task.thread.section.set(background);
+        let ctx = Ctx::new(Arc::clone(&self.shared), Arc::clone(&task.thread));
         task.stage = Stage::Running((task.factory)(ctx));
         self.shared.event(
             Some(&task.name),
@@ -431,11 +430,13 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         match catch_unwind(AssertUnwindSafe(|| handler.future.as_mut().poll(cx))) {
             Ok(Poll::Pending) => false,
             Ok(Poll::Ready(())) => {
-                self.handlers.remove(index);
+                let handler = self.handlers.remove(index);
+                self.threads.remove(&handler.thread);
                 true
             }
             Err(panic) => {
                 let handler = self.handlers.remove(index);
+                self.threads.remove(&handler.thread);
                 self.shared.event(
                     Some(&handler.name),
                     EventKind::TaskFailed {
@@ -468,6 +469,13 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             _ => None,
         });
         Some(failure.map_or(ModuleExit::Finished, ModuleExit::Failed))
+    }
+}
+
+impl<S> Drop for ModuleRun<S> {
+    fn drop(&mut self) {
+        // The copy's threads are gone with it, whatever they were waiting on.
+        self.threads.clear();
     }
 }
 
