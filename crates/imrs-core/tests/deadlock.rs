@@ -138,43 +138,57 @@ impl Clock for OwnClock {
     }
 }
 
+/// CHIP_IT and CHIP_IT2 of `chip_robot` on ports without timeouts: once both ask, nothing
+/// breaks the cycle. With the log of their turns (which stays empty).
+fn unguarded_robots(cell: &Cell) -> (ModuleSpec<()>, ModuleSpec<()>, Log) {
+    let port = |name: &str, owner: &str, user: &str| -> Port<(), i32, usage::Query> {
+        cell.port(PortSpec::new(name, owner).user_list([user]))
+            .unwrap()
+    };
+    let share_feeder = port("SHARE_FEEDER", "CHIP_IT", "CHIP_IT2");
+    let share_feeder1 = port("SHARE_FEEDER1", "CHIP_IT2", "CHIP_IT");
+    let log: Log = Arc::default();
+    let chip_it = chip_robot(
+        "CHIP_IT",
+        share_feeder.clone(),
+        &share_feeder1,
+        Arc::clone(&log),
+    );
+    let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+    (chip_it, chip_it2, log)
+}
+
+fn deadlocks(cell: &Cell) -> Vec<Event> {
+    let events = cell.events().snapshot();
+    let deadlock = |event: &Event| matches!(event.kind, EventKind::Deadlock { .. });
+    events.into_iter().filter(deadlock).collect()
+}
+
 #[test]
 fn on_a_clock_of_its_own_the_watchdog_names_the_cycle_within_its_bound() {
     paused_runtime().block_on(async {
         let virtual_time = imrs_ports::VirtualClock::new();
         let cell = Cell::new(Arc::new(OwnClock(virtual_time.clone())));
-        // No timeouts: nothing breaks this cycle, which closes at 2 s.
-        let share_feeder: Port<(), i32, usage::Query> = cell
-            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]))
-            .unwrap();
-        let share_feeder1: Port<(), i32, usage::Query> = cell
-            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT2").user_list(["CHIP_IT"]))
-            .unwrap();
-        let log: Log = Arc::default();
-        let chip_it = chip_robot("CHIP_IT", share_feeder.clone(), &share_feeder1, Arc::clone(&log));
-        let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+        let (chip_it, chip_it2, log) = unguarded_robots(&cell);
         let chip_it = cell.start(chip_it).unwrap();
         drive(&virtual_time, at(2)).await;
+        // The cycle closes at 2 s.
         let chip_it2 = cell.start(chip_it2).unwrap();
         drive(&virtual_time, at(10)).await;
 
-        let deadlocks: Vec<_> = cell
-            .events()
-            .snapshot()
-            .into_iter()
-            .filter(|event| matches!(event.kind, EventKind::Deadlock { .. }))
-            .collect();
-        assert_eq!(deadlocks.len(), 1, "a standing cycle is named once: {deadlocks:?}");
-        let found = &deadlocks[0];
+        let found = deadlocks(&cell);
+        assert_eq!(found.len(), 1, "a standing cycle is named once: {found:?}");
         let closed = at(2);
         assert!(
-            found.at > closed && found.at <= closed + Cell::DEADLOCK_BOUND,
+            found[0].at > closed && found[0].at <= closed + Cell::DEADLOCK_BOUND,
             "named at {:?}, the cycle closed at 2 s",
-            found.at
+            found[0].at
         );
         assert_eq!(
-            found.to_string().split_once("] ").map(|(_, rest)| rest),
-            Some("CHIP_IT2/CHIP_IT2: deadlock: CHIP_IT2 -[SHARE_FEEDER1]-> CHIP_IT -[SHARE_FEEDER]-> CHIP_IT2")
+            found[0].to_string().split_once("] ").map(|(_, rest)| rest),
+            Some(
+                "CHIP_IT2/CHIP_IT2: deadlock: CHIP_IT2 -[SHARE_FEEDER1]-> CHIP_IT -[SHARE_FEEDER]-> CHIP_IT2"
+            )
         );
         assert!(log.lock().unwrap().is_empty(), "neither got its answer");
         chip_it.stop();
@@ -186,41 +200,18 @@ fn on_a_clock_of_its_own_the_watchdog_names_the_cycle_within_its_bound() {
 fn a_cycle_that_closes_later_is_named_at_the_instant_it_closed() {
     paused_runtime().block_on(async {
         let (cell, clock) = Cell::virtual_clock();
-        let share_feeder: Port<(), i32, usage::Query> = cell
-            .port(PortSpec::new("SHARE_FEEDER", "CHIP_IT").user_list(["CHIP_IT2"]))
-            .unwrap();
-        let share_feeder1: Port<(), i32, usage::Query> = cell
-            .port(PortSpec::new("SHARE_FEEDER1", "CHIP_IT2").user_list(["CHIP_IT"]))
-            .unwrap();
-        let log: Log = Arc::default();
-        let chip_it = chip_robot(
-            "CHIP_IT",
-            share_feeder.clone(),
-            &share_feeder1,
-            Arc::clone(&log),
-        );
-        let chip_it2 = chip_robot("CHIP_IT2", share_feeder1, &share_feeder, Arc::clone(&log));
+        let (chip_it, chip_it2, _) = unguarded_robots(&cell);
         let chip_it = cell.start(chip_it).unwrap();
         // CHIP_IT waits alone for 7 s: a wait that lasts is no cycle.
         drive(&clock, at(7)).await;
-        assert!(
-            !cell
-                .events()
-                .snapshot()
-                .iter()
-                .any(|e| matches!(e.kind, EventKind::Deadlock { .. })),
-            "one module waiting is no deadlock"
-        );
+        assert_eq!(deadlocks(&cell), [], "one module waiting is no deadlock");
         let chip_it2 = cell.start(chip_it2).unwrap();
         drive(&clock, at(20)).await;
-        let deadlocks: Vec<_> = cell
-            .events()
-            .snapshot()
+        let found: Vec<_> = deadlocks(&cell)
             .into_iter()
-            .filter(|event| matches!(event.kind, EventKind::Deadlock { .. }))
-            .map(|event| (event.at, event.module.clone()))
+            .map(|event| (event.at, event.module))
             .collect();
-        assert_eq!(deadlocks, [(at(7), Name::from("CHIP_IT2"))]);
+        assert_eq!(found, [(at(7), Name::from("CHIP_IT2"))]);
         chip_it.stop();
         chip_it2.stop();
     });
