@@ -12,35 +12,51 @@
 //! lets it run.
 
 use std::cmp::Reverse;
-use std::collections::HashSet;
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 use imrs_ports::Name;
 
 use crate::module::thread::Thread;
 use crate::wait_record::Wait;
 
-/// The threads of a module's running copy, for the diagnosis to read their waits.
+/// The threads of a module's running copy, for the diagnosis to read their waits: kept
+/// with the module's entry among the cell's running modules, under that list's lock. The
+/// first inline, so that a module of one task (most of them) allocates no list.
 #[derive(Debug, Default)]
-pub(crate) struct ModuleThreads(Mutex<Vec<Arc<Thread>>>);
+pub(crate) struct ModuleThreads {
+    first: Option<Arc<Thread>>,
+    more: Vec<Arc<Thread>>,
+}
 
 impl ModuleThreads {
-    pub(crate) fn add(&self, thread: &Arc<Thread>) {
-        self.lock().push(Arc::clone(thread));
+    pub(crate) fn add(&mut self, thread: &Arc<Thread>) {
+        match self.first {
+            None => self.first = Some(Arc::clone(thread)),
+            Some(_) => self.more.push(Arc::clone(thread)),
+        }
     }
 
-    pub(crate) fn remove(&self, thread: &Arc<Thread>) {
-        self.lock().retain(|known| !Arc::ptr_eq(known, thread));
+    pub(crate) fn remove(&mut self, thread: &Arc<Thread>) {
+        if self
+            .first
+            .as_ref()
+            .is_some_and(|first| Arc::ptr_eq(first, thread))
+        {
+            self.first = self.more.pop();
+        } else {
+            self.more.retain(|known| !Arc::ptr_eq(known, thread));
+        }
     }
 
     /// The copy has ended: none of its threads waits any more.
-    pub(crate) fn clear(&self) {
-        self.lock().clear();
+    pub(crate) fn clear(&mut self) {
+        self.first = None;
+        self.more = Vec::new();
     }
 
-    fn lock(&self) -> MutexGuard<'_, Vec<Arc<Thread>>> {
-        // One push, retain, clear or read: never left half-done.
-        self.0.lock().unwrap_or_else(PoisonError::into_inner)
+    fn iter(&self) -> impl Iterator<Item = &Arc<Thread>> {
+        self.first.iter().chain(&self.more)
     }
 }
 
@@ -57,11 +73,12 @@ pub(crate) struct Found {
 struct LiveWait {
     module: Name,
     task: Name,
-    port: Name,
+    /// The port's [`Name::token`]: its name is looked up only for a cycle found.
+    port: usize,
     on: Vec<Name>,
-    seq: u64,
+    seq: u32,
     /// The thread and wait number: the wait's identity while it lasts.
-    key: (usize, u64),
+    key: (usize, u32),
 }
 
 /// The state the diagnosis keeps between two looks.
@@ -69,16 +86,17 @@ struct LiveWait {
 pub(crate) struct Diagnosis {
     /// The waits that closed a cycle already reported, kept while they last, so that a
     /// cycle that stands is named once.
-    reported: HashSet<(usize, u64)>,
+    reported: HashSet<(usize, u32)>,
 }
 
 impl Diagnosis {
     /// Looks at every wait of `modules` in progress and returns the cycles not reported
-    /// before. `users_of` names the running users of a port, whom its owner's post waits on.
+    /// before. `users_of` names the running users of a port (by its token), whom its
+    /// owner's post waits on.
     pub(crate) fn look<'m>(
         &mut self,
-        modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)>,
-        users_of: impl Fn(&Name) -> &'m [Name],
+        modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)> + Clone,
+        users_of: impl Fn(usize) -> &'m [Name],
     ) -> Vec<Found> {
         let waits = live_waits(modules, users_of);
         self.reported
@@ -98,14 +116,23 @@ impl Diagnosis {
             if path.iter().any(|&step| waits[step].seq > wait.seq) {
                 continue;
             }
+            let Some(cycle) = path
+                .iter()
+                .map(|&step| {
+                    Some((
+                        waits[step].module.clone(),
+                        Name::from_token(waits[step].port)?,
+                    ))
+                })
+                .collect()
+            else {
+                continue;
+            };
             self.reported.insert(wait.key);
             found.push(Found {
                 module: wait.module.clone(),
                 task: wait.task.clone(),
-                cycle: path
-                    .iter()
-                    .map(|&step| (waits[step].module.clone(), waits[step].port.clone()))
-                    .collect(),
+                cycle,
             });
         }
         found
@@ -113,22 +140,31 @@ impl Diagnosis {
 }
 
 fn live_waits<'m>(
-    modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)>,
-    users_of: impl Fn(&Name) -> &'m [Name],
+    modules: impl Iterator<Item = (&'m Name, &'m ModuleThreads)> + Clone,
+    users_of: impl Fn(usize) -> &'m [Name],
 ) -> Vec<LiveWait> {
     let mut waits = Vec::new();
     let mut read: Vec<Wait> = Vec::new();
-    for (module, threads) in modules {
-        for thread in threads.lock().iter() {
+    // A module waited on that is not running cannot be in a cycle.
+    let mut running: Option<HashMap<usize, &Name>> = None;
+    for (module, threads) in modules.clone() {
+        for thread in threads.iter() {
             read.clear();
             thread.waits.live(&mut read);
             for wait in &read {
-                let Some(port) = Name::from_token(wait.port) else {
-                    continue;
-                };
                 let mut on: Vec<Name> = match wait.peer {
-                    0 => users_of(&port).to_vec(),
-                    peer => Name::from_token(peer).into_iter().collect(),
+                    0 => users_of(wait.port).to_vec(),
+                    peer => {
+                        let running = running.get_or_insert_with(|| {
+                            let by_token = modules.clone().map(|(name, _)| (name.token(), name));
+                            by_token.collect()
+                        });
+                        running
+                            .get(&peer)
+                            .map(|&name| name.clone())
+                            .into_iter()
+                            .collect()
+                    }
                 };
                 // A wait on the module's own port is served by another thread of the
                 // module, which keeps running whatever the ranks (the scheduler's
@@ -140,7 +176,7 @@ fn live_waits<'m>(
                 waits.push(LiveWait {
                     module: module.clone(),
                     task: thread.task.clone(),
-                    port,
+                    port: wait.port,
                     on,
                     seq: wait.seq,
                     key: (Arc::as_ptr(thread) as usize, wait.seq),
@@ -201,7 +237,7 @@ mod tests {
 
     /// A module of one thread, waiting as `waits` says: (port, peer).
     fn module(thread: &str, waits: &[(&str, Option<&str>)]) -> (ModuleThreads, Vec<WaitId>) {
-        let threads = ModuleThreads::default();
+        let mut threads = ModuleThreads::default();
         let thread = Arc::new(Thread::new(name(thread), Rank::from_raw(0)));
         let ids = waits
             .iter()
@@ -275,7 +311,7 @@ mod tests {
     fn an_ended_wait_breaks_the_cycle() {
         let (a, ids) = module("A", &[("P", Some("B"))]);
         let (b, _) = module("B", &[("Q", Some("A"))]);
-        a.lock()[0].waits.end(ids[0]);
+        a.first.as_ref().unwrap().waits.end(ids[0]);
         let modules = [(name("A"), &a), (name("B"), &b)];
         assert_eq!(look(&mut Diagnosis::default(), &modules), []);
     }
@@ -288,7 +324,13 @@ mod tests {
         let users = [name("USER")];
         let found = Diagnosis::default().look(
             modules.iter().map(|(module, threads)| (module, *threads)),
-            |port| if port == "BROADCAST" { &users } else { &[] },
+            |port| {
+                if port == name("BROADCAST").token() {
+                    &users
+                } else {
+                    &[]
+                }
+            },
         );
         assert_eq!(found.len(), 1, "{found:?}");
     }

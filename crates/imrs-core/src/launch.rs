@@ -9,7 +9,6 @@ use imrs_ports::transport::Presence;
 use imrs_ports::{Name, Wiring};
 
 use crate::check::{CellError, CellErrors, check_module};
-use crate::deadlock::ModuleThreads;
 use crate::event::EventKind;
 use crate::kill::KillSwitch;
 use crate::module::ctx::Ctx;
@@ -47,7 +46,6 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
 ) -> Result<(ModuleHandle, impl Future<Output = ()> + Send + 'static), CellErrors> {
     let name = first.name.clone();
     let kill = Arc::new(KillSwitch::default());
-    let threads = Arc::new(ModuleThreads::default());
     crate::watchdog::watch(&cell);
     {
         // The modules, then the wiring: the order every path that takes both keeps.
@@ -71,7 +69,7 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
             Member {
                 switch: Arc::clone(&kill),
                 placement,
-                threads: Arc::clone(&threads),
+                threads: Default::default(),
             },
         );
     }
@@ -105,7 +103,7 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
                 parent.clone(),
                 Arc::clone(&kill),
                 children.clone(),
-                (Arc::clone(&presence), Arc::clone(&threads)),
+                Arc::clone(&presence),
             );
             let exit = copy.await;
             // The kill that ended this copy is spent; one that comes later is for the next.

@@ -49,6 +49,10 @@ impl Members {
         self.by_name.get(module)
     }
 
+    pub(crate) fn get_mut(&mut self, module: &Name) -> Option<&mut Member> {
+        self.by_name.get_mut(module)
+    }
+
     pub(crate) fn insert(&mut self, module: Name, member: Member) {
         for port in &member.placement.uses {
             self.users
@@ -92,7 +96,7 @@ pub(crate) struct Member {
     pub(crate) switch: Arc<KillSwitch>,
     pub(crate) placement: Placement,
     /// The threads of its running copy, whose waits the deadlock diagnosis reads.
-    pub(crate) threads: Arc<ModuleThreads>,
+    pub(crate) threads: ModuleThreads,
 }
 
 impl CellShared {
@@ -134,6 +138,13 @@ impl CellShared {
         }
     }
 
+    /// Changes the record of the threads of module `module`'s running copy.
+    pub(crate) fn threads_of(&self, module: &Name, change: impl FnOnce(&mut ModuleThreads)) {
+        if let Some(member) = lock(&self.modules).get_mut(module) {
+            change(&mut member.threads);
+        }
+    }
+
     /// Looks for deadlock cycles among the waits in progress, if any wait began since the
     /// last look, and logs each new one from the wait that closed it.
     pub(crate) fn diagnose(&self) {
@@ -143,12 +154,18 @@ impl CellShared {
         let found = {
             let mut diagnosis = lock(&self.diagnosis);
             let modules = lock(&self.modules);
+            let users = &modules.users;
             diagnosis.look(
                 modules
                     .by_name
                     .iter()
-                    .map(|(name, member)| (name, &*member.threads)),
-                |port| modules.users_of(port),
+                    .map(|(name, member)| (name, &member.threads)),
+                |port| {
+                    users
+                        .iter()
+                        .find(|(name, _)| name.token() == port)
+                        .map_or(&[], |(_, users)| users.as_slice())
+                },
             )
         };
         if found.is_empty() || !(self.events.is_wanted() || crate::event::traced()) {

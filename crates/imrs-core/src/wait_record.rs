@@ -10,8 +10,8 @@
 //! once a wait has lasted.
 
 use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering, fence};
-use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering, fence};
+use std::sync::{Mutex, MutexGuard, OnceLock, PoisonError};
 
 use imrs_ports::Name;
 
@@ -23,16 +23,17 @@ pub(crate) struct Wait {
     /// The module waited on, or 0 for the port's users (an owner's post, which any user may
     /// serve).
     pub(crate) peer: usize,
-    /// When the wait began, in the order of this OS thread's waits: which wait of a cycle
-    /// closed it.
-    pub(crate) seq: u64,
+    /// When the wait began, in the order of this OS thread's waits (wrapping after 2^32):
+    /// which wait of a cycle closed it, on a current-thread runtime, where every wait is on
+    /// one OS thread.
+    pub(crate) seq: u32,
 }
 
 /// Which of a record's places a wait took, to clear it when the wait ends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum WaitId {
     First,
-    More(u64),
+    More(u32),
 }
 
 #[derive(Debug, Default)]
@@ -41,9 +42,10 @@ pub(crate) struct WaitRecord {
     /// last on beginning (Release), so a reader that sees it sees the fields beside it.
     port: AtomicUsize,
     peer: AtomicUsize,
-    seq: AtomicU64,
-    /// The waits beyond the first one of a thread that waits on several ports at once.
-    more: Mutex<Vec<Wait>>,
+    seq: AtomicU32,
+    /// The waits beyond the first one of a thread that waits on several ports at once:
+    /// made the first time it does, so that the usual thread carries a pointer, not a list.
+    more: OnceLock<Box<Mutex<Vec<Wait>>>>,
 }
 
 impl WaitRecord {
@@ -64,7 +66,7 @@ impl WaitRecord {
             self.port.store(wait.port, Ordering::Release);
             return WaitId::First;
         }
-        self.lock_more().push(wait);
+        lock(self.more.get_or_init(Box::default)).push(wait);
         WaitId::More(wait.seq)
     }
 
@@ -72,7 +74,14 @@ impl WaitRecord {
     pub(crate) fn end(&self, id: WaitId) {
         match id {
             WaitId::First => self.port.store(0, Ordering::Release),
-            WaitId::More(seq) => self.lock_more().retain(|wait| wait.seq != seq),
+            WaitId::More(seq) => {
+                if let Some(more) = self.more.get() {
+                    let mut more = lock(more);
+                    if let Some(at) = more.iter().position(|wait| wait.seq == seq) {
+                        more.remove(at);
+                    }
+                }
+            }
         }
     }
 
@@ -92,37 +101,30 @@ impl WaitRecord {
                 into.push(wait);
             }
         }
-        into.extend(self.lock_more().iter().copied());
+        if let Some(more) = self.more.get() {
+            into.extend(lock(more).iter().copied());
+        }
     }
+}
 
-    fn lock_more(&self) -> MutexGuard<'_, Vec<Wait>> {
-        // One push, one retain or one copy: never left half-done.
-        self.more.lock().unwrap_or_else(PoisonError::into_inner)
-    }
+fn lock(more: &Mutex<Vec<Wait>>) -> MutexGuard<'_, Vec<Wait>> {
+    // One push, one retain or one copy: never left half-done.
+    more.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 thread_local! {
-    /// This OS thread's next wait number: its high bits say which thread, so that two
-    /// threads' numbers never meet; on a current-thread runtime, they order every wait.
-    static NEXT_SEQ: Cell<u64> = const { Cell::new(0) };
+    /// This OS thread's next wait number: on a current-thread runtime, they order every
+    /// wait of the cell.
+    static NEXT_SEQ: Cell<u32> = const { Cell::new(0) };
 }
 
-/// The next wait number of this OS thread, never 0.
-fn next_seq() -> u64 {
+/// The next wait number of this OS thread.
+fn next_seq() -> u32 {
     NEXT_SEQ.with(|next| {
-        let mut seq = next.get();
-        if seq == 0 {
-            seq = first_seq_of_a_thread();
-        }
-        next.set(seq + 1);
+        let seq = next.get().wrapping_add(1);
+        next.set(seq);
         seq
     })
-}
-
-/// Where a thread's wait numbers start: 2^40 apart, room for a million million waits each.
-fn first_seq_of_a_thread() -> u64 {
-    static THREADS: AtomicU64 = AtomicU64::new(1);
-    THREADS.fetch_add(1, Ordering::Relaxed) << 40
 }
 
 #[cfg(test)]

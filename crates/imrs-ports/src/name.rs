@@ -19,7 +19,7 @@
 //! [`Port::claim`]: crate::Port::claim
 
 use std::cmp::Ordering;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::fmt;
 use std::hash::{Hash, Hasher};
 use std::sync::{OnceLock, PoisonError, RwLock};
@@ -32,8 +32,6 @@ pub struct Name(&'static str);
 #[derive(Default)]
 struct Interned {
     names: HashSet<&'static str>,
-    /// The same names by [`Name::token`], for [`Name::from_token`].
-    by_token: HashMap<usize, &'static str>,
     from_peers: usize,
 }
 
@@ -76,7 +74,6 @@ impl Name {
         }
         let kept: &'static str = Box::leak(text.into());
         interned.names.insert(kept);
-        interned.by_token.insert(Self(kept).token(), kept);
         Some(Self(kept))
     }
 
@@ -106,13 +103,16 @@ impl Name {
         self.0.as_ptr() as usize
     }
 
-    /// The name whose [`token`](Name::token) is `token`, if any name has it.
+    /// The name whose [`token`](Name::token) is `token`, if any name has it. It looks
+    /// through every name made so far, so that names cost no room for it: for a rare reader,
+    /// such as a report of a deadlock.
     pub fn from_token(token: usize) -> Option<Self> {
         interned()
             .read()
             .unwrap_or_else(PoisonError::into_inner)
-            .by_token
-            .get(&token)
+            .names
+            .iter()
+            .find(|known| known.as_ptr() as usize == token)
             .map(|known| Self(known))
     }
 }

@@ -89,8 +89,6 @@ pub(crate) struct ModuleRun<S> {
     /// The module's presence, entered around every poll so that the ends its threads attach
     /// are known as the module's (taken out while it is entered).
     presence: Option<Arc<Presence>>,
-    /// The live threads of this copy, for the deadlock diagnosis to read their waits.
-    threads: Arc<ModuleThreads>,
     /// The module's span, where a subscriber wanted it when the copy started: boxed, since
     /// most cells have none and every idle module would carry its room.
     span: Option<Box<tracing::Span>>,
@@ -103,7 +101,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         parent: Option<Name>,
         kill: Arc<KillSwitch>,
         children: Children,
-        (presence, threads): (Arc<Presence>, Arc<ModuleThreads>),
+        presence: Arc<Presence>,
     ) -> Self {
         let order = Order::new(spec.name.clone(), spec.order);
         let background = order.background();
@@ -136,12 +134,11 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             spec.name, parent, spec.state, order, cell, children,
         ));
         let entered = Presence::enter(Some(presence));
-        let tasks = spec
+        let tasks: Vec<TaskRun<S>> = spec
             .tasks
             .into_iter()
             .map(|task| {
                 let thread = Arc::new(Thread::new(task.name.clone(), background));
-                threads.add(&thread);
                 let mut run = TaskRun {
                     name: task.name,
                     factory: task.factory,
@@ -156,6 +153,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 run
             })
             .collect();
+        shared.cell.threads_of(&shared.name, |threads| {
+            tasks.iter().for_each(|task| threads.add(&task.thread));
+        });
         Self {
             shared,
             tasks,
@@ -165,7 +165,6 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             kill,
             kill_waker: None,
             presence: entered.leave(),
-            threads,
             span,
         }
     }
@@ -305,7 +304,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         let handler = Arc::clone(handler);
         let name = exception.name.clone();
         let thread = Arc::new(Thread::new(name.clone(), rank));
-        self.threads.add(&thread);
+        self.shared
+            .cell
+            .threads_of(&self.shared.name, |threads| threads.add(&thread));
         let ctx = Ctx::new(Arc::clone(&self.shared), Arc::clone(&thread));
         self.shared.event(
             Some(&name),
@@ -424,6 +425,13 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         self.shared.raise(exception);
     }
 
+    /// A handler's thread has ended: the diagnosis reads its waits no more.
+    fn forget_thread(&self, thread: &Arc<Thread>) {
+        self.shared
+            .cell
+            .threads_of(&self.shared.name, |threads| threads.remove(thread));
+    }
+
     /// Polls running handler `index` once. Returns whether it finished.
     fn poll_handler(&mut self, index: usize, cx: &mut Context<'_>) -> bool {
         let handler = &mut self.handlers[index];
@@ -431,12 +439,12 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             Ok(Poll::Pending) => false,
             Ok(Poll::Ready(())) => {
                 let handler = self.handlers.remove(index);
-                self.threads.remove(&handler.thread);
+                self.forget_thread(&handler.thread);
                 true
             }
             Err(panic) => {
                 let handler = self.handlers.remove(index);
-                self.threads.remove(&handler.thread);
+                self.forget_thread(&handler.thread);
                 self.shared.event(
                     Some(&handler.name),
                     EventKind::TaskFailed {
@@ -475,7 +483,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
 impl<S> Drop for ModuleRun<S> {
     fn drop(&mut self) {
         // The copy's threads are gone with it, whatever they were waiting on.
-        self.threads.clear();
+        self.shared
+            .cell
+            .threads_of(&self.shared.name, ModuleThreads::clear);
     }
 }
 
