@@ -100,15 +100,15 @@ impl Cell {
     /// A cell on `clock`.
     pub fn new(clock: SharedClock) -> Self {
         let shared = Arc::new(CellShared::new(clock));
-        // On virtual time, at once; on another clock, once a runtime runs the first module.
+        // The deadlock watchdog, on a clock that needs one, once a runtime runs.
         crate::watchdog::watch(&shared);
         Self { shared }
     }
 
     /// How long a deadlock cycle may stand before it is named, on a clock other than a
-    /// virtual one (on virtual time it is named at the instant it closed, before the clock
-    /// moves on): a [`EventKind::Deadlock`](crate::EventKind::Deadlock) event, from the wait
-    /// that closed it. A send or a query answered without waiting is never looked at.
+    /// virtual one (on virtual time it is named as it closes): a
+    /// [`EventKind::Deadlock`](crate::EventKind::Deadlock) event, from the wait that closed
+    /// it. A send or a query answered without waiting is never looked at.
     pub const DEADLOCK_BOUND: std::time::Duration = crate::watchdog::BOUND;
 
     /// A cell on a new virtual clock, and that clock, to drive it.

@@ -1,15 +1,16 @@
 //! Deadlock diagnosis, off the message path: which module waits on which, through which
-//! port, found once a wait has lasted.
+//! port.
 //!
 //! A send or a query that has to wait notes its port and peer in its thread's
 //! [`WaitRecord`](crate::wait_record::WaitRecord), which no other module writes; a rendezvous
-//! that completes at once notes nothing. The graph is built only when waits have lasted:
-//! on virtual time, each time the clock is about to move (every task that could run at this
-//! instant has run, so the cycle is stamped with the instant it closed); on any other clock,
-//! at each tick of the cell's watchdog. A cycle — every module in it waiting on the next — is
-//! reported once by module and port names, from the wait that closed it (the last to begin).
-//! It is a diagnosis: the cycle may still be broken, by a timeout or by a handler whose rank
-//! lets it run.
+//! that completes at once notes nothing, and nothing cell-wide is touched for it. The graph is
+//! built from those records only when it can show something: on any clock but a virtual
+//! one, at each tick of the cell's watchdog after a wait has begun; on virtual time, as a
+//! wait begins whose peer is itself waiting, so that a cycle is stamped with the instant it
+//! closed even if a handler breaks it within that instant. A cycle — every module in it
+//! waiting on the next — is reported once by module and port names, from the wait that
+//! closed it (the last to begin). It is a diagnosis: the cycle may still be broken, by a
+//! timeout or by a handler whose rank lets it run.
 
 use std::cmp::Reverse;
 use std::collections::{HashMap, HashSet};
@@ -53,6 +54,11 @@ impl ModuleThreads {
     pub(crate) fn clear(&mut self) {
         self.first = None;
         self.more = Vec::new();
+    }
+
+    /// Whether any thread of the copy has a wait in progress.
+    pub(crate) fn any_waiting(&self) -> bool {
+        self.iter().any(|thread| thread.waits.is_waiting())
     }
 
     fn iter(&self) -> impl Iterator<Item = &Arc<Thread>> {

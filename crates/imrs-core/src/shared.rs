@@ -21,12 +21,15 @@ pub(crate) struct CellShared {
     /// carrying the text of the values of the ports that show them.
     pub(crate) observe: AtomicBool,
     /// Set by a wait that begins, cleared by the diagnosis that looks at it: while no wait
-    /// has begun since the last look, no new cycle can have closed. Shared with what calls
-    /// the diagnosis (the virtual clock's watcher), which must not keep the cell alive.
-    pub(crate) armed: Arc<AtomicBool>,
+    /// has begun since the last look, no new cycle can have closed.
+    pub(crate) armed: AtomicBool,
     pub(crate) diagnosis: Mutex<Diagnosis>,
-    /// Whether the diagnosis has been set going (a watcher of the clock, or a watchdog).
+    /// Whether the diagnosis has been set going (a watchdog, on a clock other than a
+    /// virtual one).
     pub(crate) watched: AtomicBool,
+    /// Whether the cell runs on virtual time, where a wait whose peer waits is looked at
+    /// as it begins (see [`CellShared::wait_began`]).
+    pub(crate) on_virtual_time: bool,
     pub(crate) wiring: Mutex<Wiring>,
     pub(crate) modules: Mutex<Members>,
 }
@@ -102,10 +105,11 @@ pub(crate) struct Member {
 impl CellShared {
     pub(crate) fn new(clock: SharedClock) -> Self {
         Self {
+            on_virtual_time: clock.as_virtual().is_some(),
             clock,
             events: EventLog::new(),
             observe: AtomicBool::new(false),
-            armed: Arc::default(),
+            armed: AtomicBool::new(false),
             diagnosis: Mutex::default(),
             watched: AtomicBool::new(false),
             wiring: Mutex::default(),
@@ -129,12 +133,42 @@ impl CellShared {
         self.observe.load(Ordering::Relaxed)
     }
 
-    /// A wait has begun: the next look of the diagnosis is worth making. A load, and a
-    /// store only for the first wait since the last look.
+    /// Module `module` has begun a wait on `port`, served by `peer` (or by the port's
+    /// users).
+    ///
+    /// On a clock other than a virtual one, this marks the next look of the watchdog as
+    /// worth making: a load, and a store only for the first wait since the last look.
+    ///
+    /// On virtual time a cycle may close and be broken within one instant (a query that
+    /// times out and is asked again at once, while the twin still waits, then a handler
+    /// that breaks it), and a cell's report counts each cycle met. So there the cycle is
+    /// looked for as the wait begins, as soon as a peer is seen waiting itself: one lock of
+    /// the running modules, and a look only then. A rendezvous answered at once never comes
+    /// here.
     #[inline]
-    pub(crate) fn arm_diagnosis(&self) {
-        if !self.armed.load(Ordering::Relaxed) {
+    pub(crate) fn wait_began(&self, module: &Name, port: &Name, peer: Option<&Name>) {
+        if !self.on_virtual_time {
+            if !self.armed.load(Ordering::Relaxed) {
+                self.armed.store(true, Ordering::Relaxed);
+            }
+            return;
+        }
+        let peer_waits = {
+            let modules = lock(&self.modules);
+            let waits = |other: &Name| {
+                other != module
+                    && modules
+                        .get(other)
+                        .is_some_and(|member| member.threads.any_waiting())
+            };
+            match peer {
+                Some(peer) => waits(peer),
+                None => modules.users_of(port).iter().any(waits),
+            }
+        };
+        if peer_waits {
             self.armed.store(true, Ordering::Relaxed);
+            self.diagnose();
         }
     }
 

@@ -85,6 +85,12 @@ impl WaitRecord {
         }
     }
 
+    /// Whether a wait is in progress.
+    pub(crate) fn is_waiting(&self) -> bool {
+        self.port.load(Ordering::Acquire) != 0
+            || self.more.get().is_some_and(|more| !lock(more).is_empty())
+    }
+
     /// The waits in progress, pushed onto `into`. Read from another thread: a wait that
     /// ends or begins meanwhile may be missed or seen, never seen half-written.
     pub(crate) fn live(&self, into: &mut Vec<Wait>) {

@@ -517,11 +517,12 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// Notes, in this thread's record, a wait on `port` served by `peer` (or by any of the
     /// port's users): the deadlock diagnosis reads it only if the wait lasts.
     fn wait_on(&self, port: &Name, peer: Option<&Name>) -> WaitGuard<'_> {
-        self.module.cell.arm_diagnosis();
-        WaitGuard {
+        let guard = WaitGuard {
             record: &self.thread.waits,
             id: self.thread.waits.begin(port, peer),
-        }
+        };
+        self.module.cell.wait_began(&self.module.name, port, peer);
+        guard
     }
 }
 

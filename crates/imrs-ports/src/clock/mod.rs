@@ -17,7 +17,7 @@ pub use instant::Instant;
 pub use real::RealClock;
 pub use sleep::Sleep;
 pub(crate) use sleep::deadline_passed;
-pub use virtual_clock::{BeforeAdvance, VirtualClock};
+pub use virtual_clock::VirtualClock;
 
 /// A source of time for ports, modules and the simulation.
 pub trait Clock: Send + Sync + fmt::Debug + 'static {
@@ -32,8 +32,8 @@ pub trait Clock: Send + Sync + fmt::Debug + 'static {
         self.sleep_until(self.now() + duration)
     }
 
-    /// This clock as a [`VirtualClock`], if it is one: for a cell that looks at its modules
-    /// each time virtual time is about to move, rather than on a timer of its own.
+    /// This clock as a [`VirtualClock`], if it is one: a cell on virtual time finds its
+    /// deadlocks as they close, rather than on a timer of its own.
     fn as_virtual(&self) -> Option<&VirtualClock> {
         None
     }

@@ -19,8 +19,6 @@ pub struct VirtualClock {
 #[derive(Default)]
 struct Shared {
     state: Mutex<State>,
-    /// Told before each move of the clock, in the order they came.
-    watchers: Mutex<Vec<Arc<dyn BeforeAdvance>>>,
     /// `state.now` in nanoseconds since the start, written under the lock whenever it
     /// moves: every event a module logs reads the clock, and a load costs no lock.
     now: AtomicU64,
@@ -33,34 +31,7 @@ struct State {
     timers: BTreeMap<(Instant, u64), Waker>,
 }
 
-/// What wants to look at a cell each time its virtual time is about to move: then every
-/// task that could run at this instant has run (on a paused current-thread runtime), so a
-/// wait still standing has lasted, and what is found is stamped with the instant it arose.
-pub trait BeforeAdvance: Send + Sync {
-    /// Called before the clock moves, with no lock of the clock held. Returns `false` once
-    /// the watcher wants no more calls (what it watches is gone); it is then dropped.
-    fn before_advance(&self) -> bool;
-}
-
 impl VirtualClock {
-    /// Has `watcher` told before each move of the clock, until it returns `false`.
-    pub fn before_advance(&self, watcher: Arc<dyn BeforeAdvance>) {
-        lock(&self.shared.watchers).push(watcher);
-    }
-
-    /// Tells every watcher that the clock is about to move, dropping those that are done.
-    fn tell_watchers(&self) {
-        // Taken out while they run, so that a watcher may add another without a deadlock.
-        let mut watchers = std::mem::take(&mut *lock(&self.shared.watchers));
-        if watchers.is_empty() {
-            return;
-        }
-        watchers.retain(|watcher| watcher.before_advance());
-        let mut kept = lock(&self.shared.watchers);
-        watchers.append(&mut kept);
-        *kept = watchers;
-    }
-
     /// A virtual clock standing at [`Instant::ZERO`].
     pub fn new() -> Self {
         Self::default()
@@ -74,7 +45,6 @@ impl VirtualClock {
 
     /// Moves the clock to `to` (never backwards), waking every timer due by then.
     pub fn advance_to(&self, to: Instant) {
-        self.tell_watchers();
         let due = {
             let mut state = self.shared.lock();
             state.now = state.now.max(to);
@@ -109,13 +79,6 @@ impl VirtualClock {
 /// `at` in nanoseconds since the start; past 584 years, the most a `u64` holds.
 fn nanos(at: Instant) -> u64 {
     u64::try_from(at.since_start().as_nanos()).unwrap_or(u64::MAX)
-}
-
-fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
-    // Each critical section is one push or one swap of the list: never left half-done.
-    mutex
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
 impl Shared {
