@@ -147,12 +147,17 @@ impl CellShared {
     /// here.
     #[inline]
     pub(crate) fn wait_began(&self, module: &Name, port: &Name, peer: Option<&Name>) {
-        if !self.on_virtual_time {
-            if !self.armed.load(Ordering::Relaxed) {
-                self.armed.store(true, Ordering::Relaxed);
-            }
-            return;
+        if self.on_virtual_time {
+            self.look_if_peer_waits(module, port, peer);
+        } else if !self.armed.load(Ordering::Relaxed) {
+            self.armed.store(true, Ordering::Relaxed);
         }
+    }
+
+    /// [`CellShared::wait_began`] on virtual time: kept out of line, so that the path of a
+    /// message on other clocks carries none of it.
+    #[inline(never)]
+    fn look_if_peer_waits(&self, module: &Name, port: &Name, peer: Option<&Name>) {
         let peer_waits = {
             let modules = lock(&self.modules);
             let waits = |other: &Name| {
