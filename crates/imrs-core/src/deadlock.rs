@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use imrs_ports::Name;
 
-use crate::module::thread::Thread;
+use crate::thread::Thread;
 use crate::wait_record::Wait;
 
 /// The threads of a module's running copy, for the diagnosis to read their waits: kept

@@ -156,6 +156,7 @@ mod outcome;
 mod processor;
 mod shared;
 mod supervision;
+mod thread;
 pub mod time;
 mod tree;
 mod wait_record;

@@ -25,9 +25,9 @@ use imrs_ports::clock::Sleep;
 use imrs_ports::transport::Presence;
 use imrs_ports::{Name, Respond, Served};
 
-use super::ctx::{Ctx, ModuleShared};
+use super::ctx::Ctx;
+use super::module_shared::ModuleShared;
 use super::spec::{BoxFuture, ExceptionHandler, ModuleSpec, TaskFactory, TaskResult};
-use super::thread::Thread;
 use crate::deadlock::ModuleThreads;
 use crate::event::EventKind;
 use crate::exception::Exception;
@@ -35,6 +35,7 @@ use crate::kill::KillSwitch;
 use crate::order::{Order, Rank};
 use crate::shared::{CellShared, Children};
 use crate::supervision::RestartPolicy;
+use crate::thread::Thread;
 
 /// How a module's copy ended.
 #[derive(Debug, Clone, PartialEq, Eq)]
