@@ -172,8 +172,7 @@ impl CellShared {
             }
         };
         if peer_waits {
-            self.armed.store(true, Ordering::Relaxed);
-            self.diagnose();
+            self.look();
         }
     }
 
@@ -187,9 +186,13 @@ impl CellShared {
     /// Looks for deadlock cycles among the waits in progress, if any wait began since the
     /// last look, and logs each new one from the wait that closed it.
     pub(crate) fn diagnose(&self) {
-        if !self.armed.swap(false, Ordering::AcqRel) {
-            return;
+        if self.armed.swap(false, Ordering::AcqRel) {
+            self.look();
         }
+    }
+
+    /// Looks for deadlock cycles among the waits in progress now, and logs each new one.
+    fn look(&self) {
         let found = {
             let mut diagnosis = lock(&self.diagnosis);
             let modules = lock(&self.modules);

@@ -151,13 +151,6 @@ impl<'a, Req, Rep, O> Posting<'a, Req, Rep, O> {
         }
     }
 
-    /// Calls `visit` with each module at the other end of the port, as
-    /// [`End::each_peer`](crate::End::each_peer) does: for a module that notes whom it
-    /// waits on only once the send or query has to wait.
-    pub fn each_peer(&self, visit: impl FnMut(Name)) {
-        self.attachment.each_peer(visit);
-    }
-
     /// The module this post waits on: the port's owner, for a user's post; `None` for the
     /// owner's own post, which whichever user receives first serves. A copy of a name, for
     /// a record kept while the post waits.
