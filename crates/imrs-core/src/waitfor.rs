@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::future::poll_fn;
 use std::pin::pin;
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError};
 use std::task::{Poll, Waker};
 use std::time::Duration;
 
@@ -160,25 +160,18 @@ struct Shared<M> {
 }
 
 struct Round<M> {
-    generation: u64,
     arrived: Vec<Option<M>>,
     /// How many members have arrived this round: kept, so that an arrival costs O(1).
     count: usize,
     wakers: Vec<Option<Waker>>,
-    /// The pool of the last completed round, for members that have not picked it up yet.
-    released: Option<Arc<Pool<M>>>,
+    /// Where this round's pool is published when the round is released. Each member that
+    /// arrives holds it, so that a member woken by the release reads its result with one
+    /// load, taking no lock; the pool is freed once the round's last member has read it.
+    outcome: Outcome<M>,
 }
 
-impl<M> Round<M> {
-    /// The pool of round `generation`, once that round has been released.
-    fn pool_after(&self, generation: u64) -> Option<Arc<Pool<M>>> {
-        (self.generation > generation).then(|| {
-            self.released
-                .clone()
-                .expect("a released round keeps its pool")
-        })
-    }
-}
+/// The pool of one round, once it is released.
+type Outcome<M> = Arc<OnceLock<Pool<M>>>;
 
 impl<M> Round<M> {
     /// Takes back the message of member `index`, which waits in this round.
@@ -196,7 +189,9 @@ impl<M> Round<M> {
 struct Arrival<'a, M> {
     barrier: &'a WaitFor<M>,
     index: usize,
-    generation: u64,
+    outcome: Outcome<M>,
+    /// Cleared once the round is released or the message taken back: nothing to withdraw,
+    /// and no lock to take.
     armed: bool,
 }
 
@@ -206,7 +201,9 @@ impl<M> Drop for Arrival<'_, M> {
             return;
         }
         let mut round = self.barrier.lock();
-        if round.generation == self.generation && round.arrived[self.index].is_some() {
+        // An outcome not yet published is the current round's: released rounds publish
+        // theirs under the lock.
+        if self.outcome.get().is_none() && round.arrived[self.index].is_some() {
             drop(round.withdraw(self.index));
         }
     }
@@ -257,11 +254,10 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 members: Arc::new(members),
                 clock,
                 round: Mutex::new(Round {
-                    generation: 0,
                     arrived: (0..count).map(|_| None).collect(),
                     count: 0,
                     wakers: vec![None; count],
-                    released: None,
+                    outcome: Arc::default(),
                 }),
             }),
         })
@@ -279,6 +275,10 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
 
     /// `waitfor`: `task` pools `message`, waits (at most `timeout`) until every member has,
     /// then runs `combine` over the pool and returns its result.
+    ///
+    /// The task's place among the members is found once, by name, when it arrives; woken
+    /// by the round's release, it reads the pool through that round's outcome, with no
+    /// lookup and no lock.
     pub async fn waitfor<R>(
         &self,
         task: &str,
@@ -294,36 +294,48 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                 message,
             });
         };
-        let generation = {
-            let mut round = self.lock();
-            if round.arrived[index].is_some() {
-                return Err(WaitForError::AlreadyWaiting {
-                    barrier: shared.name.clone(),
-                    task: task.into(),
-                    message,
-                });
-            }
-            round.arrived[index] = Some(message);
-            round.count += 1;
-            let generation = round.generation;
-            if round.count == round.arrived.len() {
-                self.release(&mut round);
-            }
-            generation
-        };
-        // A waiter dropped before the round is released (an outer timeout, its module
-        // killed) takes its message back, so the round does not complete without it.
-        let mut arrival = Arrival {
-            barrier: self,
-            index,
-            generation,
-            armed: true,
-        };
+        let mut message = Some(message);
+        // Set when the task arrives, at its first poll. A waiter dropped before the round is
+        // released (an outer timeout, its module killed) takes its message back, so the
+        // round does not complete without it.
+        let mut arrival: Option<Arrival<'_, M>> = None;
         let mut deadline = pin!(timeout.map(|timeout| shared.clock.sleep(timeout)));
-        let pool = poll_fn(|cx| {
+        let outcome = poll_fn(|cx| {
+            if let Some(arrival) = &arrival
+                && arrival.outcome.get().is_some()
+            {
+                // Woken by the release: one load.
+                return Poll::Ready(Ok(()));
+            }
             let mut round = self.lock();
-            if let Some(pool) = round.pool_after(generation) {
-                return Poll::Ready(Ok(pool));
+            match message.take() {
+                Some(message) => {
+                    if round.arrived[index].is_some() {
+                        return Poll::Ready(Err(WaitForError::AlreadyWaiting {
+                            barrier: shared.name.clone(),
+                            task: task.into(),
+                            message,
+                        }));
+                    }
+                    round.arrived[index] = Some(message);
+                    round.count += 1;
+                    arrival = Some(Arrival {
+                        barrier: self,
+                        index,
+                        outcome: Arc::clone(&round.outcome),
+                        armed: true,
+                    });
+                    if round.count == round.arrived.len() {
+                        // The last to arrive: the round is complete at once.
+                        self.release(&mut round);
+                        return Poll::Ready(Ok(()));
+                    }
+                }
+                // Released between the load above and the lock.
+                None if arrival.as_ref().is_some_and(|a| a.outcome.get().is_some()) => {
+                    return Poll::Ready(Ok(()));
+                }
+                None => {}
             }
             match &mut round.wakers[index] {
                 // Polled again by the same task: no clone (a reference count written).
@@ -340,8 +352,9 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             }
             let mut round = self.lock();
             // The last member may have come in just as the time ran out: the rendezvous wins.
-            if let Some(pool) = round.pool_after(generation) {
-                return Poll::Ready(Ok(pool));
+            // The release is made under the lock, so this look is the last word.
+            if arrival.as_ref().is_some_and(|a| a.outcome.get().is_some()) {
+                return Poll::Ready(Ok(()));
             }
             let message = round.withdraw(index);
             let missing = shared
@@ -360,11 +373,20 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             }))
         })
         .await;
-        arrival.armed = false;
-        let pool = pool?;
-        Ok(combine(&pool))
+        // Taken back on timeout; spent when the round was released.
+        if let Some(arrival) = &mut arrival {
+            arrival.armed = false;
+        }
+        outcome?;
+        let pool = arrival
+            .as_ref()
+            .and_then(|arrival| arrival.outcome.get())
+            .expect("a released member arrived in the round");
+        Ok(combine(pool))
     }
 
+    /// Publishes the round's pool to its members and wakes those that wait; the next round
+    /// begins with a fresh outcome.
     fn release(&self, round: &mut Round<M>) {
         let messages = round
             .arrived
@@ -372,11 +394,12 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             .map(|slot| slot.take().expect("every member arrived"))
             .collect();
         round.count = 0;
-        round.released = Some(Arc::new(Pool {
+        let outcome = std::mem::take(&mut round.outcome);
+        let published = outcome.set(Pool {
             members: Arc::clone(&self.shared.members),
             messages,
-        }));
-        round.generation += 1;
+        });
+        debug_assert!(published.is_ok(), "a round is released once");
         for waker in round.wakers.iter_mut().filter_map(Option::take) {
             waker.wake();
         }

@@ -225,3 +225,73 @@ fn a_dropped_waiter_withdraws_its_message_and_may_wait_again() {
         assert_eq!(a.await.unwrap().unwrap(), "b");
     });
 }
+
+#[test]
+fn rounds_across_threads_never_mix_and_lose_no_message() {
+    // Eight tasks on four worker threads meet for 300 rounds; each pools its round's number,
+    // so a pool holding a message of another round, or one missing, fails the combination.
+    const TASKS: usize = 8;
+    const ROUNDS: u64 = 300;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(4)
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let clock: SharedClock = Arc::new(VirtualClock::new());
+        let names: Vec<String> = (0..TASKS).map(|i| format!("T{i}")).collect();
+        let barrier = WaitFor::<u64>::new("MEET", names.clone(), clock).unwrap();
+        let tasks: Vec<_> = names
+            .into_iter()
+            .map(|name| {
+                let barrier = barrier.clone();
+                tokio::spawn(async move {
+                    for round in 0..ROUNDS {
+                        let seen = barrier
+                            .waitfor(
+                                &name,
+                                round,
+                                |pool| pool.iter().map(|(_, m)| *m).collect::<Vec<_>>(),
+                                None,
+                            )
+                            .await
+                            .unwrap();
+                        assert_eq!(seen, vec![round; TASKS], "{name} in round {round}");
+                    }
+                })
+            })
+            .collect();
+        for task in tasks {
+            task.await.unwrap();
+        }
+    });
+}
+
+#[test]
+fn a_waiter_dropped_after_its_round_was_released_takes_nothing_from_the_next() {
+    paused_runtime().block_on(async {
+        let clock: SharedClock = Arc::new(VirtualClock::new());
+        let barrier = WaitFor::<&'static str>::new("PAIR", ["A", "B"], clock).unwrap();
+        let mut a = Box::pin(barrier.waitfor("A", "a1", |_| (), None));
+        // A arrives and waits; B completes the round; A's wait is dropped unread.
+        assert!(futures_poll(a.as_mut()).is_pending());
+        let b = barrier
+            .waitfor("B", "b1", |pool| *pool.getmess("A").unwrap(), None)
+            .await;
+        assert_eq!(b, Ok("a1"));
+        drop(a);
+        // The next round meets with the next messages, none withdrawn by the dropped wait.
+        let (a, b) = tokio::join!(
+            barrier.waitfor("A", "a2", |pool| *pool.getmess("B").unwrap(), None),
+            barrier.waitfor("B", "b2", |pool| *pool.getmess("A").unwrap(), None),
+        );
+        assert_eq!((a, b), (Ok("b2"), Ok("a2")));
+    });
+}
+
+/// One poll of `future`, with a waker that does nothing.
+fn futures_poll<F: std::future::Future>(
+    future: std::pin::Pin<&mut F>,
+) -> std::task::Poll<F::Output> {
+    let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
+    future.poll(&mut cx)
+}
