@@ -9,6 +9,7 @@ use std::task::Waker;
 
 use crate::clock::SharedClock;
 use crate::error::Gone;
+use crate::inline::ServeInline;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
@@ -137,6 +138,9 @@ pub(crate) struct Core<Req, Rep> {
     /// The transport's turn in a spinning wait, if a transport gives one
     /// ([`Port::pump_with`](crate::transport::PortTransport::pump_with)).
     pub(crate) pump: OnceLock<Box<dyn Pump>>,
+    /// What answers posts in the poster's own poll, if anything does (a bounded buffer's
+    /// ports): looked at by every post, one load where it is unset.
+    pub(crate) inline: OnceLock<Arc<dyn ServeInline<Req, Rep>>>,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -158,6 +162,7 @@ impl<Req, Rep> Core<Req, Rep> {
             handing: OnceLock::new(),
             parked: AtomicBool::new(false),
             pump: OnceLock::new(),
+            inline: OnceLock::new(),
         }
     }
 

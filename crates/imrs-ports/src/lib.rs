@@ -53,6 +53,7 @@ mod core;
 mod end;
 mod error;
 pub mod filter;
+mod inline;
 mod loom;
 mod meta;
 mod module_name;

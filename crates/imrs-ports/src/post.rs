@@ -168,6 +168,18 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
         let core = &attachment.core;
         let slot = core.slot(attachment.at);
         let port = attachment.port();
+        if *this.stage == Stage::Posting
+            && let Some(server) = core.inline.get()
+        {
+            let request = this.request.take().expect("a request waits to be posted");
+            match server.serve(request, core) {
+                Ok(reply) => {
+                    *this.stage = Stage::Done;
+                    return Poll::Ready(O::answered(reply));
+                }
+                Err(request) => *this.request = Some(request),
+            }
+        }
         if this.deadline.is_none()
             && let Some(timeout) = attachment.timeout
         {

@@ -104,3 +104,156 @@ fn a_shown_filtered_port_shows_both_sides() {
     let shown = owner.shown().expect("FILTER shows its values");
     assert_eq!((shown.reply)(&Some((1, 9.0))), "Some((1, 9.0))");
 }
+
+/// One poll of `future`, with a waker that does nothing.
+fn poll_once<F: std::future::Future>(future: std::pin::Pin<&mut F>) -> std::task::Poll<F::Output> {
+    future.poll(&mut std::task::Context::from_waker(std::task::Waker::noop()))
+}
+
+#[test]
+fn while_the_filter_runs_a_send_with_room_to_spare_completes_in_its_first_poll() {
+    // The filter has started and waits: a send is one write into the buffer, and GATE's
+    // request one read, each done in its own first poll, with no turn of the filter task.
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let frequency = Frequency::new(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
+        let mut gate = frequency.owner().unwrap();
+        let mut load_it = frequency.user::<LoadIt>().unwrap();
+        let filter = tokio::spawn(BoundedBuffer::<_, 4>::new().run(frequency.filter().unwrap()));
+        tokio::task::yield_now().await;
+        for n in 0..3 {
+            let mut send = std::pin::pin!(load_it.send((0, f64::from(n))));
+            assert!(poll_once(send.as_mut()).is_ready(), "send {n} waited");
+        }
+        for n in 0..3 {
+            let mut request = std::pin::pin!(gate.send(()));
+            match poll_once(request.as_mut()) {
+                std::task::Poll::Ready(Ok(Some((0, time)))) => assert_eq!(time, f64::from(n)),
+                other => panic!("GATE's request {n} got {other:?}"),
+            }
+        }
+        let mut empty = std::pin::pin!(gate.send(()));
+        assert!(matches!(
+            poll_once(empty.as_mut()),
+            std::task::Poll::Ready(Ok(None))
+        ));
+        filter.abort();
+    });
+}
+
+#[test]
+fn a_full_buffer_takes_exactly_its_capacity_in_order_then_holds_back() {
+    on_both_runtimes(|| async {
+        let (clock, shared) = virtual_clock();
+        let frequency = Frequency::new(
+            PortSpec::new("FREQUENCY", "GATE").clock(shared),
+            "BOUNDED_BUFFER",
+        );
+        let mut gate = frequency.owner().unwrap();
+        let mut load_it = frequency
+            .user::<LoadIt>()
+            .unwrap()
+            .with_timeout(Duration::from_secs(1));
+        let filter = tokio::spawn(BoundedBuffer::<_, 5>::new().run(frequency.filter().unwrap()));
+        // Four in place and the fifth through the filter: five, and no more.
+        for n in 0..5 {
+            load_it.send((0, f64::from(n))).await.unwrap();
+        }
+        let sixth = tokio::spawn(async move { (load_it.send((0, 5.0)).await, load_it) });
+        until_sleepers(&clock, 1).await;
+        clock.advance(Duration::from_secs(1));
+        let (refused, _load_it) = sixth.await.unwrap();
+        assert!(
+            matches!(
+                refused,
+                Err(SendError::Timeout {
+                    message: (0, 5.0),
+                    ..
+                })
+            ),
+            "the sixth send should be held back, got {refused:?}"
+        );
+        for n in 0..5 {
+            assert_eq!(gate.send(()).await.unwrap(), Some((0, f64::from(n))));
+        }
+        assert_eq!(gate.send(()).await.unwrap(), None);
+        filter.abort();
+    });
+}
+
+#[test]
+fn two_users_and_gate_on_four_threads_lose_nothing_and_keep_each_users_order() {
+    const EACH: i32 = 2_000;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(4)
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let frequency = Frequency::new(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
+        let mut gate = frequency.owner().unwrap();
+        let filter = tokio::spawn(BoundedBuffer::<_, 8>::new().run(frequency.filter().unwrap()));
+        let mut load_it = frequency.user::<LoadIt>().unwrap();
+        let mut chip_it = frequency.user::<ChipIt>().unwrap();
+        let users = [
+            tokio::spawn(async move {
+                for n in 0..EACH {
+                    load_it.send((0, f64::from(n))).await.unwrap();
+                }
+            }),
+            tokio::spawn(async move {
+                for n in 0..EACH {
+                    chip_it.send((1, f64::from(n))).await.unwrap();
+                }
+            }),
+        ];
+        let mut next = [0.0, 0.0];
+        let mut read = 0;
+        while read < 2 * EACH {
+            match gate.send(()).await.unwrap() {
+                Some((user, time)) => {
+                    let user = usize::try_from(user).unwrap();
+                    assert_eq!(time, next[user], "user {user} out of order");
+                    next[user] += 1.0;
+                    read += 1;
+                }
+                None => tokio::task::yield_now().await,
+            }
+        }
+        for user in users {
+            user.await.unwrap();
+        }
+        assert_eq!(gate.send(()).await.unwrap(), None);
+        filter.abort();
+    });
+}
+
+#[test]
+fn a_stopped_filter_serves_nothing_in_place_and_a_new_one_serves_again() {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let frequency = Frequency::new(PortSpec::new("FREQUENCY", "GATE"), "BOUNDED_BUFFER");
+        let mut gate = frequency.owner().unwrap();
+        let mut load_it = frequency.user::<LoadIt>().unwrap();
+        let first = tokio::spawn(BoundedBuffer::<_, 4>::new().run(frequency.filter().unwrap()));
+        tokio::task::yield_now().await;
+        load_it.send((0, 1.0)).await.unwrap();
+        first.abort();
+        assert!(first.await.unwrap_err().is_cancelled());
+        // No filter: the send waits for one, and the message held by the stopped filter went
+        // with it, as a filter task's own messages do.
+        let mut waiting = Box::pin(load_it.send((0, 2.0)));
+        assert!(poll_once(waiting.as_mut()).is_pending());
+        let second = tokio::spawn(BoundedBuffer::<_, 4>::new().run(frequency.filter().unwrap()));
+        waiting.await.unwrap();
+        let mut in_place = std::pin::pin!(load_it.send((0, 3.0)));
+        assert!(poll_once(in_place.as_mut()).is_ready());
+        assert_eq!(gate.send(()).await.unwrap(), Some((0, 2.0)));
+        assert_eq!(gate.send(()).await.unwrap(), Some((0, 3.0)));
+        assert_eq!(gate.send(()).await.unwrap(), None);
+        second.abort();
+    });
+}
