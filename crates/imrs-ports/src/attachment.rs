@@ -158,14 +158,14 @@ impl<Req, Rep> Attachment<Req, Rep> {
 impl<Req, Rep> Attachment<Req, Rep> {
     /// The transport's turn between two looks of a spinning wait, if it has one.
     pub(crate) fn pump(&self) {
-        if let Some(pump) = self.core.pump.get() {
+        if let Some(pump) = self.core.hooks().and_then(|hooks| hooks.pump.get()) {
             pump.pump();
         }
     }
 
     /// Tells the transport, if any, that a spinning wait parks now.
     pub(crate) fn parking(&self) {
-        if let Some(pump) = self.core.pump.get() {
+        if let Some(pump) = self.core.hooks().and_then(|hooks| hooks.pump.get()) {
             pump.parking();
         }
     }

@@ -104,7 +104,7 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
                 }
                 return Poll::Pending;
             }
-            if let Some(hand) = core.handing.get() {
+            if let Some(hand) = core.hooks().and_then(|hooks| hooks.handing.get()) {
                 let message = this.message.take().expect("the message waits to be posted");
                 *this.message = Some(hand(message));
             }

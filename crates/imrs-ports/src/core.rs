@@ -9,12 +9,10 @@ use std::task::Waker;
 
 use crate::clock::SharedClock;
 use crate::error::Gone;
-use crate::inline::ServeInline;
+use crate::hooks::Hooks;
 use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
-use crate::pump::Pump;
-use crate::shared::Lender;
 use crate::shown::Shown;
 use crate::slot::Slot;
 use crate::urgency::wake_at;
@@ -126,21 +124,12 @@ pub(crate) struct Core<Req, Rep> {
     pub(crate) users: Box<[UserSlot<Req, Rep>]>,
     /// How the port's values read in event logs, if the port says.
     pub(crate) shown: OnceLock<Shown<Req, Rep>>,
-    /// Where a sender's messages are built, if a transport lends memory of its own
-    /// ([`Port::lend_with`](crate::transport::PortTransport::lend_with)).
-    pub(crate) lender: OnceLock<Lender<Req>>,
-    /// Where a broadcast is moved before it is cloned for each user, if a transport says
-    /// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
-    pub(crate) handing: OnceLock<Handing<Req>>,
     /// Whether waits park at once, whatever the process type says
     /// ([`Port::park_waits`](crate::transport::PortTransport::park_waits)).
     pub(crate) parked: AtomicBool,
-    /// The transport's turn in a spinning wait, if a transport gives one
-    /// ([`Port::pump_with`](crate::transport::PortTransport::pump_with)).
-    pub(crate) pump: OnceLock<Box<dyn Pump>>,
-    /// What answers posts in the poster's own poll, if anything does (a bounded buffer's
-    /// ports): looked at by every post, one load where it is unset.
-    pub(crate) inline: OnceLock<Arc<dyn ServeInline<Req, Rep>>>,
+    /// What transports and filters add to the port, in one allocation made when the
+    /// first is set (see [`Hooks`]); most ports have none.
+    hooks: OnceLock<Box<Hooks<Req, Rep>>>,
 }
 
 impl<Req, Rep> Core<Req, Rep> {
@@ -158,16 +147,23 @@ impl<Req, Rep> Core<Req, Rep> {
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
             shown: OnceLock::new(),
-            lender: OnceLock::new(),
-            handing: OnceLock::new(),
             parked: AtomicBool::new(false),
-            pump: OnceLock::new(),
-            inline: OnceLock::new(),
+            hooks: OnceLock::new(),
         }
     }
 
     pub(crate) fn capacity(&self) -> usize {
         self.users.len()
+    }
+
+    /// The port's hooks, if any was set: one load for a port without any.
+    pub(crate) fn hooks(&self) -> Option<&Hooks<Req, Rep>> {
+        self.hooks.get().map(|hooks| &**hooks)
+    }
+
+    /// The port's hooks, made empty if none was set yet, so that one can be.
+    pub(crate) fn hooks_to_set(&self) -> &Hooks<Req, Rep> {
+        self.hooks.get_or_init(Box::default)
     }
 
     pub(crate) fn slot(&self, id: SlotId) -> &Slot<Req, Rep> {

@@ -174,7 +174,12 @@ impl<T: Default + Send + 'static, Rep: Send + 'static, U: Usage> End<Shared<T>, 
     /// (all zeros, for a message that crosses processes). Refused, naming the port, when the
     /// transport has no memory left: every loan and every request out.
     pub fn loan(&self) -> Result<Shared<T>, LoanError> {
-        match self.attachment.core.lender.get() {
+        match self
+            .attachment
+            .core
+            .hooks()
+            .and_then(|hooks| hooks.lender.get())
+        {
             Some(lender) => lender(),
             None => Ok(Shared::default()),
         }

@@ -53,6 +53,7 @@ mod core;
 mod end;
 mod error;
 pub mod filter;
+mod hooks;
 mod inline;
 mod loom;
 mod meta;

@@ -169,7 +169,7 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
         let slot = core.slot(attachment.at);
         let port = attachment.port();
         if *this.stage == Stage::Posting
-            && let Some(server) = core.inline.get()
+            && let Some(server) = core.hooks().and_then(|hooks| hooks.inline.get())
         {
             let request = this.request.take().expect("a request waits to be posted");
             match server.serve(request, core) {

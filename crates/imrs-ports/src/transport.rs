@@ -85,7 +85,7 @@ where
         self,
         lender: impl Fn() -> Result<Req, LoanError> + Send + Sync + 'static,
     ) -> Self {
-        let _first_holds = self.core().lender.set(Box::new(lender));
+        let _first_holds = self.core().hooks_to_set().lender.set(Box::new(lender));
         self
     }
 
@@ -96,7 +96,7 @@ where
     /// every user's clone reads that one copy, rather than each being copied on its way.
     /// The first set holds, for every handle of the port.
     fn broadcast_with(self, hand: impl Fn(Req) -> Req + Send + Sync + 'static) -> Self {
-        let _first_holds = self.core().handing.set(Box::new(hand));
+        let _first_holds = self.core().hooks_to_set().handing.set(Box::new(hand));
         self
     }
 
@@ -116,7 +116,7 @@ where
     ///
     /// [`End::park_waits`]: EndTransport::park_waits
     fn pump_with(&self, pump: impl Pump) {
-        let _first_holds = self.core().pump.set(Box::new(pump));
+        let _first_holds = self.core().hooks_to_set().pump.set(Box::new(pump));
     }
 }
 

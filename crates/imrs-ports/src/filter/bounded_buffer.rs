@@ -81,7 +81,13 @@ impl<T: Send + 'static> Buffer<T> {
             });
             buffer
         };
-        let users = ends.port.attachment.core.inline.get_or_init(fresh);
+        let users = ends
+            .port
+            .attachment
+            .core
+            .hooks_to_set()
+            .inline
+            .get_or_init(fresh);
         let buffer = Arc::clone(users)
             .into_any()
             .downcast::<Self>()
@@ -90,6 +96,7 @@ impl<T: Send + 'static> Buffer<T> {
             .filter
             .attachment
             .core
+            .hooks_to_set()
             .inline
             .get_or_init(|| Arc::clone(&buffer) as Arc<dyn ServeInline<(), Option<T>>>);
         let same = Arc::clone(owner)
