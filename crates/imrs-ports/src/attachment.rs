@@ -82,8 +82,11 @@ impl<Req, Rep> Attachment<Req, Rep> {
     /// Registers the task to be woken when a request arrives for this end to serve.
     pub(crate) fn register_server(&self, cx: &mut Context<'_>) {
         match self.at {
-            SlotId::Owner => self.core.owner_wakers.server.register(cx.waker()),
-            SlotId::User(index) => self.core.users[index].wakers.server.register(cx.waker()),
+            SlotId::Owner => self.core.owner_wakers.server.register_by_ref(cx.waker()),
+            SlotId::User(index) => self.core.users[index]
+                .wakers
+                .server
+                .register_by_ref(cx.waker()),
         }
     }
 
@@ -99,7 +102,7 @@ impl<Req, Rep> Attachment<Req, Rep> {
         if any(self) {
             return Poll::Ready(());
         }
-        self.core.user_attached.register(cx.waker());
+        self.core.user_attached.register_by_ref(cx.waker());
         // Looked at again once registered: a user that attached in between is not missed.
         if any(self) {
             Poll::Ready(())

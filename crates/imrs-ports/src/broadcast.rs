@@ -93,7 +93,7 @@ impl<'a, Req: Clone, Rep> Future for Broadcasting<'a, Req, Rep> {
             // to be done with.
             let busy = users.clone().filter(attached).find(|&index| {
                 let user = &core.users[index];
-                user.wakers.poster.register(cx.waker());
+                user.wakers.poster.register_by_ref(cx.waker());
                 !user.slot.is_free()
             });
             if busy.is_some() {

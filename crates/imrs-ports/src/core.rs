@@ -10,13 +10,12 @@ use std::task::Waker;
 use crate::clock::SharedClock;
 use crate::error::Gone;
 use crate::hooks::Hooks;
-use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use crate::loom::{AtomicBool, AtomicU64, AtomicUsize, AtomicWaker, Ordering};
 use crate::meta::{Name, PortMeta};
 use crate::presence::{Presence, Watcher};
 use crate::shown::Shown;
 use crate::slot::Slot;
 use crate::urgency::wake_at;
-use crate::waker_cell::WakerCell;
 
 /// Who holds, or last held, one side of a port: the module, and its presence when the end
 /// was attached inside a module.
@@ -76,10 +75,10 @@ impl<T> std::ops::Deref for Padded<T> {
 pub(crate) struct Wakers {
     /// Wakes this side while it waits to serve (receive or respond), or, for the owner, for
     /// a broadcast's answers.
-    pub(crate) server: WakerCell,
+    pub(crate) server: AtomicWaker,
     /// Wakes the poster of this side's slot while it waits for the slot to be free or for
     /// its answer. For a user slot in a broadcast, that poster is the owner.
-    pub(crate) poster: WakerCell,
+    pub(crate) poster: AtomicWaker,
 }
 
 pub(crate) struct UserSlot<Req, Rep> {
@@ -117,7 +116,7 @@ pub(crate) struct Core<Req, Rep> {
     owner_holder: Mutex<Holder>,
     /// Wakes whoever waits for a user to attach (`End::peer_attached`): a waker of its own,
     /// so that an attaching never wakes the owner's serving, which a processor orders.
-    pub(crate) user_attached: WakerCell,
+    pub(crate) user_attached: AtomicWaker,
     /// Live `Port` handles: while one exists, a missing end may still attach.
     declarations: AtomicUsize,
     users_attached: AtomicUsize,
@@ -142,7 +141,7 @@ impl<Req, Rep> Core<Req, Rep> {
             owner_wakers: Padded(Wakers::default()),
             owner_attached: AtomicBool::new(false),
             owner_holder: Mutex::default(),
-            user_attached: WakerCell::new(),
+            user_attached: AtomicWaker::new(),
             declarations: AtomicUsize::new(1),
             users_attached: AtomicUsize::new(0),
             users: (0..capacity).map(|_| UserSlot::new()).collect(),
@@ -174,7 +173,7 @@ impl<Req, Rep> Core<Req, Rep> {
     }
 
     /// The waker of whoever posted into slot `id`.
-    pub(crate) fn poster(&self, id: SlotId) -> &WakerCell {
+    pub(crate) fn poster(&self, id: SlotId) -> &AtomicWaker {
         match id {
             SlotId::Owner => &self.owner_wakers.poster,
             SlotId::User(index) => &self.users[index].wakers.poster,
@@ -335,7 +334,7 @@ impl<Req, Rep> Core<Req, Rep> {
 pub(crate) fn register_broadcast<Req, Rep>(core: &Core<Req, Rep>, waker: &Waker) {
     for user in core.users.iter() {
         if user.in_broadcast.load(Ordering::Relaxed) {
-            user.wakers.poster.register(waker);
+            user.wakers.poster.register_by_ref(waker);
         }
     }
 }

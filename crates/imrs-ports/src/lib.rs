@@ -76,7 +76,6 @@ pub mod transport;
 mod urgency;
 pub mod usage;
 mod user_list;
-mod waker_cell;
 mod wiring;
 
 pub use broadcast::{Broadcast, Broadcasting};

@@ -1,6 +1,6 @@
 //! The concurrency primitives the rendezvous core is written against.
 //!
-//! In the library they are std's atomics and cells. The loom model
+//! In the library they are std's atomics and `atomic-waker`. The loom model
 //! (`tests/loom_slot.rs`) compiles `slot.rs` against loom's versions of the same names,
 //! so the very code that ships is the code that is model-checked.
 
@@ -15,11 +15,25 @@ impl<T> UnsafeCell<T> {
         Self(std::cell::UnsafeCell::new(value))
     }
 
-    pub(crate) fn with<R>(&self, f: impl FnOnce(*const T) -> R) -> R {
-        f(self.0.get())
-    }
-
     pub(crate) fn with_mut<R>(&self, f: impl FnOnce(*mut T) -> R) -> R {
         f(self.0.get())
+    }
+}
+
+/// `atomic_waker::AtomicWaker` with loom's method names.
+#[derive(Debug, Default)]
+pub(crate) struct AtomicWaker(atomic_waker::AtomicWaker);
+
+impl AtomicWaker {
+    pub(crate) fn new() -> Self {
+        Self(atomic_waker::AtomicWaker::new())
+    }
+
+    pub(crate) fn register_by_ref(&self, waker: &std::task::Waker) {
+        self.0.register(waker);
+    }
+
+    pub(crate) fn wake(&self) {
+        self.0.wake();
     }
 }

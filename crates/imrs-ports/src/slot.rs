@@ -16,8 +16,7 @@
 use std::mem::MaybeUninit;
 use std::task::{Context, Poll};
 
-use crate::loom::{AtomicU8, AtomicU64, Ordering, UnsafeCell};
-use crate::waker_cell::WakerCell;
+use crate::loom::{AtomicU8, AtomicU64, AtomicWaker, Ordering, UnsafeCell};
 
 const EMPTY: u8 = 0;
 const POSTED: u8 = 1;
@@ -74,11 +73,11 @@ impl<Req, Rep> Slot<Req, Rep> {
     }
 
     /// Poster: waits until the slot is free, registered in `poster` meanwhile.
-    pub(crate) fn poll_free(&self, poster: &WakerCell, cx: &mut Context<'_>) -> Poll<()> {
+    pub(crate) fn poll_free(&self, poster: &AtomicWaker, cx: &mut Context<'_>) -> Poll<()> {
         if self.is_free() {
             return Poll::Ready(());
         }
-        poster.register(cx.waker());
+        poster.register_by_ref(cx.waker());
         if self.is_free() {
             Poll::Ready(())
         } else {
@@ -133,7 +132,7 @@ impl<Req, Rep> Slot<Req, Rep> {
     ///
     /// Hands the reply back if the poster had given up (timed out, or its module died):
     /// nobody would read it, and the server is told so.
-    pub(crate) unsafe fn reply(&self, poster: &WakerCell, reply: Rep) -> Result<(), Rep> {
+    pub(crate) unsafe fn reply(&self, poster: &AtomicWaker, reply: Rep) -> Result<(), Rep> {
         // SAFETY: while TAKEN or ABANDONED the reply cell belongs to the server (the poster
         // reads it only in REPLIED), and the caller is that server.
         self.reply.with_mut(|cell| unsafe { (*cell).write(reply) });
@@ -166,7 +165,7 @@ impl<Req, Rep> Slot<Req, Rep> {
     /// # Safety
     ///
     /// As for [`Slot::reply`].
-    pub(crate) unsafe fn unreplied(&self, poster: &WakerCell) {
+    pub(crate) unsafe fn unreplied(&self, poster: &AtomicWaker) {
         if let Err(state) =
             self.state
                 .compare_exchange(TAKEN, UNREPLIED, Ordering::AcqRel, Ordering::Acquire)
@@ -184,14 +183,14 @@ impl<Req, Rep> Slot<Req, Rep> {
     /// The caller is the only poster of this slot and has a request in it.
     pub(crate) unsafe fn poll_answer(
         &self,
-        poster: &WakerCell,
+        poster: &AtomicWaker,
         cx: &mut Context<'_>,
     ) -> Poll<Answer<Rep>> {
         // SAFETY: forwarded from the caller.
         if let Some(answer) = unsafe { self.try_answer() } {
             return Poll::Ready(answer);
         }
-        poster.register(cx.waker());
+        poster.register_by_ref(cx.waker());
         // SAFETY: forwarded from the caller.
         match unsafe { self.try_answer() } {
             Some(answer) => Poll::Ready(answer),

@@ -1,20 +1,16 @@
-//! A loom model of the rendezvous slot: the very `src/slot.rs` that ships, with the waker
-//! cell it wakes through (`src/waker_cell.rs`), compiled against loom's atomics and cells,
-//! and checked under every interleaving loom explores.
+//! A loom model of the rendezvous slot: the very `src/slot.rs` that ships, compiled against
+//! loom's atomics, cells and wakers, and checked under every interleaving loom explores.
 #![allow(dead_code, unreachable_pub)]
 
 /// What `slot.rs` reaches as `crate::loom`: loom's versions of the primitives.
 mod loom {
     pub(crate) use ::loom::cell::UnsafeCell;
-    pub(crate) use ::loom::sync::atomic::{AtomicU8, AtomicU64, AtomicUsize, Ordering};
+    pub(crate) use ::loom::future::AtomicWaker;
+    pub(crate) use ::loom::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 }
 
-#[path = "support/loom_block_on.rs"]
-mod loom_block_on;
 #[path = "../src/slot.rs"]
 mod slot;
-#[path = "../src/waker_cell.rs"]
-mod waker_cell;
 
 use std::future::poll_fn;
 use std::sync::Arc as StdArc;
@@ -26,14 +22,14 @@ use slot::{Answer, Slot, Withdrawn};
 /// A slot with its poster's waker, which the port keeps on another cache line.
 struct Paired {
     slot: Slot<Counted, Counted>,
-    poster: waker_cell::WakerCell,
+    poster: ::loom::future::AtomicWaker,
 }
 
 impl Paired {
     fn new() -> Self {
         Self {
             slot: Slot::new(),
-            poster: waker_cell::WakerCell::new(),
+            poster: ::loom::future::AtomicWaker::new(),
         }
     }
 }
@@ -80,7 +76,7 @@ fn a_reply_reaches_the_waiting_poster() {
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(1, &live), 0) }.unwrap();
         // SAFETY: as above; the request is in the slot.
-        let answer = loom_block_on::block_on(poll_fn(|cx| unsafe {
+        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe {
             slot.slot.poll_answer(&slot.poster, cx)
         }));
         match answer {
@@ -114,7 +110,7 @@ fn a_dropped_request_unblocks_the_poster() {
         // SAFETY: this thread is the slot's only poster.
         unsafe { slot.post(counted(1, &live), 0) }.unwrap();
         // SAFETY: as above.
-        let answer = loom_block_on::block_on(poll_fn(|cx| unsafe {
+        let answer = ::loom::future::block_on(poll_fn(|cx| unsafe {
             slot.slot.poll_answer(&slot.poster, cx)
         }));
         assert!(matches!(answer, Answer::Unreplied));
