@@ -41,10 +41,6 @@ impl Holder {
     }
 }
 
-/// How a port's transport takes a broadcast before it is cloned for each user
-/// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
-pub(crate) type Handing<Req> = Box<dyn Fn(Req) -> Req + Send + Sync>;
-
 /// Which slot of a port: the owner's, or a user's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SlotId {

@@ -7,10 +7,13 @@
 
 use std::sync::{Arc, OnceLock};
 
-use crate::core::Handing;
 use crate::inline::ServeInline;
 use crate::pump::Pump;
 use crate::shared::Lender;
+
+/// How a port's transport takes a broadcast before it is cloned for each user
+/// ([`Port::broadcast_with`](crate::transport::PortTransport::broadcast_with)).
+pub(crate) type Handing<Req> = Box<dyn Fn(Req) -> Req + Send + Sync>;
 
 /// A port's hooks, each set once: the first set holds, for every handle of the port.
 pub(crate) struct Hooks<Req, Rep> {

@@ -11,12 +11,12 @@
 use std::any::Any;
 use std::sync::Arc;
 
-use crate::core::Core;
-
 /// What serves a port's posts inline.
 pub(crate) trait ServeInline<Req, Rep>: Send + Sync {
-    /// Answers `request`, posted to `core`, at once; or hands it back for the rendezvous.
-    fn serve(&self, request: Req, core: &Core<Req, Rep>) -> Result<Rep, Req>;
+    /// Answers `request` at once, or hands it back for the rendezvous. `another_waits`
+    /// says whether another poster's request waits in the port's rendezvous now: one that
+    /// came first.
+    fn serve(&self, request: Req, another_waits: bool) -> Result<Rep, Req>;
 
     /// The server itself, to be found again by the filter that installed it.
     fn into_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync>;

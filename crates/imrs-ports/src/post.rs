@@ -172,7 +172,9 @@ impl<Req, Rep, O: Outcome<Req, Rep>> Future for Posting<'_, Req, Rep, O> {
             && let Some(server) = core.hooks().and_then(|hooks| hooks.inline.get())
         {
             let request = this.request.take().expect("a request waits to be posted");
-            match server.serve(request, core) {
+            // With several users, one whose request waits in the rendezvous came first.
+            let another_waits = core.capacity() > 1 && core.oldest_posted_user().is_some();
+            match server.serve(request, another_waits) {
                 Ok(reply) => {
                     *this.stage = Stage::Done;
                     return Poll::Ready(O::answered(reply));

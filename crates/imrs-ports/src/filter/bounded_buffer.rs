@@ -6,7 +6,6 @@ use std::collections::VecDeque;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use super::{FilterEnds, FilteredPort};
-use crate::core::Core;
 use crate::inline::ServeInline;
 use crate::receive::{Replied, ReplyHandle};
 use crate::select::{AllClosed, select, when};
@@ -110,13 +109,13 @@ impl<T: Send + 'static> Buffer<T> {
 
 /// A user's send: written into the buffer while it has a place to spare.
 impl<T: Send + 'static> ServeInline<T, ()> for Buffer<T> {
-    fn serve(&self, message: T, core: &Core<T, ()>) -> Result<(), T> {
+    fn serve(&self, message: T, another_waits: bool) -> Result<(), T> {
         let mut held = self.held();
         // The last place is the filter task's: it may have judged that it has room and be
         // taking a message from the rendezvous right now.
         let spare = held.live && held.queue.len() + 1 < held.capacity;
         // With several users, one whose message waits in the rendezvous came first.
-        if !spare || (core.capacity() > 1 && core.oldest_posted_user().is_some()) {
+        if !spare || another_waits {
             return Err(message);
         }
         held.queue.push_back(message);
@@ -130,7 +129,7 @@ impl<T: Send + 'static> ServeInline<T, ()> for Buffer<T> {
 
 /// The owner's request: the oldest message, or `None` when the buffer is empty.
 impl<T: Send + 'static> ServeInline<(), Option<T>> for Buffer<T> {
-    fn serve(&self, request: (), _: &Core<(), Option<T>>) -> Result<Option<T>, ()> {
+    fn serve(&self, request: (), _: bool) -> Result<Option<T>, ()> {
         let mut held = self.held();
         // A full buffer's filter task has stopped taking users' messages and waits for
         // this very request: it is served there, so that the filter takes a waiting
