@@ -300,11 +300,15 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
         // round does not complete without it.
         let mut arrival: Option<Arrival<'_, M>> = None;
         let mut deadline = pin!(timeout.map(|timeout| shared.clock.sleep(timeout)));
+        // Whether the round this task arrived in has been released: one load.
+        let released = |arrival: &Option<Arrival<'_, M>>| {
+            arrival
+                .as_ref()
+                .is_some_and(|arrival| arrival.outcome.get().is_some())
+        };
         let outcome = poll_fn(|cx| {
-            if let Some(arrival) = &arrival
-                && arrival.outcome.get().is_some()
-            {
-                // Woken by the release: one load.
+            if released(&arrival) {
+                // Woken by the release.
                 return Poll::Ready(Ok(()));
             }
             let mut round = self.lock();
@@ -332,7 +336,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
                     }
                 }
                 // Released between the load above and the lock.
-                None if arrival.as_ref().is_some_and(|a| a.outcome.get().is_some()) => {
+                None if released(&arrival) => {
                     return Poll::Ready(Ok(()));
                 }
                 None => {}
@@ -353,7 +357,7 @@ impl<M: Send + Sync + 'static> WaitFor<M> {
             let mut round = self.lock();
             // The last member may have come in just as the time ran out: the rendezvous wins.
             // The release is made under the lock, so this look is the last word.
-            if arrival.as_ref().is_some_and(|a| a.outcome.get().is_some()) {
+            if released(&arrival) {
                 return Poll::Ready(Ok(()));
             }
             let message = round.withdraw(index);

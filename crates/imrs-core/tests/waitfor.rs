@@ -273,7 +273,7 @@ fn a_waiter_dropped_after_its_round_was_released_takes_nothing_from_the_next() {
         let barrier = WaitFor::<&'static str>::new("PAIR", ["A", "B"], clock).unwrap();
         let mut a = Box::pin(barrier.waitfor("A", "a1", |_| (), None));
         // A arrives and waits; B completes the round; A's wait is dropped unread.
-        assert!(futures_poll(a.as_mut()).is_pending());
+        assert!(poll_once(a.as_mut()).is_pending());
         let b = barrier
             .waitfor("B", "b1", |pool| *pool.getmess("A").unwrap(), None)
             .await;
@@ -289,9 +289,7 @@ fn a_waiter_dropped_after_its_round_was_released_takes_nothing_from_the_next() {
 }
 
 /// One poll of `future`, with a waker that does nothing.
-fn futures_poll<F: std::future::Future>(
-    future: std::pin::Pin<&mut F>,
-) -> std::task::Poll<F::Output> {
+fn poll_once<F: std::future::Future>(future: std::pin::Pin<&mut F>) -> std::task::Poll<F::Output> {
     let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
     future.poll(&mut cx)
 }

@@ -49,20 +49,41 @@ fn users_sends_return_at_once_and_gate_reads_them_in_order() {
     });
 }
 
+/// FREQUENCY on a virtual clock with a buffer of `CAP` running, LOAD_IT's end timed out
+/// after 1 s.
+struct TimedBuffer {
+    clock: imrs_ports::VirtualClock,
+    gate: imrs_ports::End<(), Option<(i32, f64)>, imrs_ports::usage::Send>,
+    load_it: imrs_ports::End<(i32, f64), (), imrs_ports::usage::Send>,
+    filter: tokio::task::JoinHandle<()>,
+}
+
+fn timed_buffer<const CAP: usize>() -> TimedBuffer {
+    let (clock, shared) = virtual_clock();
+    let frequency = Frequency::new(
+        PortSpec::new("FREQUENCY", "GATE").clock(shared),
+        "BOUNDED_BUFFER",
+    );
+    TimedBuffer {
+        clock,
+        gate: frequency.owner().unwrap(),
+        load_it: frequency
+            .user::<LoadIt>()
+            .unwrap()
+            .with_timeout(Duration::from_secs(1)),
+        filter: tokio::spawn(BoundedBuffer::<_, CAP>::new().run(frequency.filter().unwrap())),
+    }
+}
+
 #[test]
 fn a_full_buffer_holds_the_sender_back_and_loses_nothing() {
     on_both_runtimes(|| async {
-        let (clock, shared) = virtual_clock();
-        let frequency = Frequency::new(
-            PortSpec::new("FREQUENCY", "GATE").clock(shared),
-            "BOUNDED_BUFFER",
-        );
-        let mut gate = frequency.owner().unwrap();
-        let mut load_it = frequency
-            .user::<LoadIt>()
-            .unwrap()
-            .with_timeout(Duration::from_secs(1));
-        let filter = tokio::spawn(BoundedBuffer::<_, 2>::new().run(frequency.filter().unwrap()));
+        let TimedBuffer {
+            clock,
+            mut gate,
+            mut load_it,
+            filter,
+        } = timed_buffer::<2>();
 
         load_it.send((0, 1.0)).await.unwrap();
         load_it.send((0, 2.0)).await.unwrap();
@@ -146,17 +167,12 @@ fn while_the_filter_runs_a_send_with_room_to_spare_completes_in_its_first_poll()
 #[test]
 fn a_full_buffer_takes_exactly_its_capacity_in_order_then_holds_back() {
     on_both_runtimes(|| async {
-        let (clock, shared) = virtual_clock();
-        let frequency = Frequency::new(
-            PortSpec::new("FREQUENCY", "GATE").clock(shared),
-            "BOUNDED_BUFFER",
-        );
-        let mut gate = frequency.owner().unwrap();
-        let mut load_it = frequency
-            .user::<LoadIt>()
-            .unwrap()
-            .with_timeout(Duration::from_secs(1));
-        let filter = tokio::spawn(BoundedBuffer::<_, 5>::new().run(frequency.filter().unwrap()));
+        let TimedBuffer {
+            clock,
+            mut gate,
+            mut load_it,
+            filter,
+        } = timed_buffer::<5>();
         // Four in place and the fifth through the filter: five, and no more.
         for n in 0..5 {
             load_it.send((0, f64::from(n))).await.unwrap();
