@@ -179,7 +179,9 @@ pub use module::ctx::Ctx;
 /// and `ctx.query` return, and how a failure names its port. A cell author awaits these and
 /// never names them.
 pub mod op {
-    pub use crate::module::ctx::{PortFailure, PortOp, ShowReply, ShowRequest, ShowResult};
+    pub use crate::module::ctx::{
+        PortFailure, PortOp, PortOperation, ShowReply, ShowRequest, ShowResult,
+    };
 }
 pub use module::spec::{ModuleSpec, StateView, TaskError, TaskResult};
 pub use order::{Order, Rank, Section};

@@ -151,6 +151,12 @@ impl<'a, Req, Rep, O> Posting<'a, Req, Rep, O> {
         }
     }
 
+    /// The port posted to.
+    #[inline]
+    pub fn port(&self) -> &Name {
+        self.attachment.port()
+    }
+
     /// The module this post waits on: the port's owner, for a user's post; `None` for the
     /// owner's own post, which whichever user receives first serves. A copy of a name, for
     /// a record kept while the post waits.

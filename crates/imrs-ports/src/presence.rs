@@ -4,8 +4,7 @@
 //! a sender, a querier, a receiver — should wait while a new copy of the module may attach
 //! (a supervised restart), and fail at once when none ever will, as a client of a dead QNX
 //! server is unblocked with an error. Only the module's supervisor knows which: it holds a
-//! [`Presence`] for the module, enters it around every poll of the module
-//! ([`Presence::enter`]), and marks it [gone](Presence::set_gone) when the module has ended
+//! [`Presence`] for the module, polls the module within it ([`Presence::within`]), and marks it [gone](Presence::set_gone) when the module has ended
 //! for good. Every end attached while a presence is entered (and every end
 //! [bound](crate::Respond::bind) to one) is held by that module; when its side is vacant and
 //! the presence is gone, the waiters on the other side fail with `PeerGone`.
@@ -15,14 +14,17 @@
 
 use std::cell::Cell;
 use std::fmt;
+use std::ptr;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, Weak};
 
 use crate::name::Name;
 
 thread_local! {
-    /// The presence of the module being polled on this thread, if any.
-    static CURRENT: Cell<Option<Arc<Presence>>> = const { Cell::new(None) };
+    /// The presence of the module being polled on this thread, or null: a plain pointer, so
+    /// that entering it at every poll of a module is a store into a thread-local that needs
+    /// no destructor, and costs no reference count.
+    static CURRENT: Cell<*const Presence> = const { Cell::new(ptr::null()) };
 }
 
 /// Something to wake when a presence is gone: a port whose side it held.
@@ -68,23 +70,38 @@ impl Presence {
         }
     }
 
-    /// Makes `presence` the current one on this thread until the returned guard leaves: ends
-    /// attached meanwhile are held by its module. Moves the `Arc` in and out, so entering
-    /// costs no reference count.
-    pub fn enter(presence: Option<Arc<Presence>>) -> Entered {
-        Entered {
-            previous: Some(CURRENT.replace(presence)),
+    /// Runs `body` with `presence` (or none) the current one on this thread: ends attached
+    /// meanwhile are held by its module. A closure rather than a guard, so that presences
+    /// entered on one thread are left in the order they were entered, whatever the caller.
+    #[inline]
+    pub fn within<R>(presence: Option<&Arc<Presence>>, body: impl FnOnce() -> R) -> R {
+        /// Puts back the presence that was current, also when `body` unwinds.
+        struct Restore(*const Presence);
+        impl Drop for Restore {
+            #[inline]
+            fn drop(&mut self) {
+                CURRENT.set(self.0);
+            }
         }
+        let _restore = Restore(CURRENT.replace(presence.map_or(ptr::null(), Arc::as_ptr)));
+        body()
     }
 
     /// The presence entered on this thread, if any.
     pub(crate) fn current() -> Option<Arc<Presence>> {
-        CURRENT.with(|current| {
-            let presence = current.take();
-            let copy = presence.clone();
-            current.set(presence);
-            copy
-        })
+        let current = CURRENT.get();
+        if current.is_null() {
+            return None;
+        }
+        // SAFETY: a pointer other than null in `CURRENT` was put there by `within`, from an
+        // `Arc` its caller lends for the whole of `body`, and `within` puts back the one
+        // before when `body` returns or unwinds. Calls of `within` on one thread nest (each
+        // is a closure call), so the pointer is of an `Arc` that lives now; counting one more
+        // reference for the copy returned keeps it alive as long as the copy.
+        unsafe {
+            Arc::increment_strong_count(current);
+            Some(Arc::from_raw(current))
+        }
     }
 
     /// Wakes `watcher` when this presence is gone. A port is watched once, however often the
@@ -112,26 +129,41 @@ impl fmt::Debug for Presence {
     }
 }
 
-/// A presence entered on this thread; see [`Presence::enter`].
-#[must_use = "leave the presence to get it back"]
-#[derive(Debug)]
-pub struct Entered {
-    previous: Option<Option<Arc<Presence>>>,
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl Entered {
-    /// Restores the presence that was current before, and hands back the one entered.
-    pub fn leave(mut self) -> Option<Arc<Presence>> {
-        let previous = self.previous.take().expect("left once");
-        CURRENT.replace(previous)
+    fn current_module() -> Option<String> {
+        Presence::current().map(|presence| presence.module().to_string())
     }
-}
 
-impl Drop for Entered {
-    fn drop(&mut self) {
-        // Left without `leave` (a panic unwinding through the poll): restore anyway.
-        if let Some(previous) = self.previous.take() {
-            drop(CURRENT.replace(previous));
-        }
+    #[test]
+    fn within_nests_and_restores_even_on_unwind() {
+        let outer = Presence::new("OUTER");
+        let inner = Presence::new("INNER");
+        assert_eq!(current_module(), None);
+        Presence::within(Some(&outer), || {
+            assert_eq!(current_module().as_deref(), Some("OUTER"));
+            Presence::within(Some(&inner), || {
+                assert_eq!(current_module().as_deref(), Some("INNER"));
+            });
+            Presence::within(None, || assert_eq!(current_module(), None));
+            let unwound = std::panic::catch_unwind(|| {
+                Presence::within(Some(&inner), || panic!("a poll that panics"));
+            });
+            assert!(unwound.is_err());
+            assert_eq!(current_module().as_deref(), Some("OUTER"));
+        });
+        assert_eq!(current_module(), None);
+    }
+
+    #[test]
+    fn a_copy_of_the_current_presence_outlives_the_lender() {
+        let lent = Presence::new("LENT");
+        let copy = Presence::within(Some(&lent), Presence::current).expect("one is current");
+        assert_eq!(Arc::strong_count(&lent), 2);
+        drop(lent);
+        assert_eq!(copy.module().as_str(), "LENT");
+        assert_eq!(Arc::strong_count(&copy), 1);
     }
 }

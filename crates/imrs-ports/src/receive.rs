@@ -35,6 +35,12 @@ impl<'a, Req, Rep> Receiving<'a, Req, Rep> {
             deadline: None,
         }
     }
+
+    /// The port received on.
+    #[inline]
+    pub fn port(&self) -> &Name {
+        self.attachment.port()
+    }
 }
 
 impl<Req: Send + 'static, Rep: Send + 'static> Future for Receiving<'_, Req, Rep> {

@@ -15,7 +15,7 @@ use crate::shared::LoanError;
 use crate::usage::Usage;
 use crate::user_list::UserList;
 
-pub use crate::presence::{Entered, Presence};
+pub use crate::presence::Presence;
 pub use crate::pump::Pump;
 pub use crate::urgency::waking;
 

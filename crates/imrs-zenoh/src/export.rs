@@ -172,10 +172,8 @@ impl<E> Users<E> {
         let presence = Presence::new(module);
         // The end is held by the remote module's presence, so that its peers see it gone
         // when the module's host is.
-        let (end, timeout) = {
-            let _held = Presence::enter(Some(Arc::clone(&presence)));
-            attach(module).map_err(|error| error.to_string())?
-        };
+        let (end, timeout) = Presence::within(Some(&presence), || attach(module))
+            .map_err(|error| error.to_string())?;
         let end = Arc::new(tokio::sync::Mutex::new(end));
         let (gone, told) = tokio::sync::watch::channel(false);
         let room = Arc::new(Semaphore::new(MAX_WAITING));

@@ -227,10 +227,7 @@ where
                 // import included, once the end is let go: the local module's waits end
                 // with `PeerGone` rather than hang.
                 let presence = GoneOnDrop(Presence::new(&*owner));
-                let end = {
-                    let _held = Presence::enter(Some(Arc::clone(&presence.0)));
-                    T::attach_to(&bridged)
-                };
+                let end = Presence::within(Some(&presence.0), || T::attach_to(&bridged));
                 let Ok(end) = end else { return };
                 if !serve_while_live::<Req, Rep, T>(end, &watch, &asking).await {
                     return;

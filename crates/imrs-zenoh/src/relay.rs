@@ -100,10 +100,8 @@ where
                         let module = vacant.key();
                         claim(module)?;
                         let presence = Presence::new(module.as_str());
-                        let end = {
-                            let _held = Presence::enter(Some(Arc::clone(&presence)));
-                            attach(module).map_err(|e| e.to_string())?
-                        };
+                        let end = Presence::within(Some(&presence), || attach(module))
+                            .map_err(|e| e.to_string())?;
                         let asking = Asking::new(
                             session.clone(),
                             keys.deliver(module),
@@ -331,10 +329,7 @@ where
     U: Usage + imrs_ports::usage::Plain,
 {
     let presence = Presence::new(owner);
-    let end = {
-        let _held = Presence::enter(Some(Arc::clone(&presence)));
-        local.owner()
-    };
+    let end = Presence::within(Some(&presence), || local.owner());
     let end = end.map_err(|error| ZenohError::Refused {
         port: local.name().to_string(),
         reason: error.to_string(),

@@ -168,6 +168,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     }
 
     /// `SEND`: as [`End::send`], and a timeout raises `PORT.TIMEOUT` in this module.
+    #[inline]
     pub fn send<'a, Req, Rep, U>(
         &'a self,
         end: &'a mut End<Req, Rep, U>,
@@ -178,19 +179,18 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Sends,
     {
-        let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&message)));
         let started = Started {
-            waits_on: Some(Posting::waits_on),
             watch,
             primitive: Primitive::Send,
             show: ShowReply(shown.map(|shown| shown.reply)),
             done: |port, observed| EventKind::Sent { port, observed },
         };
-        PortOp::new(self, port, end.send(message), started)
+        PortOp::new(self, end.send(message), started)
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
+    #[inline]
     pub fn receive<'a, Req, Rep, U>(
         &'a self,
         end: &'a mut End<Req, Rep, U>,
@@ -200,19 +200,18 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Receives,
     {
-        let port = end.port().clone();
         let (watch, shown) = self.watch(end, |_| None);
         let started = Started {
-            waits_on: None,
             watch,
             primitive: Primitive::Receive,
             show: ShowRequest(shown.map(|shown| shown.request)),
             done: |port, observed| EventKind::Received { port, observed },
         };
-        PortOp::new(self, port, end.receive(), started)
+        PortOp::new(self, end.receive(), started)
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
+    #[inline]
     pub fn query<'a, Req, Rep, U>(
         &'a self,
         end: &'a mut End<Req, Rep, U>,
@@ -223,16 +222,14 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Queries,
     {
-        let port = end.port().clone();
         let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&query)));
         let started = Started {
-            waits_on: Some(Posting::waits_on),
             watch,
             primitive: Primitive::Query,
             show: ShowReply(shown.map(|shown| shown.reply)),
             done: |port, observed| EventKind::Queried { port, observed },
         };
-        PortOp::new(self, port, end.query(query), started)
+        PortOp::new(self, end.query(query), started)
     }
 
     /// Whether the cell observes its primitives closely ([`Cell::observe`]).
@@ -244,6 +241,7 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// of one load): its start, and the text `message` gives of what it sends, where the
     /// port shows its values; with how the port shows them.
     #[allow(clippy::type_complexity)]
+    #[inline]
     fn watch<Req, Rep, U>(
         &self,
         end: &End<Req, Rep, U>,
@@ -483,6 +481,38 @@ impl PortFailure for ReceiveError {
     }
 }
 
+/// The end's own future under a [`PortOp`]: the port it works on, and whom it waits on.
+pub trait PortOperation {
+    /// The port.
+    fn port(&self) -> &Name;
+    /// The module a wait of this operation waits on: a user's post waits on the port's
+    /// owner; `None` for a receive and for an owner's post, which any user may serve.
+    fn waits_on(&self) -> Option<&Name>;
+    /// Whether the deadlock diagnosis notes this operation's wait: a receive waits for
+    /// whoever comes, which is no peer in a cycle.
+    const NOTED: bool;
+}
+
+impl<Req, Rep, O> PortOperation for Posting<'_, Req, Rep, O> {
+    fn port(&self) -> &Name {
+        Posting::port(self)
+    }
+    fn waits_on(&self) -> Option<&Name> {
+        Posting::waits_on(self)
+    }
+    const NOTED: bool = true;
+}
+
+impl<Req, Rep> PortOperation for Receiving<'_, Req, Rep> {
+    fn port(&self) -> &Name {
+        Receiving::port(self)
+    }
+    fn waits_on(&self) -> Option<&Name> {
+        None
+    }
+    const NOTED: bool = false;
+}
+
 pin_project_lite::pin_project! {
     /// A port operation of a task, [`Ctx::send`], [`Ctx::receive`] or [`Ctx::query`]: the
     /// end's own future, and what the module logs when it ends (the event, the timeout
@@ -495,9 +525,6 @@ pin_project_lite::pin_project! {
     #[must_use = "a port operation does nothing unless awaited"]
     pub struct PortOp<'a, S, F, D> {
         ctx: &'a Ctx<S>,
-        port: Option<Name>,
-        // Whom a send or a query waits on, read once it has to wait; `None` for a receive.
-        waits_on: Option<fn(&F) -> Option<&Name>>,
         waiting: Option<WaitGuard<'a>>,
         // What an observing cell watches; `None` (and no clock read, no text) otherwise.
         watch: Option<Box<Watch>>,
@@ -518,11 +545,10 @@ struct Watch {
     text: Option<String>,
 }
 
-/// What a port operation knows when it starts: whom it would wait on, what it watches (only
+/// What a port operation knows when it starts: what it watches (only
 /// while the cell observes), which primitive it is, how to show what comes back, and the
 /// event it logs when it ends.
-struct Started<F, D> {
-    waits_on: Option<fn(&F) -> Option<&Name>>,
+struct Started<D> {
     watch: Option<Box<Watch>>,
     primitive: Primitive,
     show: D,
@@ -530,12 +556,12 @@ struct Started<F, D> {
 }
 
 impl<'a, S, F, D> PortOp<'a, S, F, D> {
-    // Built in one go, so that the operation's future is moved as few times as it can be.
-    fn new(ctx: &'a Ctx<S>, port: Name, operation: F, started: Started<F, D>) -> Self {
+    // Built in one go, and inlined into the task's future, so that the operation's future
+    // is built where it stays rather than copied there.
+    #[inline]
+    fn new(ctx: &'a Ctx<S>, operation: F, started: Started<D>) -> Self {
         Self {
             ctx,
-            port: Some(port),
-            waits_on: started.waits_on,
             waiting: None,
             watch: started.watch,
             primitive: started.primitive,
@@ -575,39 +601,38 @@ impl<Req, Handle> ShowResult<(Req, Handle)> for ShowRequest<Req> {
 impl<S, F, T, E, D> Future for PortOp<'_, S, F, D>
 where
     S: Send + Sync + 'static,
-    F: Future<Output = Result<T, E>>,
+    F: Future<Output = Result<T, E>> + PortOperation,
     E: PortFailure,
     D: ShowResult<T>,
 {
     type Output = F::Output;
 
+    #[inline]
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<F::Output> {
         let mut this = self.project();
-        let clock = &this.ctx.module.cell.clock;
         let Poll::Ready(result) = this.operation.as_mut().poll(cx) else {
-            if let Some(watch) = this.watch {
-                watch.since.get_or_insert_with(|| clock.now());
-            }
-            if let (None, Some(waits_on), Some(port)) = (&this.waiting, *this.waits_on, &this.port)
-            {
-                let peer = waits_on(this.operation.as_ref().get_ref());
-                *this.waiting = Some(this.ctx.wait_on(port, peer));
+            if this.watch.is_some() || (F::NOTED && this.waiting.is_none()) {
+                let operation = this.operation.as_ref().get_ref();
+                *this.waiting = begin_wait(this.ctx, this.watch, this.waiting.take(), operation);
             }
             return Poll::Pending;
         };
         drop(this.waiting.take());
-        let port = this.port.take().expect("a port operation completes once");
+        // Cloned only for an event: a clone is two atomic operations.
+        let port = || this.operation.as_ref().get_ref().port().clone();
         let Some(watch) = this.watch.take() else {
             // Not observed: a primitive that succeeds logs nothing, at the cost of no clock
             // read; one that fails is logged, and a timeout raises its exception.
             if let Err(error) = &result {
                 let timed_out = error.is_timeout();
+                let port = port();
                 this.ctx
                     .port_failed(port, *this.primitive, error.to_string(), None, timed_out);
             }
             return Poll::Ready(result);
         };
-        let now = clock.now();
+        let port = port();
+        let now = this.ctx.module.cell.clock.now();
         let mut observed = Box::new(Observed {
             waited: watch
                 .since
@@ -640,10 +665,29 @@ where
     }
 }
 
-impl<S, F, D> fmt::Debug for PortOp<'_, S, F, D> {
+/// A port operation has to wait: an observing cell notes since when, and a send or a query
+/// notes whom it waits on, once. Out of line: an operation that completes at once, and an
+/// operation polled again while it waits, pass by it.
+#[inline(never)]
+fn begin_wait<'a, S: Send + Sync + 'static, F: PortOperation>(
+    ctx: &'a Ctx<S>,
+    watch: &mut Option<Box<Watch>>,
+    waiting: Option<WaitGuard<'a>>,
+    operation: &F,
+) -> Option<WaitGuard<'a>> {
+    if let Some(watch) = watch {
+        watch.since.get_or_insert_with(|| ctx.now());
+    }
+    if waiting.is_some() || !F::NOTED {
+        return waiting;
+    }
+    Some(ctx.wait_on(operation.port(), operation.waits_on()))
+}
+
+impl<S, F: PortOperation, D> fmt::Debug for PortOp<'_, S, F, D> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("PortOp")
-            .field("port", &self.port)
+            .field("port", self.operation.port())
             .finish_non_exhaustive()
     }
 }

@@ -134,7 +134,6 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         let shared = Arc::new(ModuleShared::new(
             spec.name, parent, spec.state, order, cell, children,
         ));
-        let entered = Presence::enter(Some(presence));
         let tasks: Vec<TaskRun<S>> = spec
             .tasks
             .into_iter()
@@ -149,7 +148,9 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                     restarts: 0,
                 };
                 let ctx = Ctx::new(Arc::clone(&shared), Arc::clone(&run.thread));
-                run.stage = Stage::Running((run.factory)(ctx));
+                // Within the presence: the ends the task's closure attaches are the module's.
+                let future = Presence::within(Some(&presence), || (run.factory)(ctx));
+                run.stage = Stage::Running(future);
                 shared.event(Some(&run.name), EventKind::TaskStarted);
                 run
             })
@@ -165,7 +166,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             exception_handlers,
             kill,
             kill_waker: None,
-            presence: entered.leave(),
+            presence: Some(presence),
             span,
         }
     }
@@ -371,6 +372,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
     }
 
     /// Polls task `index` once. Returns whether its stage changed.
+    #[inline(always)]
     fn poll_task(&mut self, index: usize, cx: &mut Context<'_>) -> bool {
         let task = &mut self.tasks[index];
         match &mut task.stage {
@@ -378,15 +380,10 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 let outcome = catch_unwind(AssertUnwindSafe(|| future.as_mut().poll(cx)));
                 let failure = match outcome {
                     Ok(Poll::Pending) => return false,
-                    Ok(Poll::Ready(Ok(()))) => {
-                        task.stage = Stage::Finished;
-                        self.shared.event(Some(&task.name), EventKind::TaskFinished);
-                        return true;
-                    }
-                    Ok(Poll::Ready(Err(error))) => error.to_string(),
-                    Err(panic) => panic_message(panic.as_ref()),
+                    Ok(Poll::Ready(outcome)) => outcome,
+                    Err(panic) => Err(panic_message(panic.as_ref()).into()),
                 };
-                self.fail_task(index, failure);
+                self.task_ended(index, failure);
                 true
             }
             Stage::Restarting(sleep) => {
@@ -397,6 +394,19 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 true
             }
             Stage::Finished | Stage::GaveUp(_) => false,
+        }
+    }
+
+    /// Task `index`'s copy has returned `outcome`, or panicked.
+    #[inline(never)]
+    fn task_ended(&mut self, index: usize, outcome: TaskResult) {
+        match outcome {
+            Ok(()) => {
+                let task = &mut self.tasks[index];
+                task.stage = Stage::Finished;
+                self.shared.event(Some(&task.name), EventKind::TaskFinished);
+            }
+            Err(error) => self.fail_task(index, error.to_string()),
         }
     }
 
@@ -493,23 +503,67 @@ impl<S> Drop for ModuleRun<S> {
 impl<S: Send + Sync + 'static> std::future::Future for ModuleRun<S> {
     type Output = ModuleExit;
 
+    // Inlined into the supervisor's future: a module's poll is its task's poll, with no
+    // call of its own between them.
+    #[inline(always)]
     fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<ModuleExit> {
         let this = self.get_mut();
         // Without a subscriber there is no span, and nothing to enter at every poll.
-        let _entered = this.span.as_deref().map(|span| span.clone().entered());
+        if this.span.is_some() {
+            return this.poll_in_span(cx);
+        }
+        this.poll_copy(cx)
+    }
+}
+
+impl<S: Send + Sync + 'static> ModuleRun<S> {
+    #[cold]
+    #[inline(never)]
+    fn poll_in_span(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
+        let _entered = self.span.as_deref().cloned().map(tracing::Span::entered);
+        self.poll_copy(cx)
+    }
+
+    #[inline(always)]
+    fn poll_copy(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
+        let this = self;
         if this.kill.poll_killed(cx, &mut this.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
-        let entered = Presence::enter(this.presence.take());
-        let poll = this.poll_threads(cx);
-        this.presence = entered.leave();
+        // Moved out and back, so that the presence is lent while the module is borrowed.
+        let presence = this.presence.take();
+        let poll = Presence::within(presence.as_ref(), || this.poll_threads(cx));
+        this.presence = presence;
         poll
     }
 }
 
 impl<S: Send + Sync + 'static> ModuleRun<S> {
     /// One poll of the module: its threads, and the handlers their ranks admit.
+    #[inline(always)]
     fn poll_threads(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
+        // The usual module, between two messages: one task, no handler to start or run,
+        // nothing raised. Its poll is its task's poll, and one load after it tells whether
+        // the task raised something that the order must look at.
+        if self.tasks.len() == 1
+            && self.handlers.is_empty()
+            && self.responses.is_empty()
+            && !self.shared.has_pending()
+        {
+            if !self.poll_task(0, cx) {
+                if !self.shared.has_pending() {
+                    return Poll::Pending;
+                }
+            } else if let Some(exit) = self.exit() {
+                return Poll::Ready(exit);
+            }
+        }
+        self.poll_all(cx)
+    }
+
+    /// [`ModuleRun::poll_threads`] for whatever the usual case does not cover.
+    #[inline(never)]
+    fn poll_all(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
         let mut budget = TURN_BUDGET;
         loop {
             let mut progress = self.admit();
