@@ -89,9 +89,13 @@ impl Shared {
 /// The waker of one job: a flag, and the processor's task if it is parked.
 struct JobWake {
     ready: AtomicBool,
-    /// The most urgent port priority among the wakes since the job was last polled,
-    /// encoded by [`encode`]; 0 when none.
+    /// The most urgent port priority among the wakes from other threads since the job was
+    /// last polled, encoded by [`encode`]; 0 when none.
     lift: AtomicU64,
+    /// The same, for the wakes made on the thread that runs the processor's turn (one job of
+    /// the processor waking another): only that thread writes it, and only while it runs
+    /// the turn, so it is raised by a load and a store, with no read-modify-write.
+    local_lift: AtomicU64,
     shared: Arc<Shared>,
 }
 
@@ -102,14 +106,6 @@ fn encode(priority: Priority) -> u64 {
         .map_or(0, |n| u64::from(u32::MAX) + 1 - u64::from(n))
 }
 
-fn decode(lift: u64) -> Priority {
-    match lift {
-        0 => Priority::DEFAULT,
-        // Inverse of `encode`: 1 ..= 2^32 maps back onto u32::MAX ..= 0.
-        n => Priority::declared(u32::try_from(u64::from(u32::MAX) + 1 - n).unwrap_or(0)),
-    }
-}
-
 impl Wake for JobWake {
     fn wake(self: Arc<Self>) {
         self.wake_by_ref();
@@ -117,17 +113,23 @@ impl Wake for JobWake {
 
     fn wake_by_ref(self: &Arc<Self>) {
         let lift = waking();
+        if RUNNING.get() == Arc::as_ptr(&self.shared) {
+            // A job of the processor whose turn this thread is running woke another (the
+            // common case: one end of a rendezvous wakes the other). The turn reads the flag
+            // and the lift on this same thread before it ends, so plain stores are enough.
+            if lift != Priority::DEFAULT {
+                let lift = encode(lift);
+                if lift > self.local_lift.load(Ordering::Relaxed) {
+                    self.local_lift.store(lift, Ordering::Relaxed);
+                }
+            }
+            self.ready.store(true, Ordering::Relaxed);
+            return;
+        }
         if lift != Priority::DEFAULT {
             // Published by the store of `ready` below, which the turn takes before it
             // reads the lift.
             self.lift.fetch_max(encode(lift), Ordering::Relaxed);
-        }
-        if RUNNING.get() == Arc::as_ptr(&self.shared) {
-            // A job of the processor whose turn this thread is running woke another (the
-            // common case: one end of a rendezvous wakes the other). The turn reads the flag
-            // on this same thread before it ends, so a plain store is enough.
-            self.ready.store(true, Ordering::Relaxed);
-            return;
         }
         // SeqCst pairs with the loop's clearing of `polling` and its last look at the
         // flags: either the loop sees this flag, or this wake sees the loop gone and
@@ -165,15 +167,15 @@ struct Slot {
     job: Job,
     wake: Arc<JobWake>,
     waker: Waker,
-    /// The job's own priority.
-    priority: Priority,
+    /// The job's own priority, encoded by [`encode`] (so that the turn compares integers).
+    priority: u64,
     /// Woken and not yet polled since. Kept here, not in the wake's flag, so that the turn
     /// notes when it became ready.
     ready: bool,
     /// The poll count of the processor when the job was noted ready.
     ready_since: u64,
-    /// Its own priority, lifted by the ports whose messages woke it.
-    urgency: Priority,
+    /// Its own priority, lifted by the ports whose messages woke it; encoded.
+    urgency: u64,
 }
 
 /// The jobs of a processor, as its task keeps them.
@@ -359,6 +361,7 @@ impl Jobs {
                 let wake = Arc::new(JobWake {
                     ready: AtomicBool::new(false),
                     lift: AtomicU64::new(0),
+                    local_lift: AtomicU64::new(0),
                     shared: Arc::clone(shared),
                 });
                 let waker = Waker::from(Arc::clone(&wake));
@@ -366,10 +369,10 @@ impl Jobs {
                     job,
                     wake,
                     waker,
-                    priority,
+                    priority: encode(priority),
                     ready: true,
                     ready_since: polls,
-                    urgency: priority,
+                    urgency: encode(priority),
                 }
             }));
     }
@@ -384,8 +387,14 @@ impl Jobs {
                 slot.ready = true;
                 slot.ready_since = self.polls;
             }
+            let local = slot.wake.local_lift.load(Ordering::Relaxed);
+            if local != 0 {
+                // This thread runs the turn, the only writer while it does.
+                slot.wake.local_lift.store(0, Ordering::Relaxed);
+                slot.urgency = slot.urgency.max(local);
+            }
             if slot.wake.lift.load(Ordering::Relaxed) != 0 {
-                let lift = decode(slot.wake.lift.swap(0, Ordering::Relaxed));
+                let lift = slot.wake.lift.swap(0, Ordering::Relaxed);
                 slot.urgency = slot.urgency.max(lift);
             }
         }
