@@ -12,6 +12,7 @@ use imrs_sim::{DeviceError, FEEDER_CHIPS, FeederId, Line, RobotId, Role, Station
 
 use crate::alarms::{AlarmKind, alarm};
 use crate::devices::{Devices, MAX_SWEEP_SAMPLES, RobotDevice};
+use crate::feeder_policy::FeederPolicy;
 use crate::help::{drive_relay, insisted, retried};
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LineNames, ZONE_FREE, ZONE_RELEASE, ZONE_REQUEST,
@@ -20,30 +21,6 @@ use crate::names::{
 use crate::ports::CellPorts;
 use crate::reservation::{MAX_POSES, Reservation, chip_robot};
 use crate::zone_asker::ZoneAsker;
-
-/// How the two chip robots share the feeder zone.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum FeederPolicy {
-    /// The Appendix's scheme: query the twin's CRIT_SECTION, as CHIP_IT's order allows, with
-    /// asymmetric timeout handlers to break the deadlock it admits (note 6).
-    Appendix,
-    /// A monitor task that hands the zone to one robot at a time.
-    Arbiter,
-    /// A coordinator (Jiménez et al. 1992) that reserves for each robot the space its trajectory will
-    /// sweep, and lets both robots into the zone where their trajectories do not meet.
-    Coordinator,
-}
-
-impl FeederPolicy {
-    /// Its name, as `--feeder` takes it and the report prints it.
-    pub fn name(self) -> &'static str {
-        match self {
-            FeederPolicy::Appendix => "appendix",
-            FeederPolicy::Arbiter => "arbiter",
-            FeederPolicy::Coordinator => "coordinator",
-        }
-    }
-}
 
 /// One step of CHIP_IT's work schedule: `GRASP(n), INSERT(X, Y, Z)`.
 #[derive(Debug, Clone, Copy, PartialEq)]

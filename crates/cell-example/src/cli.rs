@@ -10,10 +10,9 @@ use clap::Parser;
 use imrs_ports::RealClock;
 use imrs_sim::Line;
 
-use crate::chip::FeederPolicy;
+use crate::config::{CellConfig, DEFAULT_SPEED, LineProcess, MAX_HOURS, TimelineConfig, Transport};
 use crate::faults::CellFault;
-use crate::processes::{DEFAULT_SPEED, LineProcess, Transport};
-use crate::run::{CellConfig, MAX_HOURS, TimelineConfig};
+use crate::feeder_policy::FeederPolicy;
 
 /// The chip-insertion cell of Shin (1985), Appendix, on two lines, with a report.
 #[derive(Debug, Parser)]

@@ -7,10 +7,13 @@ use std::num::NonZeroUsize;
 use std::thread;
 use std::time::Duration;
 
-use crate::chip::FeederPolicy;
+use crate::feeder_policy::FeederPolicy;
 use imrs_record::Recorder;
 
-use crate::run::{CellConfig, RunError, RunRecord, output, refused, run};
+use crate::config::CellConfig;
+use crate::run::{refused, run};
+use crate::run_error::{RunError, output};
+use crate::run_record::RunRecord;
 
 /// The policies in the order the side-by-side table shows them.
 pub const POLICIES: [FeederPolicy; 3] = [

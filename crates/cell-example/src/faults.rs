@@ -1,10 +1,15 @@
-//! The faults an operator can inject with `--fault KIND[:WHICH]@TIME`.
+//! The faults an operator can inject with `--fault KIND[:WHICH]@TIME`, and their injection
+//! into a run.
 
 use std::fmt;
 use std::str::FromStr;
+use std::sync::PoisonError;
 use std::time::Duration;
 
-use imrs_sim::{FeederId, Line};
+use imrs_ports::Instant;
+use imrs_sim::{Fault, FaultKind, FeederId, Line, RobotId, Role, Sim, Station};
+
+use crate::gate::ReleaseDeath;
 
 /// A fault to inject into a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -128,6 +133,26 @@ impl fmt::Display for CellFault {
             CellFaultKind::FeederEmpty(feeder) => write!(f, "feeder:{}@{at}s", feeder.0),
             CellFaultKind::PalletJam(line) => write!(f, "jam:{line:?}@{at}s"),
         }
+    }
+}
+
+/// Sets `faults` to happen in `sim`; a RELEASE death goes to its line's GATE through
+/// `deaths`, as the simulation does not run GATE.
+pub(crate) fn inject(faults: &[CellFault], sim: &Sim, deaths: &[ReleaseDeath; 2]) {
+    for fault in faults {
+        let at = Instant::from_start(fault.at);
+        let kind = match fault.kind {
+            CellFaultKind::ReleaseDies(line) => {
+                *deaths[line.index()]
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner) = Some(at);
+                continue;
+            }
+            CellFaultKind::RobotFault(line) => FaultKind::Robot(RobotId::new(line, Role::ChipIt)),
+            CellFaultKind::FeederEmpty(feeder) => FaultKind::FeederEmpty(feeder),
+            CellFaultKind::PalletJam(line) => FaultKind::Jam(line, Station::Load),
+        };
+        sim.inject(Fault { at, kind });
     }
 }
 

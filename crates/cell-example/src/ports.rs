@@ -5,13 +5,11 @@ use std::fmt;
 use std::time::Duration;
 
 use imrs_core::{Cell, Ctx};
-use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_ports::{AnyUser, BoundedBufferPort, End, Port, PortSpec, SharedClock, WireError, usage};
 use imrs_sim::{Line, PalletId};
-use serde::{Deserialize, Serialize};
 
 use crate::carrier::Imported;
-use crate::chip::FeederPolicy;
+use crate::feeder_policy::FeederPolicy;
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LINE_DOWN, LineNames, ZONE_FREE, ZONE_RELEASE,
     ZONE_REQUEST, ZONE_RESERVE,
@@ -42,55 +40,6 @@ pub type ZonePort<Req = ZoneAsker> = Port<Req, (), usage::Receive, AnyUser, 2>;
 /// LINE_DOWN: the world tells FEEDER_MONITOR that a line's process has died, and which run
 /// of it comes next (see [`ZoneAsker`]). It stays in the world's process.
 pub type LineDownPort = Port<(Line, u32), (), usage::Receive, AnyUser, 1>;
-
-/// The longest module name a [`ModuleName`] holds.
-const MODULE_NAME: usize = 32;
-
-/// A module's name as a message that can cross processes: fixed-size and self-contained.
-#[derive(Clone, Copy, Default, PartialEq, Eq, ZeroCopySend, FromBytes, Serialize, Deserialize)]
-#[repr(C)]
-#[type_name("cell_example::ModuleName")]
-pub struct ModuleName {
-    len: u32,
-    bytes: [u8; MODULE_NAME],
-}
-
-impl ModuleName {
-    /// `name`, cut to its first 32 bytes (at a character's boundary).
-    pub fn new(name: &str) -> Self {
-        let mut len = name.len().min(MODULE_NAME);
-        while !name.is_char_boundary(len) {
-            len -= 1;
-        }
-        let mut bytes = [0; MODULE_NAME];
-        bytes[..len].copy_from_slice(&name.as_bytes()[..len]);
-        Self {
-            len: len as u32,
-            bytes,
-        }
-    }
-
-    /// The name; empty if a peer wrote a record that is not one.
-    pub fn as_str(&self) -> &str {
-        let len = usize::try_from(self.len).unwrap_or(usize::MAX);
-        self.bytes
-            .get(..len)
-            .and_then(|bytes| std::str::from_utf8(bytes).ok())
-            .unwrap_or("")
-    }
-}
-
-impl fmt::Debug for ModuleName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        fmt::Debug::fmt(self.as_str(), f)
-    }
-}
-
-impl fmt::Display for ModuleName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
 
 /// Where a chip robot finds a port of the feeder zone's keeper — the arbiter or the
 /// coordinator: declared in this process, or imported from the process the keeper runs in.

@@ -7,32 +7,12 @@ use std::fmt;
 use imrs_sim::{FeederId, PalletId, RobotId, Role};
 
 use crate::alarms::AlarmKind;
-use crate::chip::{FeederPolicy, ZoneWaits};
+use crate::chip::ZoneWaits;
+use crate::feeder_policy::FeederPolicy;
 use crate::gate::CycleTimeHistory;
 use crate::outage::Outage;
-use crate::run::RunRecord;
-use crate::tally::Cycles;
-
-/// One line's figures.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LineFigures {
-    /// Pallets the gate released.
-    pub released: u32,
-    /// Pallets that left the line done.
-    pub completed: u32,
-    /// Of them, cards with every chip of the work schedule.
-    pub good: u32,
-    /// Of them, cards that left with a chip missing (a step failed: Shin 1985, note 5).
-    pub short: u32,
-    /// Pallets still on the conveyor at the end.
-    pub in_progress: u32,
-    /// Pallets taken off the line (jams).
-    pub scrapped: u32,
-    /// Chips on the completed cards.
-    pub chips: u32,
-    /// Seconds between completed pallets: mean and worst.
-    pub cycle: Option<(f64, f64)>,
-}
+use crate::run_record::RunRecord;
+use crate::tally::{Cycles, LineFigures};
 
 /// One invariant, checked against what was measured.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -9,8 +9,8 @@ use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::devices::Pose;
+use crate::module_name::ModuleName;
 use crate::names::LineNames;
-use crate::ports::ModuleName;
 use crate::zone_asker::ZoneAsker;
 
 /// The most poses a reservation holds.

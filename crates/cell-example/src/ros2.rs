@@ -24,7 +24,7 @@ use imrs_zenoh::Host;
 use tokio::sync::mpsc::unbounded_channel;
 use tokio::task::JoinHandle;
 
-use crate::run::RunError;
+use crate::run_error::RunError;
 use crate::tally::Tally;
 
 /// How often the joints are published, on the cell's clock, while something moves.

@@ -3,6 +3,7 @@
 //! the ports of the cell, never on the length of the run.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use imrs_core::{Event, EventKind};
 use imrs_ports::Name;
@@ -10,7 +11,6 @@ use imrs_sim::{Line, PalletId, RobotId, SimEvent, SimEventKind, Station};
 
 use crate::alarms::AlarmKind;
 use crate::chip::{chips_per_card, place_of_chip};
-use crate::report::LineFigures;
 
 /// How far a chip may lie from its work-schedule place, in metres.
 pub const PLACE_TOLERANCE: f32 = 0.001;
@@ -18,6 +18,28 @@ pub const PLACE_TOLERANCE: f32 = 0.001;
 /// At most this many offending pallets are named per broken invariant; the rest are counted
 /// in the invariant's verdict all the same.
 const NAMED_OFFENDERS: usize = 16;
+
+/// One line's figures: counted here as the events come, but for the pallets in progress and
+/// the cycle, which the report adds at the end.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LineFigures {
+    /// Pallets the gate released.
+    pub released: u32,
+    /// Pallets that left the line done.
+    pub completed: u32,
+    /// Of them, cards with every chip of the work schedule.
+    pub good: u32,
+    /// Of them, cards that left with a chip missing (a step failed: Shin 1985, note 5).
+    pub short: u32,
+    /// Pallets still on the conveyor at the end.
+    pub in_progress: u32,
+    /// Pallets taken off the line (jams).
+    pub scrapped: u32,
+    /// Chips on the completed cards.
+    pub chips: u32,
+    /// Seconds between completed pallets: mean and worst.
+    pub cycle: Option<(f64, f64)>,
+}
 
 /// The gaps between completed pallets of one line: their sum (added gap by gap, in order),
 /// their number and the worst.
@@ -240,4 +262,9 @@ impl Tally {
     pub fn in_flight(&self) -> usize {
         self.placed.len() + self.screwed.len()
     }
+}
+
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // A fold is one call; a panic in it leaves the tally as the last whole event left it.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
 }

@@ -13,7 +13,7 @@ use imrs_ipc::{FromBytes, ZeroCopySend};
 use imrs_sim::Line;
 use serde::{Deserialize, Serialize};
 
-use crate::ports::ModuleName;
+use crate::module_name::ModuleName;
 
 /// A chip robot's word to the feeder zone's monitor: a fixed-size record that crosses
 /// processes as it is.

@@ -3,10 +3,10 @@
 
 use std::ffi::OsString;
 use std::os::unix::ffi::OsStringExt;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 use cell_example::{CellConfig, FeederPolicy, RunError, parse, run};
+use imrs_testkit::example_binary;
 
 fn args(list: &[&str]) -> Vec<OsString> {
     list.iter().map(OsString::from).collect()
@@ -127,16 +127,9 @@ fn a_fault_after_the_end_of_the_run_is_refused() {
     );
 }
 
-/// The example binary, built beside this test by `cargo test`.
-fn chip_cell() -> PathBuf {
-    let test = std::env::current_exe().unwrap();
-    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
-    profile_dir.join("examples").join("chip_cell")
-}
-
 #[test]
 fn a_reader_that_stops_reading_does_not_make_the_example_panic() {
-    let mut child = Command::new(chip_cell())
+    let mut child = Command::new(example_binary("chip_cell"))
         .args(["--hours", "0.01"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -152,7 +145,7 @@ fn a_reader_that_stops_reading_does_not_make_the_example_panic() {
 
 #[test]
 fn the_example_refuses_a_non_utf8_argument_with_status_2() {
-    let output = Command::new(chip_cell())
+    let output = Command::new(example_binary("chip_cell"))
         .arg(OsString::from_vec(vec![0xff]))
         .output()
         .expect("the example is built with the tests");
@@ -163,7 +156,7 @@ fn the_example_refuses_a_non_utf8_argument_with_status_2() {
 
 #[test]
 fn the_example_draws_the_appendix_module_tree() {
-    let output = Command::new(chip_cell())
+    let output = Command::new(example_binary("chip_cell"))
         .args(["--hours", "0.01", "--tree"])
         .output()
         .expect("the example is built with the tests");
@@ -190,7 +183,7 @@ fn the_example_records_and_draws_as_the_readme_says() {
     let dir = std::env::temp_dir().join(format!("imrs-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (mcap, svg) = (dir.join("cell.mcap"), dir.join("cell.svg"));
-    let output = Command::new(chip_cell())
+    let output = Command::new(example_binary("chip_cell"))
         .args(["--hours", "0.02", "--feeder", "appendix", "--record"])
         .arg(&mcap)
         .arg("--timeline")
@@ -210,7 +203,7 @@ fn the_example_records_and_draws_as_the_readme_says() {
 #[test]
 fn rust_log_shows_what_the_core_emits_and_nothing_without_it() {
     let run_with = |log: Option<&str>| {
-        let mut command = Command::new(chip_cell());
+        let mut command = Command::new(example_binary("chip_cell"));
         command.args(["--hours", "0.02", "--feeder", "appendix"]);
         match log {
             Some(filter) => command.env("RUST_LOG", filter),

@@ -11,17 +11,11 @@
 //! leaves 28 ms of wall time for the round trip to the world and back; at ×20, 85 ms, and
 //! at ×10, 170 ms.
 
-use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
-/// The example binary, built beside this test by `cargo test`.
-fn chip_cell() -> PathBuf {
-    let test = std::env::current_exe().unwrap();
-    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
-    profile_dir.join("examples").join("chip_cell")
-}
+use imrs_testkit::example_binary;
 
 /// The processes `pid` started, as Linux lists them.
 fn children_of(pid: u32) -> Vec<u32> {
@@ -84,7 +78,7 @@ impl World {
     fn start(args: &[&str]) -> Self {
         // A test that failed holding the lock left no cell behind: `Drop` killed it.
         let alone = ONE_CELL.lock().unwrap_or_else(PoisonError::into_inner);
-        let child = Command::new(chip_cell())
+        let child = Command::new(example_binary("chip_cell"))
             .arg("--processes")
             .args(args)
             .stdout(Stdio::piped())
@@ -536,7 +530,7 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
             "--transport zenoh with --feeder appendix",
         ),
     ] {
-        let output = Command::new(chip_cell())
+        let output = Command::new(example_binary("chip_cell"))
             .arg("--processes")
             .args(flags)
             .output()
@@ -555,7 +549,10 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
         &["--transport", "zenoh"][..],
         &["--processes", "--speed", "0.5"][..],
     ] {
-        let output = Command::new(chip_cell()).args(flags).output().unwrap();
+        let output = Command::new(example_binary("chip_cell"))
+            .args(flags)
+            .output()
+            .unwrap();
         let errors = String::from_utf8_lossy(&output.stderr);
         assert_eq!(output.status.code(), Some(2), "{flags:?}: {errors}");
         assert!(

@@ -3,19 +3,15 @@
 //! note-6 deadlock of the Appendix's scheme on the timeline.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::time::Duration;
 
 use cell_example::{CellConfig, FeederPolicy, TimelineConfig, run};
 use imrs_core::EventKind;
+use imrs_testkit::temp_path;
 use serde_json::Value;
 
-fn temp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("imrs-chip-{}-{name}", std::process::id()))
-}
-
 fn recorded(name: &str, feeder: FeederPolicy) -> (cell_example::RunRecord, Vec<u8>) {
-    let path = temp(name);
+    let path = temp_path("imrs-chip", name);
     let config = CellConfig {
         hours: 0.05,
         seed: 1985,
@@ -96,7 +92,7 @@ fn a_recorded_run_holds_every_event_on_channels_with_schemas_and_an_index() {
         });
     assert!(reported, "FREQUENCY shows the cycle times sent on it");
     let summed = {
-        let path = temp("summed.mcap");
+        let path = temp_path("imrs-chip", "summed.mcap");
         std::fs::write(&path, &bytes).unwrap();
         let summary = imrs_record::read_summary(&path).unwrap();
         std::fs::remove_file(&path).unwrap();
@@ -150,7 +146,7 @@ fn recording_changes_nothing_the_cell_does() {
 
 #[test]
 fn the_timeline_of_the_appendix_scheme_shows_its_deadlock() {
-    let path = temp("appendix.svg");
+    let path = temp_path("imrs-chip", "appendix.svg");
     let config = CellConfig {
         hours: 0.05,
         feeder: FeederPolicy::Appendix,
@@ -193,7 +189,7 @@ fn a_recording_that_cannot_be_written_is_refused_by_name() {
 #[test]
 fn the_timeline_keeps_only_its_window_however_long_the_run() {
     let draw = |hours: f64| {
-        let path = temp(&format!("window-{hours}.svg"));
+        let path = temp_path("imrs-chip", &format!("window-{hours}.svg"));
         let config = CellConfig {
             hours,
             feeder: FeederPolicy::Appendix,

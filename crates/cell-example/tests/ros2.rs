@@ -2,46 +2,20 @@
 //! on `rmw_zenoh`'s conventions, not ours) lists the cell's topics and service, reads the
 //! robots' joints, receives the alarm a robot fault raises, and asks the status.
 
-use std::net::TcpListener;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 use cell_example::alarms::AlarmKind;
+use imrs_testkit::{example_binary, free_endpoint, python_with};
 
-/// The example binary, built beside this test by `cargo test`.
-fn chip_cell() -> PathBuf {
-    let test = std::env::current_exe().unwrap();
-    let profile_dir = test.parent().and_then(|deps| deps.parent()).unwrap();
-    profile_dir.join("examples").join("chip_cell")
-}
-
-/// Python 3 with zenoh-ros2-sdk, installed with pip where it is missing.
-fn python_with_ros2_client() -> &'static str {
-    let importable = || {
-        Command::new("python3")
-            .args(["-c", "import zenoh_ros2_sdk"])
-            .status()
-            .is_ok_and(|status| status.success())
-    };
-    if !importable() {
-        let installed = Command::new("python3")
-            .args(["-m", "pip", "install", "--quiet", "zenoh-ros2-sdk==0.1.8"])
-            .status()
-            .expect("python3 runs");
-        assert!(installed.success(), "pip could not install zenoh-ros2-sdk");
-    }
-    "python3"
-}
+/// The Python package the test drives: a ROS 2 client on `rmw_zenoh`'s conventions.
+const ROS2_CLIENT: &str = "zenoh-ros2-sdk==0.1.8";
 
 #[test]
 fn a_ros_2_client_lists_the_cell_reads_its_joints_and_alarms_and_asks_its_status() {
-    let python = python_with_ros2_client();
-    let endpoint = {
-        let listener = TcpListener::bind("127.0.0.1:0").expect("a free port on loopback");
-        format!("tcp/{}", listener.local_addr().expect("its address"))
-    };
+    let python = python_with("zenoh_ros2_sdk", ROS2_CLIENT);
+    let endpoint = free_endpoint();
     // Twenty seconds on the wall clock, line A's RELEASE dying at 10 s: an alarm.
-    let cell = Command::new(chip_cell())
+    let cell = Command::new(example_binary("chip_cell"))
         .args([
             "--ros2",
             &endpoint,

@@ -10,6 +10,7 @@ use std::time::Duration;
 use imrs_core::prelude::*;
 use imrs_core::time::drive;
 use imrs_core::{Pool, WaitFor, WaitForError};
+use imrs_testkit::poll_once;
 
 /// `n` tasks named T0..Tn each pool their number after `i` seconds; each combines the pool
 /// its own way (its number times 1000 plus the sum of all). Returns, for each task, its
@@ -286,10 +287,4 @@ fn a_waiter_dropped_after_its_round_was_released_takes_nothing_from_the_next() {
         );
         assert_eq!((a, b), (Ok("b2"), Ok("a2")));
     });
-}
-
-/// One poll of `future`, with a waker that does nothing.
-fn poll_once<F: std::future::Future>(future: std::pin::Pin<&mut F>) -> std::task::Poll<F::Output> {
-    let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
-    future.poll(&mut cx)
 }

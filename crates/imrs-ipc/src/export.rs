@@ -660,7 +660,7 @@ mod tests {
     use imrs_ports::{AnyUser, PortSpec};
 
     use super::*;
-    use crate::import::connect;
+    use crate::connect::connect;
     use crate::wire::RequestMeta;
     use crate::{FromBytes, ZeroCopySend};
 

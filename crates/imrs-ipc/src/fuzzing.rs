@@ -24,5 +24,5 @@ pub fn connection_answer(
     module: &str,
 ) -> Option<Result<bool, IpcError>> {
     let (meta, _) = ReplyMeta::read_from_prefix(bytes).ok()?;
-    Some(crate::import::answered(meta, port, module))
+    Some(crate::connect::answered(meta, port, module))
 }

@@ -154,6 +154,7 @@
 mod bridge;
 mod broadcast;
 mod carry;
+mod connect;
 mod dispatch;
 mod entry;
 mod error;

@@ -16,8 +16,9 @@ use std::sync::{Arc, Mutex};
 use crate::bridge::is_served;
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
+use crate::connect::connect;
 use crate::export::{Forward, Refusal, bridge};
-use crate::import::{Relay, SharedAsker, Take, connect, keep_attached, relay};
+use crate::import::{Relay, SharedAsker, Take, keep_attached, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 
 /// The service a remote user module is served on.

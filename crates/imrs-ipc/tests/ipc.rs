@@ -5,13 +5,14 @@
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use imrs_ipc::{FromBytes, Imported, IpcError, Remote, ZeroCopySend, export, import};
 use imrs_ports::{
     AnyUser, End, Name, Port, PortSpec, ProcessType, ReplyHandle, SendError, Shared, WireError,
     usage,
 };
+use imrs_testkit::unique_name;
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -82,13 +83,6 @@ fn assert_inspected(mut answer: Shared<Frame>, seed: u64, factor: u64) {
     for at in [4, 5, 4096, 8191] {
         assert_eq!(answer.words[at], word(seed, at).wrapping_mul(factor));
     }
-}
-
-fn cell(test: &str) -> String {
-    let nanos = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    format!("t{}-{test}-{nanos}", std::process::id())
 }
 
 /// A child process, killed when the test ends however it ends.
@@ -245,7 +239,7 @@ async fn within<T>(seconds: u64, future: impl Future<Output = T>) -> T {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_send_crosses_to_the_owners_process_and_its_reply_comes_back() {
-    let cell = cell("send");
+    let cell = unique_name("send");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -262,7 +256,7 @@ async fn a_send_crosses_to_the_owners_process_and_its_reply_comes_back() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn two_user_processes_are_served_at_once() {
-    let cell = cell("users");
+    let cell = unique_name("users");
     let _owner = owner(&cell, "DOUBLE");
     let users: Vec<Peer> = ["ASKER", "ASKER_2"]
         .iter()
@@ -277,7 +271,7 @@ async fn two_user_processes_are_served_at_once() {
 /// of that may need the runtime, and every reply must cross.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn replies_given_outside_the_runtime_cross_while_requests_keep_coming() {
-    let cell = cell("outside");
+    let cell = unique_name("outside");
     let remote = Remote::new(&cell).unwrap();
     let modules = ["ASKER", "ASKER_2", "ASKER_3", "ASKER_4"];
     let port: Port<Number, Number, usage::Receive, AnyUser, 4> =
@@ -337,7 +331,7 @@ fn block_on<F: Future>(future: F) -> F::Output {
 /// bridge must need nothing of the runtime there, and the reply must still come.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_send_polled_outside_the_runtime_crosses_and_its_reply_wakes_it() {
-    let cell = cell("outside-send");
+    let cell = unique_name("outside-send");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -359,7 +353,7 @@ async fn a_send_polled_outside_the_runtime_crosses_and_its_reply_wakes_it() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_module_not_on_the_user_list_is_refused_by_name() {
-    let cell = cell("unlisted");
+    let cell = unique_name("unlisted");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let error = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -379,7 +373,7 @@ async fn a_module_not_on_the_user_list_is_refused_by_name() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_type_the_other_process_does_not_share_is_refused_naming_the_port() {
-    let cell = cell("types");
+    let cell = unique_name("types");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let error =
@@ -394,7 +388,7 @@ async fn a_type_the_other_process_does_not_share_is_refused_naming_the_port() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_killed_mid_rendezvous_fails_the_sender_and_its_restart_is_served() {
-    let cell = cell("kill");
+    let cell = unique_name("kill");
     let mut first = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -421,7 +415,7 @@ async fn an_owner_killed_mid_rendezvous_fails_the_sender_and_its_restart_is_serv
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn two_cells_with_the_same_port_names_never_meet() {
-    let (a, b) = (cell("cell-a"), cell("cell-b"));
+    let (a, b) = (unique_name("cell-a"), unique_name("cell-b"));
     // Were their services one, the second owner would be refused: one owner per port.
     let _owner_a = owner(&a, "DOUBLE");
     let _owner_b = owner(&b, "DOUBLE");
@@ -480,7 +474,7 @@ struct ReplyMeta {
 async fn a_malformed_request_is_refused_and_the_owner_keeps_serving() {
     use iceoryx2::prelude::*;
 
-    let cell = cell("garbage");
+    let cell = unique_name("garbage");
     let _owner = owner(&cell, "DOUBLE");
     let node = NodeBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
@@ -541,7 +535,7 @@ async fn a_malformed_request_is_refused_and_the_owner_keeps_serving() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_user_timeout_holds_across_processes_and_the_late_reply_harms_nothing() {
-    let cell = cell("timeout");
+    let cell = unique_name("timeout");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -582,7 +576,7 @@ async fn a_user_timeout_holds_across_processes_and_the_late_reply_harms_nothing(
 async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
     use std::os::unix::fs::PermissionsExt;
 
-    let cell = cell("permissions");
+    let cell = unique_name("permissions");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -659,7 +653,7 @@ async fn a_ports_shared_memory_and_service_files_are_for_the_cells_user_only() {
 async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
     use imrs_ports::{AnyUser, Port, PortSpec, select, usage};
 
-    let cell = cell("select");
+    let cell = unique_name("select");
     // This process owns both: DOUBLE, used from another process, and LOCAL, from here.
     let remote_port: Port<Number, Number, usage::Receive, AnyUser, 2> = Port::new(
         PortSpec::new("DOUBLE", "DOUBLER")
@@ -701,7 +695,7 @@ async fn an_owner_selects_over_an_exported_port_and_a_local_one() {
 async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
     use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
-    let cell = cell("user-killed");
+    let cell = unique_name("user-killed");
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -726,7 +720,7 @@ async fn a_user_killed_mid_rendezvous_harms_nobody_and_its_restart_is_served() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
-    let cell = cell("query");
+    let cell = unique_name("query");
     let mut responder = peer(&["responder", &cell, "TRIPLE"]);
     let stdout = responder.0.stdout.take().expect("piped");
     let mut line = String::new();
@@ -764,7 +758,7 @@ async fn a_query_crosses_and_the_owners_response_handler_answers_it() {
 async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_back() {
     use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
-    let cell = cell("send-all");
+    let cell = unique_name("send-all");
     let port: Port<Number, Number, usage::SendAll, AnyUser, 2> =
         Port::new(PortSpec::new("NEWS", "BROADCASTER").user_list(["ASKER", "ASKER_2"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -794,7 +788,7 @@ async fn a_broadcast_reaches_users_in_other_processes_and_their_replies_come_bac
 async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
     use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
-    let cell = cell("full");
+    let cell = unique_name("full");
     // Room for one user, whoever it is.
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("SINGLE", "OWNER"));
@@ -819,7 +813,7 @@ async fn a_port_full_of_users_refuses_one_more_process_with_its_capacity() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() {
-    let cell = cell("dropped");
+    let cell = unique_name("dropped");
     let _owner = owner(&cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -844,7 +838,7 @@ async fn a_send_dropped_halfway_loses_nothing_and_the_next_gets_its_own_reply() 
 async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceoryx2s_default() {
     use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
-    let cell = cell("many");
+    let cell = unique_name("many");
     // Three times iceoryx2's default of 8 clients to a service.
     const USERS: usize = 24;
     let port: Port<Number, Number, usage::Receive, AnyUser, USERS> =
@@ -894,7 +888,7 @@ async fn a_port_admits_as_many_user_processes_as_its_restrictions_say_not_iceory
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn importing_a_port_that_nobody_exports_says_so_at_once() {
-    let remote = Remote::new(&cell("nobody")).unwrap();
+    let remote = Remote::new(&unique_name("nobody")).unwrap();
     let started = std::time::Instant::now();
     let error =
         import::<Imported<Number, Number, usage::Receive>, _>(&remote, "NOBODYS", "OWNER", "USER")
@@ -914,7 +908,7 @@ async fn importing_a_port_that_nobody_exports_says_so_at_once() {
 async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_this_one() {
     use imrs_ports::{AnyUser, Port, PortSpec, usage};
 
-    let cell = cell("call-all");
+    let cell = unique_name("call-all");
     let port: Port<Number, Number, usage::CallAll, AnyUser, 3> =
         Port::new(PortSpec::new("POLL", "CALLER").user_list(["REMOTE_1", "REMOTE_2", "LOCAL"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -960,7 +954,7 @@ async fn a_callall_query_reaches_response_handlers_in_other_processes_and_in_thi
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_sender() {
-    let cell = cell("tight");
+    let cell = unique_name("tight");
     let remote = Remote::new(&cell).unwrap();
     let mut owner = started_owner("tight-owner", &cell, "DOUBLE");
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -990,7 +984,7 @@ async fn a_tight_port_crosses_as_any_other_and_a_dead_owner_still_fails_the_send
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_tight_port_is_served_whether_the_other_side_spins_or_has_parked() {
-    let cell = cell("tight-turns");
+    let cell = unique_name("tight-turns");
     let _owner = started_owner("tight-owner", &cell, "DOUBLE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Number, Number, usage::Receive>, _>(
@@ -1028,7 +1022,7 @@ async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_do
 
     // The port keeps the bridge's turns, and the bridge keeps the port: dropping the export
     // must still let the bridge go, with its hold on the port.
-    let cell = cell("tight-dropped");
+    let cell = unique_name("tight-dropped");
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
     let exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1046,7 +1040,7 @@ async fn a_tight_port_whose_export_is_dropped_closes_as_a_port_of_one_process_do
 async fn an_owners_query_reaches_its_user_in_another_process_and_a_gone_user_fails_it() {
     use imrs_ports::{AnyUser, Port, PortSpec, QueryError, usage};
 
-    let cell = cell("query");
+    let cell = unique_name("query");
     // ASK_STATUS(N): USAGE=QUERY, USERLIST=(CHILD): the parent asks its child.
     let port: Port<Number, Number, usage::Query, AnyUser, 1> =
         Port::new(PortSpec::new("ASK_STATUS", "PARENT").user_list(["CHILD"]));
@@ -1080,7 +1074,7 @@ fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
         .enable_time()
         .build()
         .unwrap();
-    let cell = cell("no-io");
+    let cell = unique_name("no-io");
     runtime.block_on(async {
         let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
             Port::new(PortSpec::new("QUIET", "OWNER"));
@@ -1097,7 +1091,7 @@ fn a_runtime_without_its_io_driver_is_refused_by_name_not_by_a_panic() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
-    let cell = cell("shared");
+    let cell = unique_name("shared");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
@@ -1152,7 +1146,7 @@ async fn a_frame_built_in_a_loan_is_read_in_place_and_so_is_its_reply() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn loans_beyond_what_the_port_allows_are_refused_by_name_and_one_given_back_is_lent_again() {
-    let cell = cell("loans");
+    let cell = unique_name("loans");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
@@ -1191,7 +1185,7 @@ async fn loans_beyond_what_the_port_allows_are_refused_by_name_and_one_given_bac
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served() {
-    let cell = cell("copied");
+    let cell = unique_name("copied");
     let _vision = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
@@ -1221,7 +1215,7 @@ async fn a_frame_on_the_heap_or_in_another_ports_loan_is_copied_once_and_served(
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_handler() {
-    let cell = cell("shared-query");
+    let cell = unique_name("shared-query");
     let _inspector = started_owner("inspector", &cell, "INSPECT");
     let remote = Remote::new(&cell).unwrap();
     let imported = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::Response>, _>(
@@ -1247,7 +1241,7 @@ async fn a_query_built_in_a_loan_is_answered_in_place_by_the_owners_response_han
 /// loan, which the owner reads in place.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_process() {
-    let cell = cell("shared-owner-query");
+    let cell = unique_name("shared-owner-query");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::Query, AnyUser, 1> =
         Port::new(PortSpec::new("ASK_FRAME", "PARENT").user_list(["CHILD"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1297,7 +1291,7 @@ async fn an_owners_query_of_frames_is_answered_in_place_by_its_user_in_another_p
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn loans_held_while_their_owner_dies_fail_by_name_and_serve_its_restart() {
-    let cell = cell("loan-kill");
+    let cell = unique_name("loan-kill");
     let mut first = started_owner("vision", &cell, "IMAGE");
     let remote = Remote::new(&cell).unwrap();
     let imported = import::<Imported<Shared<Frame>, Shared<Frame>, usage::Receive>, _>(
@@ -1364,7 +1358,7 @@ fn nodes_of(pid: u32) -> Vec<&'static str> {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_process_killed_while_nobody_waited_on_it_is_swept_by_the_next_to_start() {
-    let mut killed = owner(&cell("killed-idle"), "DOUBLE");
+    let mut killed = owner(&unique_name("killed-idle"), "DOUBLE");
     let pid = killed.0.id();
     assert!(nodes_of(pid).contains(&"alive"), "{:?}", nodes_of(pid));
     // Killed with no request waiting on it: no bridge looks for it, and its shared memory
@@ -1375,7 +1369,7 @@ async fn a_process_killed_while_nobody_waited_on_it_is_swept_by_the_next_to_star
     assert!(!nodes_of(pid).contains(&"alive"), "{:?}", nodes_of(pid));
     // The next process to wire a port across processes, in any cell, removes it: iceoryx2
     // sweeps the host's dead nodes whenever a node is created, as each crossing port does.
-    let _next = owner(&cell("next"), "DOUBLE");
+    let _next = owner(&unique_name("next"), "DOUBLE");
     assert_eq!(
         nodes_of(pid),
         Vec::<&str>::new(),
@@ -1434,7 +1428,7 @@ async fn answered_every_frame(users: Vec<Peer>) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes() {
-    let cell = cell("shared-send-all");
+    let cell = unique_name("shared-send-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1454,7 +1448,7 @@ async fn a_broadcast_of_frames_is_read_in_place_by_users_in_two_other_processes(
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_processes() {
-    let cell = cell("shared-call-all");
+    let cell = unique_name("shared-call-all");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::CallAll, AnyUser, 2> =
         Port::new(PortSpec::new("LOOK", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1473,7 +1467,7 @@ async fn a_callall_of_frames_is_answered_in_place_by_handlers_in_two_other_proce
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_broadcast_of_frames_to_a_user_process_killed_ends_with_the_others_answers_and_its_restart_is_served()
  {
-    let cell = cell("shared-send-all-kill");
+    let cell = unique_name("shared-send-all-kill");
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> =
         Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1559,7 +1553,7 @@ async fn read_in_place_here_and_in_two_other_processes(
     test: &str,
     build: impl Fn(&mut imrs_ports::End<Shared<Frame>, Shared<Frame>, usage::SendAll>) -> Shared<Frame>,
 ) {
-    let cell = cell(test);
+    let cell = unique_name(test);
     let port: Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 3> =
         Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT", "HERE"]));
     let _exported = imrs_ipc::export(&Remote::new(&cell).unwrap(), &port).unwrap();
@@ -1611,7 +1605,7 @@ async fn read_in_place_here_and_in_two_other_processes(
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_unlisted_module() {
-    let cell = cell("shared-send-all-refused");
+    let cell = unique_name("shared-send-all-refused");
     let remote = Remote::new(&cell).unwrap();
     let nobody = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
         &remote, "FRAMES", "CAMERA", "LEFT",
@@ -1651,7 +1645,7 @@ async fn a_broadcast_port_of_frames_refuses_an_absent_owner_a_wrong_type_and_an_
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_processes() {
-    let cell = cell("shared-send-all-again");
+    let cell = unique_name("shared-send-all-again");
     let remote = Remote::new(&cell).unwrap();
     let declare = || -> Port<Shared<Frame>, Shared<Frame>, usage::SendAll, AnyUser, 2> {
         Port::new(PortSpec::new("FRAMES", "CAMERA").user_list(["LEFT", "RIGHT"]))
@@ -1684,7 +1678,7 @@ async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_pr
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_of_broadcasts_killed_mid_run_and_started_again_reaches_its_user_again() {
-    let cell = cell("shared-send-all-owner-killed");
+    let cell = unique_name("shared-send-all-owner-killed");
     let mut first = started(&["camera", &cell, "FRAMES", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
     let imported = imrs_ipc::import::<Imported<Shared<Frame>, Shared<Frame>, usage::SendAll>, _>(
@@ -1747,7 +1741,7 @@ fn five_times(_: &(), number: Number) -> Number {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_again() {
-    let cell = cell("query-owner-killed");
+    let cell = unique_name("query-owner-killed");
     let first = started(&["parent", &cell, "ASK_STATUS", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
     let imported = imrs_ipc::import::<Imported<Number, Number, usage::Query>, _>(
@@ -1765,7 +1759,7 @@ async fn an_owner_of_queries_killed_mid_run_and_started_again_reaches_its_user_a
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_of_callalls_killed_mid_run_and_started_again_reaches_its_user_again() {
-    let cell = cell("call-all-owner-killed");
+    let cell = unique_name("call-all-owner-killed");
     let first = started(&["caller", &cell, "POLL", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
     let imported = imrs_ipc::import::<Imported<Number, Number, usage::CallAll>, _>(
@@ -1780,7 +1774,7 @@ async fn an_owner_of_callalls_killed_mid_run_and_started_again_reaches_its_user_
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_owner_of_broadcasts_of_numbers_killed_mid_run_and_started_again_reaches_its_user_again()
 {
-    let cell = cell("send-all-owner-killed");
+    let cell = unique_name("send-all-owner-killed");
     let first = started(&["announcer", &cell, "NEWS", "1000000"]);
     let remote = Remote::new(&cell).unwrap();
     let imported = imrs_ipc::import::<Imported<Number, Number, usage::SendAll>, _>(
@@ -1843,7 +1837,7 @@ async fn answers_an_owner_killed_and_started_again(
 /// owner's process, so that claims without end grow nothing there.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_refused_claim_leaves_no_name_in_the_owners_process() {
-    let cell = cell("claims");
+    let cell = unique_name("claims");
     let remote = Remote::new(&cell).unwrap();
     let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
         Port::new(PortSpec::new("DOUBLE", "DOUBLER").user_list(["ASKER"]));

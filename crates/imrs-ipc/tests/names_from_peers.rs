@@ -6,10 +6,11 @@
 
 use std::io::Read;
 use std::process::{Command, Stdio};
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use imrs_ipc::{FromBytes, Remote, ZeroCopySend, export};
 use imrs_ports::{AnyUser, Name, Port, PortSpec, usage};
+use imrs_testkit::unique_name;
 
 /// The peer's message: the same by name, size and alignment.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
@@ -50,10 +51,7 @@ async fn user(cell: &str, module: &str) -> (Option<i32>, String) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_new_name_past_the_bound_is_refused_by_name_across_processes() {
-    let nanos = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.subsec_nanos());
-    let cell = format!("t{}-names-{nanos}", std::process::id());
+    let cell = unique_name("names");
     let remote = Remote::new(&cell).unwrap();
     let open: Port<Number, Number, usage::Receive, AnyUser, 4> =
         Port::new(PortSpec::new("OPEN", "DOUBLER"));

@@ -8,6 +8,7 @@ use common::{on_both_runtimes, until, until_sleepers, virtual_clock};
 use imrs_ports::{
     AnyUser, BoundedBuffer, BoundedBufferPort, Named, PortSpec, SendError, user_list,
 };
+use imrs_testkit::poll_once;
 
 struct LoadIt;
 impl Named for LoadIt {
@@ -124,11 +125,6 @@ fn a_shown_filtered_port_shows_both_sides() {
     let owner = port.owner().unwrap();
     let shown = owner.shown().expect("FILTER shows its values");
     assert_eq!((shown.reply)(&Some((1, 9.0))), "Some((1, 9.0))");
-}
-
-/// One poll of `future`, with a waker that does nothing.
-fn poll_once<F: std::future::Future>(future: std::pin::Pin<&mut F>) -> std::task::Poll<F::Output> {
-    future.poll(&mut std::task::Context::from_waker(std::task::Waker::noop()))
 }
 
 #[test]

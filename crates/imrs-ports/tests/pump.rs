@@ -2,14 +2,13 @@
 //! the transport a turn between their looks, in the waiting module's own thread, and tell it
 //! when they park; waits that park at once give none.
 
-use std::future::Future;
-use std::pin::pin;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-use std::task::{Context, Poll, Waker};
+use std::task::Poll;
 
 use imrs_ports::transport::{EndTransport as _, PortTransport as _, Pump};
 use imrs_ports::{End, Port, PortSpec, ProcessType, usage};
+use imrs_testkit::poll_once;
 
 type Doubler = Port<u64, u64, usage::Receive>;
 
@@ -35,14 +34,6 @@ impl Pump for Counting {
     fn parking(&self) {
         self.0.parkings.fetch_add(1, Ordering::Relaxed);
     }
-}
-
-/// Polls `future` once, as an executor would before it parks the task.
-fn poll_once<F: Future>(future: F) -> Poll<F::Output> {
-    let mut future = pin!(future);
-    future
-        .as_mut()
-        .poll(&mut Context::from_waker(Waker::noop()))
 }
 
 #[test]

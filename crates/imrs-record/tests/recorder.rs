@@ -7,10 +7,11 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use common::{name, run, temp};
+use common::{name, run};
 use foxglove::messages::{FrameTransforms, Log, SceneUpdate};
 use imrs_core::EventKind;
 use imrs_record::{Recorder, read_summary};
+use imrs_testkit::temp_path;
 use prost::Message as _;
 use serde_json::Value;
 
@@ -18,7 +19,7 @@ use serde_json::Value;
 type Read = (String, String, u64, Vec<u8>);
 
 fn record(file: &str) -> (common::Ran, Vec<Read>, std::path::PathBuf) {
-    let path = temp(file);
+    let path = temp_path("imrs-record", file);
     let recorder = Recorder::create(&path).unwrap();
     let ran = run(Some(&recorder), None);
     let recorded = recorder.finish().unwrap();
@@ -125,7 +126,7 @@ fn every_event_is_on_its_channel_with_a_schema_and_the_file_has_its_summary_and_
 }
 
 fn read_summary_of(bytes: &[u8]) -> imrs_record::RecordingSummary {
-    let path = temp("again.mcap");
+    let path = temp_path("imrs-record", "again.mcap");
     std::fs::write(&path, bytes).unwrap();
     let summary = read_summary(&path).unwrap();
     std::fs::remove_file(&path).unwrap();
@@ -209,7 +210,7 @@ fn the_scene_decodes_in_foxglove_schemas_and_agrees_with_rapier() {
 /// present, every field of the type the schema gives it.
 #[test]
 fn the_json_messages_match_their_json_schemas() {
-    let path = temp("json.mcap");
+    let path = temp_path("imrs-record", "json.mcap");
     let recorder = Recorder::create(&path).unwrap();
     run(Some(&recorder), None);
     recorder.finish().unwrap();
@@ -269,7 +270,7 @@ fn the_same_run_records_the_same_messages_in_the_same_order_at_the_same_times() 
 
 #[test]
 fn a_recording_is_finished_once_and_a_file_that_cannot_be_made_is_named() {
-    let path = temp("twice.mcap");
+    let path = temp_path("imrs-record", "twice.mcap");
     let recorder = Recorder::create(&path).unwrap();
     recorder.finish().unwrap();
     let again = recorder.finish().unwrap_err().to_string();
@@ -313,7 +314,7 @@ fn two_recordings_made_at_once_on_two_threads_never_mix() {
 
 #[test]
 fn messages_that_come_after_finish_are_dropped_and_the_file_stays_whole() {
-    let path = temp("finished-early.mcap");
+    let path = temp_path("imrs-record", "finished-early.mcap");
     let recorder = Recorder::create(&path).unwrap();
     let finished = recorder.finish().unwrap();
     let before = std::fs::read(&path).unwrap();

@@ -3,11 +3,12 @@
 
 mod common;
 
-use common::{run, temp};
+use common::run;
 use imrs_record::{RecordError, Recorder, read_summary};
+use imrs_testkit::temp_path;
 
 fn recorded() -> Vec<u8> {
-    let path = temp("whole.mcap");
+    let path = temp_path("imrs-record", "whole.mcap");
     let recorder = Recorder::create(&path).unwrap();
     run(Some(&recorder), None);
     recorder.finish().unwrap();
@@ -17,7 +18,7 @@ fn recorded() -> Vec<u8> {
 }
 
 fn summary_of(name: &str, bytes: &[u8]) -> Result<imrs_record::RecordingSummary, RecordError> {
-    let path = temp(name);
+    let path = temp_path("imrs-record", name);
     std::fs::write(&path, bytes).unwrap();
     let read = read_summary(&path);
     std::fs::remove_file(&path).unwrap();
@@ -86,6 +87,8 @@ fn random_bytes_an_empty_file_and_a_damaged_middle_are_refused_not_panicked_on()
         .unwrap_err()
         .to_string();
     assert!(error.contains("not a readable MCAP recording"), "{error}");
-    let missing = read_summary(temp("missing.mcap")).unwrap_err().to_string();
+    let missing = read_summary(temp_path("imrs-record", "missing.mcap"))
+        .unwrap_err()
+        .to_string();
     assert!(missing.contains("missing.mcap"), "{missing}");
 }

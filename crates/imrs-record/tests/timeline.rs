@@ -3,10 +3,11 @@
 
 mod common;
 
-use common::{run, secs, temp};
+use common::{run, secs};
 use imrs_record::Timeline;
 use imrs_record::timeline::{MarkKind, SpanKind};
 use imrs_sim::SimEventKind;
+use imrs_testkit::temp_path;
 
 #[test]
 fn the_deadlock_shows_as_both_robots_waiting_on_each_other_and_a_mark() {
@@ -85,7 +86,7 @@ fn only_the_window_is_kept() {
 fn the_picture_is_drawn_with_a_row_per_module_and_robot() {
     let timeline = Timeline::new(secs(0), secs(40));
     run(None, Some(&timeline));
-    let path = temp("timeline.svg");
+    let path = temp_path("imrs-record", "timeline.svg");
     timeline.render_svg(&path).unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
     std::fs::remove_file(&path).unwrap();

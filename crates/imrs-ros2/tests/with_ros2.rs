@@ -4,8 +4,6 @@
 //! `zenoh-ros2-sdk`, a ROS 2 client on those conventions from PyPI that computes the type
 //! hashes and keys itself.
 
-use std::net::TcpListener;
-use std::process::Command;
 use std::time::Duration;
 
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
@@ -14,35 +12,13 @@ use imrs_ros2::msgs::sensor_msgs::JointState;
 use imrs_ros2::msgs::std_msgs::{self, Header};
 use imrs_ros2::msgs::std_srvs::{Trigger, TriggerRequest, TriggerResponse};
 use imrs_ros2::{Bridge, Node, ros_message, ros_service};
+use imrs_testkit::{free_endpoint, python_with};
 use imrs_zenoh::Host;
 
 /// The Python packages the tests drive: zenoh at the version of the zenoh crate, and the
 /// ROS 2 client on it.
 const ZENOH: &str = "eclipse-zenoh==1.10.2";
 const ROS2_CLIENT: &str = "zenoh-ros2-sdk==0.1.8";
-
-/// Python 3 with `module` importable, `package` installed with pip where it is missing.
-fn python_with(module: &str, package: &str) -> &'static str {
-    let importable = || {
-        Command::new("python3")
-            .args(["-c", &format!("import {module}")])
-            .status()
-            .is_ok_and(|status| status.success())
-    };
-    if !importable() {
-        let installed = Command::new("python3")
-            .args(["-m", "pip", "install", "--quiet", package])
-            .status()
-            .expect("python3 runs");
-        assert!(installed.success(), "pip could not install {package}");
-    }
-    "python3"
-}
-
-fn free_endpoint() -> String {
-    let listener = TcpListener::bind("127.0.0.1:0").expect("a free port on loopback");
-    format!("tcp/{}", listener.local_addr().expect("its address"))
-}
 
 /// A host listening on `endpoint`, with node /chip_cell on it.
 async fn chip_cell_node(endpoint: &str) -> (Host, Node) {

@@ -1,73 +1,18 @@
-//! A schema network: the top-level assemblage, the processor its instances run on, and the
-//! trace of their lives.
+//! A schema network: the handle to its top-level assemblage, through which the cell
+//! instantiates at the top, reads the trace, and stops every instance.
 
-use std::fmt;
 use std::sync::Arc;
 
-use imrs_core::{Log, Processor, Record};
-use imrs_ports::{Instant, Name, SharedClock};
+use imrs_core::{Log, Processor};
+use imrs_ports::{Name, SharedClock};
 
 use crate::cx::Cx;
 use crate::error::SchemaError;
 use crate::instance::Si;
+use crate::net::Net;
 use crate::schema::Schema;
 use crate::scope::Scope;
-
-/// How an instance ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Ending {
-    /// Its behaviour said `STOP` (for a task-unit: its r-schema did).
-    Stopped,
-    /// Another instance (or the network) deinstantiated it, or the assemblage it is in
-    /// ended.
-    Deinstantiated,
-    /// An assemblage whose components had all ended.
-    ComponentsEnded,
-    /// Its behaviour failed.
-    Failed(SchemaError),
-}
-
-/// One line of a network's trace.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TraceEntry {
-    /// When, on the network's clock.
-    pub at: Instant,
-    /// The instance.
-    pub instance: Name,
-    /// `None` when it was instantiated; how it ended, when it ended.
-    pub ended: Option<Ending>,
-}
-
-impl Record for TraceEntry {}
-
-impl fmt::Display for TraceEntry {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let at = self.at.since_start().as_secs_f64();
-        match &self.ended {
-            None => write!(f, "{at:9.3} s  {} instantiated", self.instance),
-            Some(Ending::Failed(error)) => {
-                write!(f, "{at:9.3} s  {} failed: {error}", self.instance)
-            }
-            Some(ending) => write!(f, "{at:9.3} s  {} ended: {ending:?}", self.instance),
-        }
-    }
-}
-
-pub(crate) struct Net {
-    pub(crate) clock: SharedClock,
-    pub(crate) processor: Processor,
-    trace: Log<TraceEntry>,
-}
-
-impl Net {
-    pub(crate) fn record(&self, instance: &Name, ended: Option<Ending>) {
-        self.trace.record(TraceEntry {
-            at: self.clock.now(),
-            instance: instance.clone(),
-            ended,
-        });
-    }
-}
+use crate::trace::TraceEntry;
 
 /// A network of schema instances: the top-level assemblage.
 ///

@@ -9,7 +9,7 @@ use imrs_ports::Name;
 use tokio::sync::Notify;
 
 use crate::error::SchemaError;
-use crate::network::Net;
+use crate::net::Net;
 
 /// The components of one assemblage (or of the network's top), by schema and number.
 pub(crate) struct Scope {

@@ -1,5 +1,7 @@
-//! The simulation: the world, the stepper that moves it on the framework clock, and the
-//! handles through which modules drive its devices.
+//! The simulation: the world, the stepper that moves it on the framework clock, and what
+//! the handles through which modules drive its devices ask of it. Each device's file
+//! hands its handle out (`Sim::robot`, `Sim::gate`, `Sim::relay`): a handle holds the
+//! simulation, so the simulation names no device.
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -10,10 +12,9 @@ use imrs_ports::{Instant, SharedClock};
 use tokio::sync::Notify;
 use tokio::sync::futures::Notified;
 
-use crate::device::{Gate, Relay, Robot};
 use crate::event::{SimEvent, SimEventKind, SimLog};
 use crate::fault::Fault;
-use crate::ids::{FeederId, Line, PalletId, RobotId, Station};
+use crate::ids::{FeederId, Line, PalletId, RobotId};
 use crate::layout::STEP;
 use crate::scene::Scene;
 use crate::step::next_step_after;
@@ -149,21 +150,6 @@ impl Sim {
     /// Spawns [`Sim::run`] on the current tokio runtime.
     pub fn spawn(&self) -> tokio::task::JoinHandle<()> {
         tokio::spawn(self.clone().run())
-    }
-
-    /// The robot `id`.
-    pub fn robot(&self, id: RobotId) -> Robot {
-        Robot::new(self.clone(), id)
-    }
-
-    /// The gate of `line`.
-    pub fn gate(&self, line: Line) -> Gate {
-        Gate::new(self.clone(), line)
-    }
-
-    /// The freeze relay of `station` on `line`.
-    pub fn relay(&self, line: Line, station: Station) -> Relay {
-        Relay::new(self.clone(), line, station)
     }
 
     /// Injects `fault`, to strike at its time.

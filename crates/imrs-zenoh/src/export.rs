@@ -397,7 +397,7 @@ pub(crate) async fn reply(query: &Query, answer: Result<Vec<u8>, String>) {
     }
 }
 
-mod sealed {
+pub(crate) mod sealed {
     use super::*;
 
     pub trait Exports {
@@ -440,7 +440,7 @@ asked!(usage::Response);
 
 /// `port`'s checks of a remote module: its claim, refused in words that name the port; and
 /// its user list, as [`Exported::watch_user`] checks it.
-fn checks_of<Req, Rep, U, L, const N: usize>(
+pub(crate) fn checks_of<Req, Rep, U, L, const N: usize>(
     port: &Port<Req, Rep, U, L, N>,
 ) -> (Box<Claim>, Box<Admits>)
 where
@@ -460,76 +460,4 @@ where
         }),
         Box::new(move |module: &str| listed.admits(module)),
     )
-}
-
-/// Exports with [`crate::relay`], for a port whose owner starts each rendezvous.
-macro_rules! relayed {
-    ($usage:ty, $($bound:tt)*) => {
-        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize>
-            sealed::Exports for Port<Req, Rep, $usage, L, N>
-        {
-            async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
-                let owner = self.owner_module().to_string();
-                let port = self.clone();
-                crate::relay::export_relayed::<Req, Rep, _>(
-                    host,
-                    self.name().as_str(),
-                    owner,
-                    checks_of(self),
-                    move |module| port.attach_relayed(module),
-                )
-                .await
-            }
-        }
-
-        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize> Export
-            for Port<Req, Rep, $usage, L, N>
-        {
-        }
-    };
-}
-
-relayed!(usage::SendAll, Clone);
-relayed!(usage::CallAll, Clone);
-relayed!(usage::Query, Send);
-
-/// A remote module's end of a port whose owner starts each rendezvous: the end it
-/// receives broadcasts on, or its response end (whose handler never runs: the relay takes
-/// each query and answers it with the module's host's answer).
-trait AttachRelayed<Req, Rep> {
-    type End;
-    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError>;
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
-    for Port<Req, Rep, usage::SendAll, L, N>
-{
-    type End = imrs_ports::End<Req, Rep, usage::Receive>;
-    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
-        self.user_named(module)
-    }
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
-    for Port<Req, Rep, usage::CallAll, L, N>
-{
-    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
-    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
-        self.answer(module, never_handled::<Req, Rep>)
-    }
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
-    for Port<Req, Rep, usage::Query, L, N>
-{
-    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
-    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
-        self.answer(module, never_handled::<Req, Rep>)
-    }
-}
-
-/// The handler of a relayed response end: never run, as the relay takes each query and
-/// answers it with the module's host's answer.
-fn never_handled<Req, Rep>(_: &(), _: Req) -> Rep {
-    unreachable!("a relayed port's queries are taken, never handled here")
 }

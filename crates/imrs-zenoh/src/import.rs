@@ -337,7 +337,7 @@ pub(crate) async fn connect(
     }
 }
 
-mod sealed {
+pub(crate) mod sealed {
     use super::*;
 
     pub trait Imports: Sized {
@@ -370,30 +370,3 @@ macro_rules! asked {
 
 asked!(usage::Receive, End<Req, Rep, usage::Receive>);
 asked!(usage::Response, ResponseEnd<Req, Rep, ()>);
-
-/// Imports with [`crate::relay`], for a port whose owner starts each rendezvous.
-macro_rules! relayed {
-    ($usage:ty, $($bound:tt)*) => {
-        impl<Req: Message + $($bound)*, Rep: Message + Default> sealed::Imports
-            for Imported<Req, Rep, $usage>
-        {
-            async fn import_from(
-                host: &Host,
-                port: &str,
-                owner: &str,
-                module: &str,
-            ) -> Result<Self, ZenohError> {
-                crate::relay::import_relayed::<Req, Rep, $usage>(host, port, owner, module).await
-            }
-        }
-
-        impl<Req: Message + $($bound)*, Rep: Message + Default> Import
-            for Imported<Req, Rep, $usage>
-        {
-        }
-    };
-}
-
-relayed!(usage::SendAll, Clone);
-relayed!(usage::CallAll, Clone);
-relayed!(usage::Query, Send);

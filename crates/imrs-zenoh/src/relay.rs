@@ -10,19 +10,24 @@
 //! When the module's host is gone, its relay ends and its end is let go, as for a module
 //! that ended; when the owner's host is gone, the local module's waits end with
 //! `PeerGone`, and when it comes back the module connects again, with no new import.
+//!
+//! Here too such ports are made `Export` and `Import`, beside what exports and imports
+//! them: the owner's side and the user's side of the other ports know nothing of relays.
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use imrs_ports::transport::Presence;
 use imrs_ports::usage::Usage;
-use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, WireError, usage};
+use imrs_ports::{AnyUser, End, Port, PortSpec, ReceiveError, UserList, WireError, usage};
 use tokio::task::JoinHandle;
 
 use crate::asking::{Asking, Pending};
 use crate::connected::Connected;
-use crate::export::{Admits, Claim, Exported, module_of, reply, sender_of};
-use crate::import::{NO_TIMEOUT, begin, connect_to, reconnect};
+use crate::export::sealed::Exports;
+use crate::export::{Admits, Claim, Export, Exported, checks_of, module_of, reply, sender_of};
+use crate::import::sealed::Imports;
+use crate::import::{Import, NO_TIMEOUT, begin, connect_to, reconnect};
 use crate::message::{Message, decode, encode};
 use crate::opening::{Opening, live, watch_users};
 use crate::take::Take;
@@ -190,6 +195,78 @@ async fn relay<Req: Message, Rep: Message, T: Take<Req, Rep>>(
 
 /// How often a relay told its module is gone looks whether the last query was answered.
 const RECHECK: std::time::Duration = std::time::Duration::from_millis(10);
+
+/// Exports with [`export_relayed`], for a port whose owner starts each rendezvous.
+macro_rules! exported {
+    ($usage:ty, $($bound:tt)*) => {
+        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize>
+            Exports for Port<Req, Rep, $usage, L, N>
+        {
+            async fn export_to(&self, host: &Host) -> Result<Exported, ZenohError> {
+                let owner = self.owner_module().to_string();
+                let port = self.clone();
+                export_relayed::<Req, Rep, _>(
+                    host,
+                    self.name().as_str(),
+                    owner,
+                    checks_of(self),
+                    move |module| port.attach_relayed(module),
+                )
+                .await
+            }
+        }
+
+        impl<Req: Message + $($bound)*, Rep: Message + Default, L: UserList, const N: usize> Export
+            for Port<Req, Rep, $usage, L, N>
+        {
+        }
+    };
+}
+
+exported!(usage::SendAll, Clone);
+exported!(usage::CallAll, Clone);
+exported!(usage::Query, Send);
+
+/// A remote module's end of a port whose owner starts each rendezvous: the end it
+/// receives broadcasts on, or its response end (whose handler never runs: the relay takes
+/// each query and answers it with the module's host's answer).
+trait AttachRelayed<Req, Rep> {
+    type End;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError>;
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::SendAll, L, N>
+{
+    type End = imrs_ports::End<Req, Rep, usage::Receive>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.user_named(module)
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::CallAll, L, N>
+{
+    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.answer(module, never_handled::<Req, Rep>)
+    }
+}
+
+impl<Req: Send + 'static, Rep: Send + 'static, L: UserList, const N: usize> AttachRelayed<Req, Rep>
+    for Port<Req, Rep, usage::Query, L, N>
+{
+    type End = imrs_ports::ResponseEnd<Req, Rep, ()>;
+    fn attach_relayed(&self, module: &str) -> Result<Self::End, WireError> {
+        self.answer(module, never_handled::<Req, Rep>)
+    }
+}
+
+/// The handler of a relayed response end: never run, as the relay takes each query and
+/// answers it with the module's host's answer.
+fn never_handled<Req, Rep>(_: &(), _: Req) -> Rep {
+    unreachable!("a relayed port's queries are taken, never handled here")
+}
 
 /// The local port's owner end on a user's host: hands a broadcast or query from the
 /// owner's host to the one local module, and gives back its reply.
@@ -373,3 +450,30 @@ where
     };
     encode(port, &answer).map_err(|e| e.to_string())
 }
+
+/// Imports with [`import_relayed`], for a port whose owner starts each rendezvous.
+macro_rules! imported {
+    ($usage:ty, $($bound:tt)*) => {
+        impl<Req: Message + $($bound)*, Rep: Message + Default> Imports
+            for Imported<Req, Rep, $usage>
+        {
+            async fn import_from(
+                host: &Host,
+                port: &str,
+                owner: &str,
+                module: &str,
+            ) -> Result<Self, ZenohError> {
+                import_relayed::<Req, Rep, $usage>(host, port, owner, module).await
+            }
+        }
+
+        impl<Req: Message + $($bound)*, Rep: Message + Default> Import
+            for Imported<Req, Rep, $usage>
+        {
+        }
+    };
+}
+
+imported!(usage::SendAll, Clone);
+imported!(usage::CallAll, Clone);
+imported!(usage::Query, Send);

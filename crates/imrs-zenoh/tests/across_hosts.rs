@@ -5,8 +5,9 @@ mod common;
 
 use std::time::Duration;
 
-use common::{PROMPTLY, free_endpoint, listening, two_hosts, within};
+use common::{PROMPTLY, listening, two_hosts, within};
 use imrs_ports::{AnyUser, Port, PortSpec, SendError, usage};
+use imrs_testkit::free_endpoint;
 use imrs_zenoh::{Host, Imported, ZenohError, export, import};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

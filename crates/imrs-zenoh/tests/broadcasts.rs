@@ -7,8 +7,9 @@ mod common;
 
 use std::collections::BTreeSet;
 
-use common::{PROMPTLY, free_endpoint, listening, within};
+use common::{PROMPTLY, listening, within};
 use imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, usage};
+use imrs_testkit::free_endpoint;
 use imrs_zenoh::{Host, Imported, export, import};
 
 async fn connecting(cell: &str, endpoint: &str) -> Host {

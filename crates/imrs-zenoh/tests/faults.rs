@@ -10,8 +10,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use common::relay::{Impairment, Relay};
-use common::{PROMPTLY, free_endpoint, listening, within};
+use common::{PROMPTLY, listening, within};
 use imrs_ports::{AnyUser, Port, PortSpec, ReceiveError, SendError, usage};
+use imrs_testkit::free_endpoint;
 use imrs_zenoh::{Host, Imported, export, import};
 
 /// How many times the owner served each request, by its number.

@@ -8,8 +8,9 @@ mod common;
 use std::process::Stdio;
 use std::time::Duration;
 
-use common::{PROMPTLY, free_endpoint, within};
+use common::{PROMPTLY, within};
 use imrs_ports::{SendError, usage};
+use imrs_testkit::free_endpoint;
 use imrs_zenoh::netns::Netns;
 use imrs_zenoh::{Host, Imported, import};
 use tokio::io::{AsyncBufReadExt, AsyncReadExt, BufReader};

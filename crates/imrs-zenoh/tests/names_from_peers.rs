@@ -4,8 +4,9 @@
 
 mod common;
 
-use common::{PROMPTLY, free_endpoint, two_hosts, within};
+use common::{PROMPTLY, two_hosts, within};
 use imrs_ports::{AnyUser, Name, Port, PortSpec, usage};
+use imrs_testkit::free_endpoint;
 use imrs_zenoh::{Imported, ZenohError, export, import};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -4,37 +4,17 @@
 
 mod common;
 
-use std::process::Command;
-
-use common::{PROMPTLY, free_endpoint, listening, within};
+use common::{PROMPTLY, listening, within};
 use imrs_ports::{AnyUser, Port, PortSpec, usage};
+use imrs_testkit::{free_endpoint, python_with};
 use imrs_zenoh::export;
 
 /// The Python package the test drives, at the version of the zenoh crate.
 const CLIENT: &str = "eclipse-zenoh==1.10.2";
 
-/// Python 3 with `zenoh` importable, installed with pip where it is missing.
-fn python_with_zenoh() -> &'static str {
-    let has_zenoh = || {
-        Command::new("python3")
-            .args(["-c", "import zenoh"])
-            .status()
-            .is_ok_and(|status| status.success())
-    };
-    if !has_zenoh() {
-        let installed = Command::new("python3")
-            .args(["-m", "pip", "install", "--quiet", CLIENT])
-            .status()
-            .expect("python3 runs");
-        assert!(installed.success(), "pip could not install {CLIENT}");
-        assert!(has_zenoh(), "{CLIENT} installed, yet `import zenoh` fails");
-    }
-    "python3"
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_python_client_sends_queries_listens_and_is_refused_off_the_list() {
-    let python = python_with_zenoh();
+    let python = python_with("zenoh", CLIENT);
     let endpoint = free_endpoint();
     let host = listening("python_cell", &endpoint).await;
     let double: Port<u64, u64, usage::Receive, AnyUser, 2> =

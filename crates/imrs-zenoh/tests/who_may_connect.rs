@@ -71,7 +71,7 @@ impl Drop for Authority {
 
 /// A TLS endpoint on loopback that nothing listens on now.
 fn tls_endpoint() -> String {
-    common::free_endpoint().replacen("tcp/", "tls/", 1)
+    imrs_testkit::free_endpoint().replacen("tcp/", "tls/", 1)
 }
 
 /// GRIP's users, each with its host.

@@ -3,6 +3,7 @@
 //! world's process when it runs in another (`chip_cell --processes`). The modules' code is
 //! the same either way.
 
+mod device;
 mod remote;
 mod server;
 mod wire;
@@ -14,7 +15,8 @@ use imrs_sim::{
     Target,
 };
 
-pub use remote::{Device, Link, RemoteDevices};
+pub use device::Device;
+pub use remote::{Link, RemoteDevices};
 pub use server::{DevicePort, DevicePorts, LineRuns, WORLD, world};
 pub use wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op, Pose};
 
@@ -32,9 +34,7 @@ impl Devices {
     pub fn robot(&self, id: RobotId) -> RobotDevice {
         match self {
             Devices::Local(sim) => RobotDevice::Local(sim.robot(id)),
-            Devices::Remote(remote) => {
-                RobotDevice::Remote(id, remote.link(remote::Device::Robot(id)))
-            }
+            Devices::Remote(remote) => RobotDevice::Remote(id, remote.link(Device::Robot(id))),
         }
     }
 
@@ -42,7 +42,7 @@ impl Devices {
     pub fn gate(&self, line: Line) -> GateDevice {
         match self {
             Devices::Local(sim) => GateDevice::Local(sim.gate(line)),
-            Devices::Remote(remote) => GateDevice::Remote(remote.link(remote::Device::Gate(line))),
+            Devices::Remote(remote) => GateDevice::Remote(remote.link(Device::Gate(line))),
         }
     }
 
@@ -50,11 +50,9 @@ impl Devices {
     pub fn relay(&self, line: Line, station: Station) -> RelayDevice {
         match self {
             Devices::Local(sim) => RelayDevice::Local(sim.relay(line, station)),
-            Devices::Remote(remote) => RelayDevice::Remote(
-                line,
-                station,
-                remote.link(remote::Device::Relay(line, station)),
-            ),
+            Devices::Remote(remote) => {
+                RelayDevice::Remote(line, station, remote.link(Device::Relay(line, station)))
+            }
         }
     }
 }

@@ -10,7 +10,7 @@ use imrs_sim::{Line, Sim};
 
 use crate::names::LINE_SUPERVISOR;
 
-use super::remote::Device;
+use super::device::Device;
 use super::wire::{Answer, DeviceAnswer, DeviceCall, MAX_SWEEP_SAMPLES, Op};
 use super::{Devices, GateDevice, RelayDevice, RobotDevice};
 

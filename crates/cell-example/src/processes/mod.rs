@@ -60,25 +60,26 @@ use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::alarms::AlarmKind;
 use crate::carrier::{Carrier, CarrierError, Crossing, Exported, Imported};
-use crate::chip::{FeederPolicy, SharedWaits, ZoneWaits, feeder_coordinator, feeder_monitor};
+use crate::chip::{SharedWaits, ZoneWaits, feeder_coordinator, feeder_monitor};
+use crate::config::{CellConfig, LineProcess, Transport};
 use crate::devices::{
     Answer, Device, DeviceAnswer, DeviceCall, DevicePorts, Devices, LineRuns, Op, RemoteDevices,
     world,
 };
-use crate::faults::{CellFault, CellFaultKind};
+use crate::faults::{CellFault, CellFaultKind, inject};
+use crate::feeder_policy::FeederPolicy;
 use crate::gate::{CycleTimeHistory, ReleaseDeath, SharedCycleTimes};
 use crate::lateness::Lateness;
+use crate::line_modules::LineModules;
 use crate::names::{
     FEEDER_COORDINATOR, FEEDER_MONITOR, LINE_SUPERVISOR, LineNames, ZONE_FREE, ZONE_RELEASE,
     ZONE_REQUEST, ZONE_RESERVE,
 };
 use crate::outage::Outage;
 use crate::ports::{CellPorts, ZoneLink};
-use crate::run::{CellConfig, LineModules, RunError, RunRecord, inject, lock};
-use crate::tally::Tally;
-
-/// How much faster than the wall clock a run across processes goes, unless `--speed` says.
-pub const DEFAULT_SPEED: f64 = 60.0;
+use crate::run_error::RunError;
+use crate::run_record::RunRecord;
+use crate::tally::{Tally, lock};
 
 /// How long the world gives the lines' processes to start before the epoch.
 const STARTUP: Duration = Duration::from_secs(2);
@@ -94,43 +95,6 @@ pub const RESTARTS: u32 = 3;
 /// How often, in the cell's time, a line's process sends its figures so far: a line that
 /// dies loses at most this much of them.
 const SNAPSHOT_PERIOD: Duration = Duration::from_secs(60);
-
-/// What carries the ports between the processes of a run across processes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Transport {
-    /// iceoryx2: the processes of one host, through shared memory.
-    Ipc,
-    /// zenoh: each process a host of its own (a network namespace, where they can be made).
-    Zenoh,
-}
-
-impl Transport {
-    /// Its name, as `--transport` takes it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Transport::Ipc => "ipc",
-            Transport::Zenoh => "zenoh",
-        }
-    }
-}
-
-/// What makes a process one line's part of a cell run across processes: the line, the
-/// cell's name, where the world's host is (over zenoh), and the moment its time starts.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LineProcess {
-    /// The line whose modules it runs.
-    pub line: Line,
-    /// Which run of the line's process it is: 0 first, then one more each time the world
-    /// starts it again.
-    pub run: u32,
-    /// The cell's name, from which every port's service name (or key) is derived.
-    pub remote: String,
-    /// Over zenoh, the world's host's endpoint, which the line's host connects to; over
-    /// iceoryx2, `None`.
-    pub connect: Option<String>,
-    /// When the cell's time is zero, on the system clock.
-    pub epoch: SystemTime,
-}
 
 fn refused(process: &str, why: impl std::fmt::Display) -> RunError {
     RunError::Processes {

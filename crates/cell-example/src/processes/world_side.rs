@@ -124,7 +124,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
     cell.events()
         .subscribe(move |event| lock(&folded).cell(event));
     // A line's RELEASE dies in the line's process; the simulation's faults happen here.
-    inject(config, &sim, &Default::default());
+    inject(&config.faults, &sim, &Default::default());
 
     let ports = CellPorts::new(&clock);
     // The arbiter, or the coordinator, runs here; under the Appendix's policy the lines ask

@@ -29,8 +29,10 @@
 mod cell;
 mod policy;
 mod sim;
+mod state;
 mod way;
 
 pub use cell::{Arrivals, Robot, Skill, TaskSpec, Workcell, Zone};
 pub use policy::{PartDriven, Policy, RunTime, Static};
-pub use sim::{Dispatch, Estimate, Outcome, Refusal, State, simulate};
+pub use sim::{Dispatch, Outcome, Refusal, simulate};
+pub use state::{Estimate, State};

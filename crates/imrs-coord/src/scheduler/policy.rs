@@ -2,7 +2,7 @@
 //! with.
 
 use super::cell::Workcell;
-use super::sim::State;
+use super::state::State;
 
 /// Chooses, for an idle robot, the task it starts now (or none: it waits).
 pub trait Policy {

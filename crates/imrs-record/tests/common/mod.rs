@@ -5,7 +5,6 @@
 #![allow(dead_code, unreachable_pub)]
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
 use imrs_core::Event;
@@ -26,14 +25,6 @@ pub struct Ran {
     pub events: Vec<Event>,
     pub sim_events: Vec<SimEvent>,
     pub scene: Scene,
-}
-
-/// A path in the system's temporary directory, new at every call, ending in `name`: tests
-/// that run at once never share a file.
-pub fn temp(name: &str) -> std::path::PathBuf {
-    static NEXT: AtomicU32 = AtomicU32::new(0);
-    let n = NEXT.fetch_add(1, Ordering::Relaxed);
-    std::env::temp_dir().join(format!("imrs-record-{}-{n}-{name}", std::process::id()))
 }
 
 fn chip_robot(

@@ -17,8 +17,17 @@ pub struct Robot {
     id: RobotId,
 }
 
+// The simulation hands out its robots here, beside what a robot is: a robot holds the
+// simulation, so the simulation's own file names no device.
+impl Sim {
+    /// The robot `id`.
+    pub fn robot(&self, id: RobotId) -> Robot {
+        Robot::new(self.clone(), id)
+    }
+}
+
 impl Robot {
-    pub(crate) fn new(sim: Sim, id: RobotId) -> Self {
+    fn new(sim: Sim, id: RobotId) -> Self {
         Self { sim, id }
     }
 

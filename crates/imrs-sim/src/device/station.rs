@@ -33,8 +33,22 @@ impl Release {
     }
 }
 
+// The simulation hands out its gates and relays here, beside what they are: each holds
+// the simulation, so the simulation's own file names no device.
+impl Sim {
+    /// The gate of `line`.
+    pub fn gate(&self, line: Line) -> Gate {
+        Gate::new(self.clone(), line)
+    }
+
+    /// The freeze relay of `station` on `line`.
+    pub fn relay(&self, line: Line, station: Station) -> Relay {
+        Relay::new(self.clone(), line, station)
+    }
+}
+
 impl Gate {
-    pub(crate) fn new(sim: Sim, line: Line) -> Self {
+    fn new(sim: Sim, line: Line) -> Self {
         Self { sim, line }
     }
 
@@ -80,7 +94,7 @@ pub struct Relay {
 }
 
 impl Relay {
-    pub(crate) fn new(sim: Sim, line: Line, station: Station) -> Self {
+    fn new(sim: Sim, line: Line, station: Station) -> Self {
         Self { sim, line, station }
     }
 

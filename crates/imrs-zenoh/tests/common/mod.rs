@@ -1,20 +1,13 @@
-//! What the tests across hosts share: free endpoints, hosts, and a bounded wait.
+//! What the tests across hosts share: hosts, and a bounded wait. Their free endpoints come
+//! from `imrs_testkit::free_endpoint`.
 
 #![allow(dead_code)]
 
 pub(crate) mod relay;
 
-use std::net::TcpListener;
 use std::time::Duration;
 
 use imrs_zenoh::Host;
-
-/// A TCP endpoint on loopback that nothing listens on now.
-pub(crate) fn free_endpoint() -> String {
-    let listener = TcpListener::bind("127.0.0.1:0").expect("a free port on loopback");
-    let port = listener.local_addr().expect("its address").port();
-    format!("tcp/127.0.0.1:{port}")
-}
 
 /// Two hosts of `cell`: the first listens on `endpoint`, the second connects to it.
 pub(crate) async fn two_hosts(cell: &str, endpoint: &str) -> (Host, Host) {
