@@ -29,9 +29,9 @@ pub(super) enum Wait {
     Spin,
 }
 
-pub(super) type RawService<T> =
+type RawService<T> =
     iceoryx2::service::port_factory::request_response::PortFactory<Svc, T, (), T, ()>;
-pub(super) type RawEvents = iceoryx2::service::port_factory::event::PortFactory<Svc>;
+type RawEvents = iceoryx2::service::port_factory::event::PortFactory<Svc>;
 
 /// The raw services of `part`: the request-response service and its two events, on a node
 /// that must live as long as they are used.
