@@ -35,7 +35,7 @@ use zerocopy::FromBytes;
 
 use crate::bridge::{MAX_PENDING, Svc, node, refusal, transport};
 use crate::carry::{Answer, Asker, Carry, Held, Loan, Reply, lend_reply, lock};
-use crate::export::Forward;
+use crate::export::attach::Forward;
 use crate::import::Take;
 use crate::{IpcError, Remote, Wire};
 

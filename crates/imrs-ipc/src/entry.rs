@@ -8,7 +8,7 @@
 
 use imrs_ports::{Port, Shared, UserList, usage};
 
-use crate::export::Exported;
+use crate::export::exported::Exported;
 use crate::import::Imported;
 use crate::{IpcError, Remote, Wire};
 

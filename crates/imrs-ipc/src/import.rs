@@ -22,7 +22,7 @@ use crate::bridge::{Readiness, Svc};
 use crate::carry::{Asker, Carry, Pending, lend, lock};
 use crate::connect::{Connection, ask_connect, connect};
 use crate::dispatch::{Dispatch, Work};
-use crate::export::InFlight;
+use crate::export::exported::InFlight;
 use crate::sweep::sweep_dead;
 use crate::turn::{Quiet, Turn, Turns};
 use crate::wire::{OK, RequestMeta, SEND};

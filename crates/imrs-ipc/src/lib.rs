@@ -171,7 +171,7 @@ mod wire;
 
 pub use entry::{Export, Import, export, import};
 pub use error::IpcError;
-pub use export::Exported;
+pub use export::exported::Exported;
 pub use import::Imported;
 pub use wire::{Remote, Wire};
 

@@ -17,7 +17,8 @@ use crate::bridge::is_served;
 use crate::broadcast::{Broadcaster, Inbox, Ticket, Ticketed, Ticketing, Tuned};
 use crate::carry::{Carry, lend, lock};
 use crate::connect::connect;
-use crate::export::{Forward, Refusal, bridge};
+use crate::export::attach::{Forward, Refusal};
+use crate::export::serving::bridge;
 use crate::import::{Relay, SharedAsker, Take, keep_attached, relay};
 use crate::{Exported, Imported, IpcError, Remote, Wire};
 

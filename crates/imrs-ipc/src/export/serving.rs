@@ -1,252 +1,25 @@
-//! The owner's side: a port exported to other processes. The bridge, woken by iceoryx2's
-//! request events, takes each request into the real port from the remote module's own end
-//! — a send, or a query its owner's order answers — and, woken again when the reply comes,
-//! sends it back through shared memory. It does so where it is woken ([`crate::dispatch`]):
-//! in the reactor's thread as the request comes, in the module's as it answers. On a TIGHT
-//! port the owner's spinning receive does the same in its turns.
+//! The bridge in the owner's process: it takes each request from shared memory into the real
+//! port through its module's end, and, woken when the reply comes, sends it back; in a task
+//! of the runtime or a thread of its own, and in a spinning owner's turns.
 
-use imrs_ports::transport::{EndTransport as _, PortTransport as _};
 use std::collections::HashMap;
 use std::marker::PhantomData;
 use std::pin::Pin;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::task::{Context, Poll, Wake, Waker};
-use std::thread::JoinHandle;
 
 use iceoryx2::port::notifier::Notifier;
-use imrs_ports::usage::{Plain, Usage};
-use imrs_ports::{ClaimRefused, End, Name, Port, ProcessType, Shared, UserList, WireError, usage};
+use imrs_ports::Name;
 
+use super::attach::{Forward, Refusal, Users, user};
+use super::exported::{Exported, InFlight, Worker};
 use crate::bridge::{Channel, Readiness, Side, Svc, TICK};
 use crate::carry::{Active, Carry, Held, Server, lock};
 use crate::dispatch::{Dispatch, Work};
-use crate::turn::{Quiet, Turn, Turns};
-use crate::wire::{
-    CONNECT, MALFORMED, NO_REPLY, NOT_ON_USER_LIST, OK, REFUSED, ReplyMeta, SEND, TIGHT,
-    TOO_MANY_NAMES, TOO_MANY_USERS,
-};
+use crate::turn::{Quiet, Turns};
+use crate::wire::{CONNECT, MALFORMED, NO_REPLY, OK, ReplyMeta, SEND, TIGHT};
 use crate::{IpcError, Remote, Wire};
-
-/// A remote module's end of the real port, through which its requests go in.
-pub(crate) trait Forward<Req, Rep>: Send + 'static {
-    /// The request, as the module's primitive on this port; its reply, or `None`.
-    fn forward(&mut self, request: Req) -> impl Future<Output = Option<Rep>> + Send + '_;
-}
-
-impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Send> {
-    async fn forward(&mut self, request: Req) -> Option<Rep> {
-        self.send(request).await.ok()
-    }
-}
-
-/// A query: a remote user's to the owner of a `RESPONSE` port, or a remote owner's to the
-/// one local user of a `QUERY` port, once that user has attached (the owner counts a remote
-/// module attached from its connection; here the module attaches a moment later).
-impl<Req: Send + 'static, Rep: Send + 'static> Forward<Req, Rep> for End<Req, Rep, usage::Query> {
-    async fn forward(&mut self, request: Req) -> Option<Rep> {
-        self.peer_attached().await;
-        self.query(request).await.ok()
-    }
-}
-
-/// Why a remote module could not be attached.
-pub(crate) enum Refusal {
-    /// The port's own wiring error.
-    Wire(WireError),
-    /// The module is not on the port's user list (its name, not kept).
-    NotOnUserList,
-    /// Every user place of the port is taken.
-    Full {
-        /// The port's number of users.
-        capacity: usize,
-    },
-    /// The module's name would be one more than the process keeps from peers
-    /// ([`Name::MOST_FROM_PEERS`]).
-    TooManyNames,
-    /// Something else failed (a relay back to the module's process).
-    Failed,
-}
-
-impl From<ClaimRefused> for Refusal {
-    fn from(refused: ClaimRefused) -> Self {
-        match refused {
-            ClaimRefused::NotOnUserList { .. } => Self::NotOnUserList,
-            ClaimRefused::Full { capacity, .. } => Self::Full { capacity },
-            ClaimRefused::TooManyNames { .. } => Self::TooManyNames,
-        }
-    }
-}
-
-impl From<WireError> for Refusal {
-    fn from(error: WireError) -> Self {
-        Self::Wire(error)
-    }
-}
-
-/// A port exported to other processes: served while this is held, withdrawn when dropped.
-pub struct Exported {
-    port: Name,
-    stop: Arc<AtomicBool>,
-    worker: Worker,
-    in_flight: Arc<InFlight>,
-}
-
-/// The requests from other processes taken and not yet answered there.
-#[derive(Default)]
-pub(crate) struct InFlight {
-    count: AtomicUsize,
-    idle: tokio::sync::Notify,
-}
-
-impl InFlight {
-    fn taken(&self) {
-        self.count.fetch_add(1, Ordering::AcqRel);
-    }
-
-    fn answered(&self) {
-        if self.count.fetch_sub(1, Ordering::AcqRel) == 1 {
-            self.idle.notify_waiters();
-        }
-    }
-
-    /// Waits until no request is in flight.
-    pub(crate) async fn settled(&self) {
-        loop {
-            let idle = self.idle.notified();
-            if self.count.load(Ordering::Acquire) == 0 {
-                return;
-            }
-            idle.await;
-        }
-    }
-}
-
-/// Who serves the port's requests: a tokio task woken by the users' notify through tokio's
-/// reactor, or, where attaching a user connects a relay back to its process (a wait of its
-/// own), a thread of ours.
-enum Worker {
-    Task(tokio::task::JoinHandle<()>),
-    Thread(Option<JoinHandle<()>>),
-}
-
-impl Exported {
-    /// The port.
-    pub fn port(&self) -> &Name {
-        &self.port
-    }
-
-    /// Waits until every request taken from another process has been answered there. A
-    /// reply usually crosses as part of the module's `reply`, but where the bridge is busy
-    /// in another thread it is left to a task of the runtime: a process that ends cleanly
-    /// awaits this first, so that the replies its modules gave reach their senders.
-    pub async fn settled(&self) {
-        self.in_flight.settled().await;
-    }
-
-    pub(crate) fn in_flight(&self) -> Arc<InFlight> {
-        Arc::clone(&self.in_flight)
-    }
-}
-
-impl Drop for Exported {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        match &mut self.worker {
-            Worker::Task(task) => task.abort(),
-            Worker::Thread(thread) => {
-                if let Some(thread) = thread.take() {
-                    let _ = thread.join();
-                }
-            }
-        }
-    }
-}
-
-/// Exports `port` (a port its owner receives on) to the other processes of `remote`'s
-/// cell: their modules' sends arrive at its owner's `receive`. Call it within the tokio
-/// runtime the cell runs on: the remote users' sends run there. Refused if another process
-/// already exports the port, or if the processes disagree on its types.
-pub(crate) fn export<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
-    remote: &Remote,
-    port: &Port<Req, Rep, usage::Receive, L, N>,
-) -> Result<Exported, IpcError> {
-    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
-}
-
-/// Exports `port`, a port of messages built in place ([`Shared`]), as [`export`] does a
-/// port of values: a remote module's request is read where its sender built it, in shared
-/// memory, with nothing copied on the way. The owner's reply, built in a loan made for the
-/// request ([`Shared::loan_reply`]), crosses back the same way; one built on the heap is
-/// copied once into its sample.
-pub(crate) fn export_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
-    remote: &Remote,
-    port: &Port<Shared<Req>, Shared<Rep>, usage::Receive, L, N>,
-) -> Result<Exported, IpcError> {
-    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
-}
-
-/// Exports `port` (a `RESPONSE` port) to the other processes of `remote`'s cell: their
-/// modules' queries wait for its owner's response handler, which runs when the owner's
-/// order says, as for a query from its own process.
-pub(crate) fn export_response<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
-    remote: &Remote,
-    port: &Port<Req, Rep, usage::Response, L, N>,
-) -> Result<Exported, IpcError> {
-    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
-}
-
-/// Exports `port`, a `RESPONSE` port of messages built in place ([`Shared`]), as
-/// [`export_response`] does a port of values: a remote module's query is read in place by
-/// the owner's response handler, which runs when the owner's order says and can build its
-/// answer in place too ([`Shared::loan_reply`]).
-pub(crate) fn export_response_shared<Req: Wire, Rep: Wire, L: UserList, const N: usize>(
-    remote: &Remote,
-    port: &Port<Shared<Req>, Shared<Rep>, usage::Response, L, N>,
-) -> Result<Exported, IpcError> {
-    export_port::<Req, Rep, _, _, _, _, N>(remote, port)
-}
-
-/// Exports `port`, whose remote users' requests (wire type `Req`, carried in the port as
-/// `M`) go in through each remote module's own end. On a TIGHT port the owner's spinning
-/// waits also do the bridge's work, in the owner's thread.
-fn export_port<Req, Rep, M, R, U, L, const N: usize>(
-    remote: &Remote,
-    port: &Port<M, R, U, L, N>,
-) -> Result<Exported, IpcError>
-where
-    Req: Wire,
-    Rep: Wire,
-    M: Carry<Req>,
-    R: Carry<Rep>,
-    U: Usage,
-    U::Complement: Plain,
-    L: UserList,
-    End<M, R, U::Complement>: Forward<M, R>,
-{
-    let tight = port.process_type() == ProcessType::Tight;
-    let attached = port.clone();
-    let (exported, side) = bridge::<Req, Rep, M, R, _, _>(
-        remote,
-        Name::from(port),
-        N,
-        false,
-        tight,
-        move |module: &str| {
-            // Refused by its name's text before the name is made: see `Port::claim`.
-            let module = attached.claim(module)?;
-            // The remote module's end waits in the bridge's task, which a spinning wait
-            // would keep off its worker: it parks, whatever the port's process type.
-            let mut end = attached.user_named(module)?;
-            end.park_waits();
-            Ok(end)
-        },
-    )?;
-    if tight {
-        port.pump_with(Turn(side));
-    }
-    Ok(exported)
-}
 
 /// Serves port `name`'s requests from other processes: each remote module is attached by
 /// `attach`, and its requests (wire type `Req`, carried in the port as `M`) go in through
@@ -376,9 +149,6 @@ where
         weak,
     ))
 }
-
-/// The remote modules' ends, by module.
-type Users<E> = HashMap<String, Arc<tokio::sync::Mutex<E>>>;
 
 /// A request gone into the real port through its module's end: it ends with the request
 /// answered in shared memory, the other process not yet woken. It answers where the reply
@@ -595,36 +365,6 @@ where
     }
 }
 
-/// The end of remote module `module`, attached at its first request; or the status of the
-/// port's refusal.
-fn user<E>(
-    attach: &mut impl FnMut(&str) -> Result<E, Refusal>,
-    users: &mut Users<E>,
-    module: &str,
-) -> Result<Arc<tokio::sync::Mutex<E>>, (u32, u32)> {
-    if let Some(end) = users.get(module) {
-        return Ok(Arc::clone(end));
-    }
-    match attach(module) {
-        Ok(end) => {
-            let end = Arc::new(tokio::sync::Mutex::new(end));
-            users.insert(module.to_owned(), Arc::clone(&end));
-            Ok(end)
-        }
-        Err(Refusal::Wire(WireError::NotOnUserList { .. }) | Refusal::NotOnUserList) => {
-            Err((NOT_ON_USER_LIST, 0))
-        }
-        Err(
-            Refusal::Wire(WireError::TooManyUsers { capacity, .. }) | Refusal::Full { capacity },
-        ) => Err((TOO_MANY_USERS, u32::try_from(capacity).unwrap_or(u32::MAX))),
-        Err(Refusal::TooManyNames) => Err((
-            TOO_MANY_NAMES,
-            u32::try_from(Name::MOST_FROM_PEERS).unwrap_or(u32::MAX),
-        )),
-        Err(_) => Err((REFUSED, 0)),
-    }
-}
-
 /// Replies through shared memory, with `status` and `detail`. The request is let go when
 /// the last holder drops it: here, or, for a request read in place, the module.
 fn reply<Req: Wire, Rep: Wire, R: Carry<Rep>>(
@@ -651,82 +391,4 @@ fn respond<Req: Wire, Rep: Wire, R: Carry<Rep>>(active: &Held<Req, Rep>, answer:
 /// Wakes the users' bridges: a reply is there.
 fn notify(notifier: &Mutex<Notifier<Svc>>) {
     let _ = lock(notifier).notify();
-}
-
-#[cfg(test)]
-mod tests {
-    use std::pin::pin;
-
-    use imrs_ports::{AnyUser, PortSpec};
-
-    use super::*;
-    use crate::connect::connect;
-    use crate::wire::RequestMeta;
-    use crate::{FromBytes, ZeroCopySend};
-
-    #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend, FromBytes)]
-    #[repr(C)]
-    #[type_name("imrs_ipc_unit::Number")]
-    struct Number {
-        value: u64,
-    }
-
-    /// Polls `future` once, without yielding: a spinning wait's one poll.
-    async fn poll_once<F: Future + Unpin>(future: &mut F) -> Poll<F::Output> {
-        std::future::poll_fn(|cx| Poll::Ready(Pin::new(&mut *future).poll(cx))).await
-    }
-
-    #[test]
-    fn a_spinning_owner_takes_a_waiting_request_at_its_first_poll_however_many_came_before() {
-        // One thread: the bridge's task cannot run while the owner's task spins, so every
-        // request must go in through the owner's own turns.
-        let runtime = tokio::runtime::Builder::new_current_thread()
-            .enable_all()
-            .build()
-            .unwrap();
-        runtime.block_on(async {
-            let remote = Remote::new(&format!("unit-turns-{}", std::process::id())).unwrap();
-            let port: Port<Number, Number, usage::Receive, AnyUser, 1> =
-                Port::new(PortSpec::new("DOUBLE", "DOUBLER").process_type(ProcessType::Tight));
-            let _exported = export(&remote, &port).unwrap();
-            let mut owner = port.owner().unwrap();
-            // The handshake waits for the bridge's task, which runs on this thread meanwhile.
-            let connection = tokio::task::spawn_blocking({
-                let remote = remote.clone();
-                move || connect::<Number, Number>(&remote, &Name::from("DOUBLE"), "ASKER")
-            })
-            .await
-            .unwrap()
-            .unwrap();
-            let ask = |value: u64| {
-                let mut loan = connection.client.loan_uninit().unwrap();
-                *loan.user_header_mut() = RequestMeta::new(SEND, "ASKER");
-                loan.write_payload(Number { value }).send().unwrap()
-            };
-            // All in one poll of this task, as a module that never waits long: more requests
-            // than tokio's budget for one poll (128), each sent with no wake-up, so that only
-            // the owner's spinning receive can take it.
-            let mut answered = None;
-            for value in 1..=400 {
-                let pending = ask(value);
-                let mut receive = pin!(owner.receive());
-                let Poll::Ready(Ok((request, reply))) = poll_once(&mut receive).await else {
-                    panic!("request {value} waited in shared memory past the owner's spin");
-                };
-                assert_eq!(request.value, value);
-                reply.reply(Number { value: 2 * value });
-                // The turn that took this request sent the reply to the one before.
-                if let Some((value, pending)) = answered.replace((value, pending)) {
-                    let response = pending.receive().unwrap().expect("the reply was sent");
-                    assert_eq!(response.payload().value, 2 * value);
-                }
-            }
-            // The last reply goes at the next wait's first turn.
-            let mut receive = pin!(owner.receive());
-            assert!(poll_once(&mut receive).await.is_pending());
-            let (value, pending) = answered.unwrap();
-            let response = pending.receive().unwrap().expect("the reply was sent");
-            assert_eq!(response.payload().value, 2 * value);
-        });
-    }
 }
