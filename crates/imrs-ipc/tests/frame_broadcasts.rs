@@ -300,7 +300,6 @@ async fn an_owner_that_exports_a_broadcast_port_again_is_rejoined_by_its_user_pr
         }
         let mut camera = port.owner().unwrap();
         // The second time, the user processes connected to the first export only.
-        eprintln!("DBG {export} peers at once {:?}", camera.peers());
         until_users(&camera, 2).await;
         for seed in seeds.by_ref().take(half as usize) {
             let mut frame = camera.loan().unwrap();

@@ -74,7 +74,7 @@ pub(super) fn rows() -> Vec<Def> {
         "ctx/one_processor".into(),
         "`ctx` round trip, both modules on one processor",
         "raw `End` round trip, both ends on one processor",
-        "≤ 1.3",
+        "≤ 1.15",
         Measure::Ratio(
             case("ctx_same_thread/ctx", "ctx"),
             one("ctx_same_thread/raw_end", "raw End"),
@@ -85,7 +85,7 @@ pub(super) fn rows() -> Vec<Def> {
         "ctx/two_workers".into(),
         "`ctx` round trip, each module a task of a two-worker runtime",
         "raw `End` round trip, placed the same",
-        "≤ 1.3",
+        "≤ 1.15",
         Measure::Ratio(
             case("ctx_multi_thread/ctx", "ctx"),
             one("ctx_multi_thread/raw_end", "raw End"),
@@ -98,7 +98,7 @@ pub(super) fn rows() -> Vec<Def> {
         "ring/tokio/1".into(),
         "ring of 1,000 modules, 1 thread, time per hop",
         "1,000 tokio tasks + mpsc + oneshot, 1 thread",
-        "≤ 1.2",
+        "≤ 1.0",
         Measure::Ratio(imrs_ring_1(), one("ring_1000/tokio/1_threads", "tokio")),
         " a hop",
     );
@@ -127,7 +127,7 @@ pub(super) fn rows() -> Vec<Def> {
             format!("ring/tokio/{n}"),
             &format!("ring of 1,000 modules, {n} threads"),
             &format!("1,000 tokio tasks + mpsc + oneshot, {n} threads"),
-            "–",
+            if n == 2 { "≤ 1.2" } else { "–" },
             Measure::Ratio(case(id("imrs"), "imrs"), one(&id("tokio"), "tokio")),
             " a hop",
         );
@@ -195,7 +195,7 @@ pub(super) fn rows() -> Vec<Def> {
                 format!("same_thread/prioritized/{size}"),
                 &format!("same-thread {bytes} on one processor, priorities on"),
                 "priorities off",
-                "≤ 1.1",
+                "≤ 1.05",
                 Measure::Ratio(
                     case(same("imrs_one_processor_prioritized"), "on"),
                     one(&same("imrs_one_processor"), "off"),
@@ -209,7 +209,7 @@ pub(super) fn rows() -> Vec<Def> {
         "idle".into(),
         "idle module, 10,000 modules waiting in `ctx.receive`: KiB resident each",
         "a tokio task waiting on an mpsc receiver",
-        "≤ 2 KiB",
+        "≤ 1.5 KiB",
         Measure::IdleKib,
         "",
     );
@@ -217,7 +217,7 @@ pub(super) fn rows() -> Vec<Def> {
         "filter/processor".into(),
         "bounded-buffer filter, a job on one processor with its peers",
         "tokio bounded mpsc, one task",
-        "≤ 3",
+        "≤ 2",
         Measure::Ratio(
             case("filter/bounded_buffer_on_processor", "filter"),
             one("filter/tokio_mpsc", "mpsc"),
@@ -351,7 +351,7 @@ pub(super) fn rows() -> Vec<Def> {
             );
         }
     }
-    for (size, bytes, target) in [("8B", "8 B", "≤ 1.2"), ("1KiB", "1 KiB", "≤ 2")] {
+    for (size, bytes, target) in [("8B", "8 B", "≤ 1.2"), ("1KiB", "1 KiB", "≤ 1.2")] {
         let tight = |who: &str| format!("rendezvous_tight/{who}/{size}");
         row(
             format!("tight/payload/{size}"),
