@@ -613,7 +613,7 @@ where
         let Poll::Ready(result) = this.operation.as_mut().poll(cx) else {
             if this.watch.is_some() || (F::NOTED && this.waiting.is_none()) {
                 let operation = this.operation.as_ref().get_ref();
-                *this.waiting = begin_wait(this.ctx, this.watch, this.waiting.take(), operation);
+                begin_wait(this.ctx, this.watch, this.waiting, operation);
             }
             return Poll::Pending;
         };
@@ -672,16 +672,15 @@ where
 fn begin_wait<'a, S: Send + Sync + 'static, F: PortOperation>(
     ctx: &'a Ctx<S>,
     watch: &mut Option<Box<Watch>>,
-    waiting: Option<WaitGuard<'a>>,
+    waiting: &mut Option<WaitGuard<'a>>,
     operation: &F,
-) -> Option<WaitGuard<'a>> {
+) {
     if let Some(watch) = watch {
         watch.since.get_or_insert_with(|| ctx.now());
     }
-    if waiting.is_some() || !F::NOTED {
-        return waiting;
+    if F::NOTED && waiting.is_none() {
+        *waiting = Some(ctx.wait_on(operation.port(), operation.waits_on()));
     }
-    Some(ctx.wait_on(operation.port(), operation.waits_on()))
 }
 
 impl<S, F: PortOperation, D> fmt::Debug for PortOp<'_, S, F, D> {
