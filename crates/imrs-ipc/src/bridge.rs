@@ -79,16 +79,24 @@ impl Readiness {
     /// Takes the other side's notifications, and registers `cx`'s waker to be woken when
     /// it next notifies: whether it had notified since the last call. `Err` if the reactor
     /// is gone.
+    ///
+    /// The notifications are taken at every call, not only when the socket was readable:
+    /// iceoryx2's notifier sends no datagram while its listener is marked notified, and it
+    /// marks it so only after sending. A take that falls between the two reads the datagram
+    /// (the reactor, which looks at the socket later, then sees nothing to report) and
+    /// leaves the mark set: from then on every notify is silent, until the listener takes
+    /// again. Taken only on readiness, that never came, and each reply waited for the
+    /// bridge's sweep.
     pub(crate) fn drain(&self, cx: &mut Context<'_>) -> std::io::Result<bool> {
-        let mut notified = false;
+        // Cleared before the notifications are taken: one that comes after is a new edge,
+        // which wakes the waker again.
         while let Poll::Ready(ready) = self.socket.poll_read_ready(cx) {
-            // Cleared before the notifications are taken: one that comes after is a new
-            // edge, which wakes the waker again.
             ready?.clear_ready();
-            let _ = self.listener.try_wait(|_| {});
-            notified = true;
         }
-        Ok(notified)
+        Ok(self
+            .listener
+            .try_wait(|_| {})
+            .is_ok_and(|notifications| notifications > 0))
     }
 }
 
@@ -237,5 +245,62 @@ impl<Req: Wire, Rep: Wire> Channel<Req, Rep> {
             .notifier_builder()
             .create()
             .map_err(|error| transport(&self.port, "notifying", error))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::mem::ManuallyDrop;
+    use std::os::fd::FromRawFd;
+    use std::os::unix::net::UnixDatagram;
+
+    use super::*;
+
+    /// Takes one datagram from the listener's socket behind iceoryx2's back: whether there
+    /// was one.
+    fn take_datagram(socket: RawFd) -> bool {
+        // SAFETY: the descriptor is the listener's socket, open while the test holds the
+        // listener; `ManuallyDrop` keeps this borrowed view from closing it.
+        let socket = ManuallyDrop::new(unsafe { UnixDatagram::from_raw_fd(socket) });
+        socket.set_nonblocking(true).expect("a socket");
+        socket.recv(&mut [0; 64]).is_ok()
+    }
+
+    /// The race's outcome made by hand: a notify's datagram read before the notifier marked
+    /// the listener notified. The mark stays, the socket is empty, and every notify after
+    /// sends nothing; a drain that took notifications only on readiness never heard again.
+    #[tokio::test(flavor = "current_thread")]
+    async fn a_listener_left_marked_with_an_empty_socket_is_heard_again_after_a_drain() {
+        let node = NodeBuilder::new().create::<Svc>().unwrap();
+        let name = ServiceName::new(&imrs_testkit::unique_name("drain")).unwrap();
+        let events = node
+            .service_builder(&name)
+            .event()
+            .event_id_max_value(0)
+            .open_or_create()
+            .unwrap();
+        let notifier = events.notifier_builder().create().unwrap();
+        let listener = events.listener_builder().create().unwrap();
+        let readiness = Readiness::new(listener, &Name::from("DRAIN")).unwrap();
+        let socket = readiness.socket.get_ref().0;
+
+        notifier.notify().unwrap();
+        assert!(take_datagram(socket), "a notify sends a datagram");
+        notifier.notify().unwrap();
+        assert!(
+            !take_datagram(socket),
+            "a listener marked notified gets no datagram"
+        );
+
+        let mut cx = Context::from_waker(std::task::Waker::noop());
+        assert!(
+            readiness.drain(&mut cx).unwrap(),
+            "the drain did not take the notifications waiting"
+        );
+        notifier.notify().unwrap();
+        assert!(
+            take_datagram(socket),
+            "after the drain a notify wakes the listener again"
+        );
     }
 }

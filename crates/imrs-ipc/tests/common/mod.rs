@@ -125,10 +125,17 @@ pub(crate) async fn answers(mut peer: Peer) -> Vec<u64> {
         if let Some(status) = peer.0.try_wait().unwrap() {
             break status;
         }
-        assert!(
-            tokio::time::Instant::now() < deadline,
-            "a peer process hung"
-        );
+        if tokio::time::Instant::now() >= deadline {
+            let _ = peer.0.kill();
+            let _ = peer.0.wait();
+            let mut text = String::new();
+            let _ = std::io::Read::read_to_string(&mut peer.0.stdout.take().unwrap(), &mut text);
+            panic!(
+                "a peer process hung after {} answers: {:?}",
+                text.lines().count(),
+                text.lines().last()
+            );
+        }
         tokio::time::sleep(Duration::from_millis(20)).await;
     };
     let mut text = String::new();
