@@ -1,6 +1,7 @@
 //! What carries the chip cell's ports between its processes (`--processes`): iceoryx2
 //! between processes of one host, or zenoh between hosts (`--transport zenoh`). The lines'
-//! modules do not know which: an imported port is a local port either way.
+//! modules do not know which: an imported port is a local port either way. Zenoh is there
+//! in a build with the `zenoh` feature.
 
 use std::fmt;
 use std::sync::Arc;
@@ -10,9 +11,112 @@ use imrs_ports::{AnyUser, Port};
 
 /// A message that crosses on either carrier: a fixed-size record iceoryx2 reads in place,
 /// and a `serde` type zenoh carries in CDR.
+#[cfg(feature = "zenoh")]
 pub trait Crossing: imrs_ipc::Wire + imrs_zenoh::Message {}
 
+#[cfg(feature = "zenoh")]
 impl<T: imrs_ipc::Wire + imrs_zenoh::Message> Crossing for T {}
+
+/// A message that crosses: a fixed-size record iceoryx2 reads in place.
+#[cfg(not(feature = "zenoh"))]
+pub trait Crossing: imrs_ipc::Wire {}
+
+#[cfg(not(feature = "zenoh"))]
+impl<T: imrs_ipc::Wire> Crossing for T {}
+
+/// A port that either carrier exports.
+#[cfg(feature = "zenoh")]
+pub trait Exportable<W>: imrs_ipc::Export<W> + imrs_zenoh::Export {}
+
+#[cfg(feature = "zenoh")]
+impl<W, P: imrs_ipc::Export<W> + imrs_zenoh::Export> Exportable<W> for P {}
+
+/// A port that iceoryx2 exports.
+#[cfg(not(feature = "zenoh"))]
+pub trait Exportable<W>: imrs_ipc::Export<W> {}
+
+#[cfg(not(feature = "zenoh"))]
+impl<W, P: imrs_ipc::Export<W>> Exportable<W> for P {}
+
+/// Imports `port` over iceoryx2, as [`Importable::import_ipc`].
+fn ipc_import<Req: Crossing, Rep: Crossing, U: Usage>(
+    remote: &imrs_ipc::Remote,
+    port: &str,
+    owner: &str,
+    module: &str,
+) -> Result<Imported<Req, Rep, U>, CarrierError>
+where
+    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
+{
+    let imported =
+        imrs_ipc::import::<imrs_ipc::Imported<Req, Rep, U>, _>(remote, port, owner, module)
+            .map_err(CarrierError::Ipc)?;
+    Ok(Arc::new(imported))
+}
+
+/// A usage whose ports of `Req` and `Rep` either carrier imports: how each does.
+pub trait Importable<Req: Crossing, Rep: Crossing>: Usage {
+    /// Imports `port` from another process of `remote`'s cell.
+    fn import_ipc(
+        remote: &imrs_ipc::Remote,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> Result<Imported<Req, Rep, Self>, CarrierError>;
+
+    /// Imports `port` from another host of `host`'s cell.
+    #[cfg(feature = "zenoh")]
+    fn import_zenoh(
+        host: &imrs_zenoh::Host,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> impl Future<Output = Result<Imported<Req, Rep, Self>, CarrierError>> + Send;
+}
+
+#[cfg(feature = "zenoh")]
+impl<Req: Crossing, Rep: Crossing, U: Usage> Importable<Req, Rep> for U
+where
+    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
+    imrs_zenoh::Imported<Req, Rep, U>: imrs_zenoh::Import,
+{
+    fn import_ipc(
+        remote: &imrs_ipc::Remote,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
+        ipc_import(remote, port, owner, module)
+    }
+
+    async fn import_zenoh(
+        host: &imrs_zenoh::Host,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
+        let imported =
+            imrs_zenoh::import::<imrs_zenoh::Imported<Req, Rep, U>>(host, port, owner, module)
+                .await
+                .map_err(CarrierError::Zenoh)?;
+        Ok(Arc::new(imported))
+    }
+}
+
+#[cfg(not(feature = "zenoh"))]
+impl<Req: Crossing, Rep: Crossing, U: Usage> Importable<Req, Rep> for U
+where
+    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
+{
+    fn import_ipc(
+        remote: &imrs_ipc::Remote,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
+        ipc_import(remote, port, owner, module)
+    }
+}
 
 /// A port imported from another process, by either carrier: its local stand-in.
 pub trait Bridged<Req: Send + 'static, Rep: Send + 'static, U: Usage>: Send + Sync {
@@ -28,6 +132,7 @@ impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Bridged<Req, Rep, U>
     }
 }
 
+#[cfg(feature = "zenoh")]
 impl<Req: Send + 'static, Rep: Send + 'static, U: Usage> Bridged<Req, Rep, U>
     for imrs_zenoh::Imported<Req, Rep, U>
 {
@@ -44,6 +149,7 @@ pub enum Exported {
     /// To the processes of this host.
     Ipc(imrs_ipc::Exported),
     /// To the hosts of the cell.
+    #[cfg(feature = "zenoh")]
     Zenoh(imrs_zenoh::Exported),
 }
 
@@ -53,17 +159,18 @@ pub enum CarrierError {
     /// On iceoryx2.
     Ipc(imrs_ipc::IpcError),
     /// On zenoh.
+    #[cfg(feature = "zenoh")]
     Zenoh(imrs_zenoh::ZenohError),
 }
 
 impl CarrierError {
     /// Whether nobody exports the port yet.
     pub fn is_no_owner(&self) -> bool {
-        matches!(
-            self,
-            CarrierError::Ipc(imrs_ipc::IpcError::NoOwner { .. })
-                | CarrierError::Zenoh(imrs_zenoh::ZenohError::NoOwner { .. })
-        )
+        match self {
+            CarrierError::Ipc(error) => matches!(error, imrs_ipc::IpcError::NoOwner { .. }),
+            #[cfg(feature = "zenoh")]
+            CarrierError::Zenoh(error) => matches!(error, imrs_zenoh::ZenohError::NoOwner { .. }),
+        }
     }
 }
 
@@ -71,6 +178,7 @@ impl fmt::Display for CarrierError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             CarrierError::Ipc(error) => error.fmt(f),
+            #[cfg(feature = "zenoh")]
             CarrierError::Zenoh(error) => error.fmt(f),
         }
     }
@@ -84,6 +192,7 @@ pub enum Carrier {
     /// iceoryx2, between the processes of this host, under the cell's name.
     Ipc(imrs_ipc::Remote),
     /// zenoh, between the hosts of the cell.
+    #[cfg(feature = "zenoh")]
     Zenoh(imrs_zenoh::Host),
 }
 
@@ -91,6 +200,7 @@ impl fmt::Debug for Carrier {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Carrier::Ipc(remote) => f.debug_tuple("Ipc").field(&remote.cell()).finish(),
+            #[cfg(feature = "zenoh")]
             Carrier::Zenoh(host) => f.debug_tuple("Zenoh").field(&host.cell()).finish(),
         }
     }
@@ -100,12 +210,13 @@ impl Carrier {
     /// Exports `port` to the cell's other processes.
     pub async fn export<P, W>(&self, port: &P) -> Result<Exported, CarrierError>
     where
-        P: imrs_ipc::Export<W> + imrs_zenoh::Export,
+        P: Exportable<W>,
     {
         match self {
             Carrier::Ipc(remote) => imrs_ipc::export(remote, port)
                 .map(Exported::Ipc)
                 .map_err(CarrierError::Ipc),
+            #[cfg(feature = "zenoh")]
             Carrier::Zenoh(host) => imrs_zenoh::export(host, port)
                 .await
                 .map(Exported::Zenoh)
@@ -123,20 +234,12 @@ impl Carrier {
     where
         Req: Crossing,
         Rep: Crossing,
-        U: Usage,
-        imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
-        imrs_zenoh::Imported<Req, Rep, U>: imrs_zenoh::Import,
+        U: Importable<Req, Rep>,
     {
-        Ok(match self {
-            Carrier::Ipc(remote) => Arc::new(
-                imrs_ipc::import::<imrs_ipc::Imported<Req, Rep, U>, _>(remote, port, owner, module)
-                    .map_err(CarrierError::Ipc)?,
-            ),
-            Carrier::Zenoh(host) => Arc::new(
-                imrs_zenoh::import::<imrs_zenoh::Imported<Req, Rep, U>>(host, port, owner, module)
-                    .await
-                    .map_err(CarrierError::Zenoh)?,
-            ),
-        })
+        match self {
+            Carrier::Ipc(remote) => U::import_ipc(remote, port, owner, module),
+            #[cfg(feature = "zenoh")]
+            Carrier::Zenoh(host) => U::import_zenoh(host, port, owner, module).await,
+        }
     }
 }

@@ -55,7 +55,8 @@ struct Flags {
     /// Be seen from ROS 2 (rmw_zenoh) as node /chip_cell: the robots' joints on
     /// /joint_states, the alarms on /alarms, and the status service /status
     /// (std_srvs/Trigger). A zenoh peer listening on ENDPOINT, where ROS 2 nodes connect
-    /// (rmw_zenoh's default router is tcp/localhost:7447). Runs on the wall clock.
+    /// (rmw_zenoh's default router is tcp/localhost:7447). Runs on the wall clock. Needs
+    /// the chip cell built with its `ros2` feature.
     #[arg(long, value_name = "ENDPOINT", conflicts_with = "processes")]
     ros2: Option<String>,
     /// Show no progress bar (it is shown only on a terminal anyway).
@@ -67,7 +68,8 @@ struct Flags {
     #[arg(long)]
     processes: bool,
     /// With --processes: what carries the ports between the processes: iceoryx2 on this
-    /// host, or zenoh with each process a host of its own (a network namespace, as root).
+    /// host, or zenoh with each process a host of its own (a network namespace, as root;
+    /// needs the chip cell built with its `zenoh` feature).
     #[arg(long, value_enum, default_value_t = Transport::Ipc, requires = "processes")]
     transport: Transport,
     /// With --processes: how many times as fast as the wall clock the cell runs.
@@ -90,6 +92,26 @@ struct Flags {
     /// world restarts a line whose process died).
     #[arg(long, hide = true, default_value_t = 0, requires = "line_process")]
     run: u32,
+}
+
+/// Why a flag is refused by a build without the cargo feature `feature` that brings its
+/// layer in, and how to turn it on.
+pub(crate) fn not_built(flag: &str, feature: &str) -> String {
+    format!(
+        "{flag} needs the chip cell built with its `{feature}` feature: \
+         cargo run --release --features cell-example/{feature} --example chip_cell -- ..."
+    )
+}
+
+/// Refuses a flag that was `used` where its feature is not `built`, by name.
+fn built_for(used: bool, flag: &str, feature: &str, built: bool) -> Result<(), CliError> {
+    if used && !built {
+        return Err(CliError {
+            message: format!("error: {}\n", not_built(flag, feature)),
+            status: 2,
+        });
+    }
+    Ok(())
 }
 
 fn speed(text: &str) -> Result<f64, String> {
@@ -163,6 +185,14 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         message: error.render().to_string(),
         status: if error.use_stderr() { 2 } else { 0 },
     })?;
+    built_for(
+        flags.ros2.is_some(),
+        "--ros2",
+        "ros2",
+        cfg!(feature = "ros2"),
+    )?;
+    let zenoh = flags.transport == Transport::Zenoh || flags.connect.is_some();
+    built_for(zenoh, "--transport zenoh", "zenoh", cfg!(feature = "zenoh"))?;
     let timeline = flags.timeline.map(|path| TimelineConfig {
         path,
         from: Duration::from_secs_f64(flags.timeline_from),
@@ -195,4 +225,25 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<CellConfig, Cli
         ros2: flags.ros2,
         ..CellConfig::default()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flag_whose_feature_is_not_built_is_refused_by_name_with_how_to_build_it() {
+        let refused = built_for(true, "--ros2", "ros2", false).unwrap_err();
+        assert_eq!(refused.status, 2);
+        assert!(
+            refused
+                .message
+                .contains("--ros2 needs the chip cell built with its `ros2` feature"),
+            "{}",
+            refused.message
+        );
+        assert!(refused.message.contains("--features cell-example/ros2"));
+        assert!(built_for(true, "--ros2", "ros2", true).is_ok());
+        assert!(built_for(false, "--ros2", "ros2", false).is_ok());
+    }
 }

@@ -35,6 +35,7 @@ pub mod ports;
 pub mod processes;
 pub mod report;
 pub mod reservation;
+#[cfg(feature = "ros2")]
 pub mod ros2;
 pub mod run;
 pub mod run_error;

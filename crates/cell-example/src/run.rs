@@ -19,14 +19,19 @@ use crate::gate::{ReleaseDeath, SharedCycleTimes};
 use crate::line_modules::LineModules;
 use crate::ports::CellPorts;
 use crate::processes;
+#[cfg(feature = "ros2")]
 use crate::ros2;
 use crate::run_error::{RunError, output};
 use crate::run_record::RunRecord;
 use crate::tally::{Tally, lock};
 
-/// What [`run`] refuses before it simulates anything: hours out of range, or a fault set
-/// after the end.
+/// What [`run`] refuses before it simulates anything: hours out of range, a fault set
+/// after the end, or a layer this build left out.
 pub fn refused(config: &CellConfig) -> Option<RunError> {
+    #[cfg(not(feature = "ros2"))]
+    if config.ros2.is_some() {
+        return Some(RunError::Ros2(crate::cli::not_built("--ros2", "ros2")));
+    }
     let hours_ok = config.hours.is_finite() && config.hours > 0.0 && config.hours <= MAX_HOURS;
     if !hours_ok {
         return Some(RunError::Hours(config.hours));
@@ -136,10 +141,12 @@ async fn simulate(
     cell.check(&declarations)?;
 
     sim.spawn();
+    #[cfg(feature = "ros2")]
     let _ros2 = match &config.ros2 {
         Some(endpoint) => Some(ros2::serve(endpoint, &sim, &cell, Arc::clone(&tally)).await?),
         None => None,
     };
+
     match config.feeder {
         FeederPolicy::Arbiter => {
             cell.start(feeder_monitor(&ports))?;

@@ -415,6 +415,10 @@ fn under_the_coordinator_a_line_killed_is_started_again_and_the_other_goes_on() 
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "zenoh"),
+    ignore = "needs the `zenoh` feature: cargo test --workspace --all-features"
+)]
 fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
     // Six simulated minutes at twenty times the wall clock, the lines' processes each in a
     // network namespace of its own (as root; else on loopback, said loudly).
@@ -441,6 +445,10 @@ fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "zenoh"),
+    ignore = "needs the `zenoh` feature: cargo test --workspace --all-features"
+)]
 fn over_zenoh_a_line_whose_host_is_cut_off_and_healed_is_started_again() {
     let world = World::start(&["--transport", "zenoh", "--hours", "0.1", "--speed", "20"]);
     world.lines();
@@ -525,6 +533,7 @@ fn what_does_not_cross_processes_is_refused_by_name_before_anything_starts() {
         (&["--record", "x.mcap"][..], "--record"),
         (&["--tree"][..], "--tree"),
         (&["--realtime"][..], "--realtime"),
+        #[cfg(feature = "zenoh")]
         (
             &["--transport", "zenoh", "--feeder", "appendix"][..],
             "--transport zenoh with --feeder appendix",

@@ -11,6 +11,10 @@ use imrs_testkit::{example_binary, free_endpoint, python_with};
 const ROS2_CLIENT: &str = "zenoh-ros2-sdk==0.1.8";
 
 #[test]
+#[cfg_attr(
+    not(feature = "ros2"),
+    ignore = "needs the `ros2` feature: cargo test --workspace --all-features"
+)]
 fn a_ros_2_client_lists_the_cell_reads_its_joints_and_alarms_and_asks_its_status() {
     let python = python_with("zenoh_ros2_sdk", ROS2_CLIENT);
     let endpoint = free_endpoint();

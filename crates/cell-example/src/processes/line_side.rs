@@ -26,6 +26,9 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
     let lateness = Lateness::probe(clock.sleep_until(Instant::ZERO));
     let carrier = match &process.connect {
         None => Carrier::Ipc(Remote::new(&process.remote).map_err(carried(name))?),
+        #[cfg(not(feature = "zenoh"))]
+        Some(_) => return Err(refused(name, crate::cli::not_built("--connect", "zenoh"))),
+        #[cfg(feature = "zenoh")]
         Some(endpoint) => {
             let host = Host::builder(&process.remote)
                 .connect(endpoint)
@@ -150,6 +153,7 @@ async fn line_process(config: &CellConfig, process: &LineProcess) -> Result<Valu
 
 /// Waits (up to the world's patience) until the world's host is seen exporting `line`'s
 /// gate device.
+#[cfg(feature = "zenoh")]
 async fn await_world(host: &Host, line: Line) -> Result<(), String> {
     let port = Device::Gate(line).port();
     let deadline = std::time::Instant::now() + PATIENCE;

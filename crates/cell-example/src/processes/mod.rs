@@ -53,8 +53,8 @@ use imrs_core::prelude::*;
 use imrs_ipc::Remote;
 use imrs_ports::{End, Instant, RealClock, SharedClock, usage};
 use imrs_sim::{DeviceError, Line, RobotId, Role, Sim, SimConfig, Target};
+#[cfg(feature = "zenoh")]
 use imrs_zenoh::Host;
-use imrs_zenoh::netns::Netns;
 use serde_json::{Value, json};
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 

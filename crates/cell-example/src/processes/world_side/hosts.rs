@@ -1,6 +1,23 @@
 //! Where the lines' hosts are, over zenoh, and the world's side of what carries the ports.
 
+use super::lines::Heard;
 use super::*;
+
+#[cfg(feature = "zenoh")]
+pub(super) use imrs_zenoh::netns::Netns;
+
+/// A line's network namespace, of which a build without the `zenoh` feature has none: no
+/// value of it can be made, so the code that would start a line inside one never runs.
+#[cfg(not(feature = "zenoh"))]
+#[derive(Debug)]
+pub(super) enum Netns {}
+
+#[cfg(not(feature = "zenoh"))]
+impl Netns {
+    pub(super) fn command(&self, _program: impl AsRef<std::ffi::OsStr>) -> Command {
+        match *self {}
+    }
+}
 
 /// Over zenoh, where the lines' hosts are: a network namespace each, joined to the world's
 /// by a veth link, or (where namespaces cannot be made) this host's loopback.
@@ -24,6 +41,12 @@ pub(super) async fn world_carrier(
             Carrier::Ipc(Remote::new(cell).map_err(carried("world"))?),
             None,
         )),
+        #[cfg(not(feature = "zenoh"))]
+        Transport::Zenoh => Err(refused(
+            "world",
+            crate::cli::not_built("--transport zenoh", "zenoh"),
+        )),
+        #[cfg(feature = "zenoh")]
         Transport::Zenoh => {
             let netns = Netns::make(0).and_then(|a| Ok(vec![a, Netns::make(1)?]));
             // The world listens only where its lines reach it: on each namespace's link, or
@@ -52,6 +75,7 @@ pub(super) async fn world_carrier(
 }
 
 /// A port of this host free now.
+#[cfg(feature = "zenoh")]
 fn free_port() -> Result<u16, RunError> {
     let probe = std::net::TcpListener::bind("0.0.0.0:0")
         .map_err(|error| refused("world", format!("no free port: {error}")))?;
@@ -63,6 +87,7 @@ fn free_port() -> Result<u16, RunError> {
 
 /// The lines' hosts: in `netns`, or on loopback (said loudly) where they could not be
 /// made; the world listening on `port`.
+#[cfg(feature = "zenoh")]
 fn hosts(netns: Result<Vec<Netns>, String>, port: u16) -> Hosts {
     match netns {
         Ok(netns) => Hosts {
@@ -88,4 +113,54 @@ fn hosts(netns: Result<Vec<Netns>, String>, port: u16) -> Hosts {
             }
         }
     }
+}
+
+/// Over zenoh, a watch of each line's host: one cut off is told as `UNSEEN`, as if its
+/// process died. The watches end when their tasks are aborted.
+#[cfg(feature = "zenoh")]
+pub(super) async fn watch_hosts(
+    carrier: &Carrier,
+    exported: &[Exported],
+    tell: &UnboundedSender<Heard>,
+) -> Result<Vec<tokio::task::JoinHandle<()>>, RunError> {
+    use super::lines::UNSEEN;
+
+    let mut watchers = Vec::new();
+    if !matches!(carrier, Carrier::Zenoh(_)) {
+        return Ok(watchers);
+    }
+    for line in Line::ALL {
+        let gate = Device::Gate(line);
+        let exported_gate = exported
+            .iter()
+            .find_map(|exported| match exported {
+                Exported::Zenoh(exported) if exported.port() == gate.port() => Some(exported),
+                _ => None,
+            })
+            .ok_or_else(|| refused("world", format!("port {} is not exported", gate.port())))?;
+        let mut watch = exported_gate
+            .watch_user(&gate.user())
+            .await
+            .map_err(carried("world"))?;
+        let tell = tell.clone();
+        watchers.push(tokio::spawn(async move {
+            loop {
+                watch.gone().await;
+                if tell.send((line, UNSEEN, Said::Unseen)).is_err() {
+                    return;
+                }
+            }
+        }));
+    }
+    Ok(watchers)
+}
+
+/// Without the `zenoh` feature every line is a process of this host: no host to watch.
+#[cfg(not(feature = "zenoh"))]
+pub(super) async fn watch_hosts(
+    _carrier: &Carrier,
+    _exported: &[Exported],
+    _tell: &UnboundedSender<Heard>,
+) -> Result<Vec<tokio::task::JoinHandle<()>>, RunError> {
+    Ok(Vec::new())
 }

@@ -18,6 +18,13 @@ pub(super) enum Said {
     Ended(Option<ExitStatus>),
     /// Over zenoh: its host is gone from the world's sight (killed, or cut off), as the
     /// world watches it, whatever run it is in.
+    #[cfg_attr(
+        not(feature = "zenoh"),
+        expect(
+            dead_code,
+            reason = "told only by the watch of a line's host over zenoh"
+        )
+    )]
     Unseen,
     /// A line the world does not understand.
     Garbled(String),
@@ -42,9 +49,16 @@ impl Said {
 }
 
 /// What a line's process said, with its line and run.
-type Heard = (Line, u32, Said);
+pub(super) type Heard = (Line, u32, Said);
 
 /// The run of what the world's watch of a line's host says: whichever run is up.
+#[cfg_attr(
+    not(feature = "zenoh"),
+    expect(
+        dead_code,
+        reason = "told only by the watch of a line's host over zenoh"
+    )
+)]
 pub(super) const UNSEEN: u32 = u32::MAX;
 
 pub(super) async fn hear_from(hear: &mut UnboundedReceiver<Heard>) -> Result<Heard, RunError> {

@@ -9,8 +9,8 @@ mod hosts;
 mod lines;
 mod supervisor;
 
-use self::hosts::world_carrier;
-use self::lines::{LinePlace, Lines, Said, UNSEEN, hear_from, start_line};
+use self::hosts::{Netns, watch_hosts, world_carrier};
+use self::lines::{LinePlace, Lines, Said, hear_from, start_line};
 use self::supervisor::Supervisor;
 
 /// Runs the cell across three processes — this one the world's — and folds the lines'
@@ -134,32 +134,7 @@ async fn world_process(config: &CellConfig) -> Result<RunRecord, RunError> {
         lines.0.push((line, 0, start(line, 0, &config.faults)?));
     }
     // Over zenoh, each line's host is watched: one cut off is treated as one that died.
-    let mut watchers = Vec::new();
-    if let Carrier::Zenoh(_) = &carrier {
-        for line in Line::ALL {
-            let gate = Device::Gate(line);
-            let exported_gate = exported
-                .iter()
-                .find_map(|exported| match exported {
-                    Exported::Zenoh(exported) if exported.port() == gate.port() => Some(exported),
-                    _ => None,
-                })
-                .ok_or_else(|| refused("world", format!("port {} is not exported", gate.port())))?;
-            let mut watch = exported_gate
-                .watch_user(&gate.user())
-                .await
-                .map_err(carried("world"))?;
-            let tell = tell.clone();
-            watchers.push(tokio::spawn(async move {
-                loop {
-                    watch.gone().await;
-                    if tell.send((line, UNSEEN, Said::Unseen)).is_err() {
-                        return;
-                    }
-                }
-            }));
-        }
-    }
+    let watchers = watch_hosts(&carrier, &exported, &tell).await?;
     // A line that cannot start (or dies before it is first ready) fails the run: there is
     // nothing yet to go on from.
     for _ in Line::ALL {
