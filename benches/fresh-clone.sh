@@ -8,7 +8,8 @@ set -euo pipefail
 what="${1:-first-run}"
 root="$(cd "$(dirname "$0")/.." && pwd)"
 clone="$(mktemp -d)"
-trap 'rm -rf "$clone"' EXIT
+log="$(mktemp)"
+trap 'rm -rf "$clone" "$log"' EXIT
 git clone --quiet "$root" "$clone"
 cd "$clone"
 commit="$(git rev-parse --short HEAD)"
@@ -18,10 +19,9 @@ case "$what" in
     *) echo "usage: $0 [first-run|ci]" >&2; exit 2 ;;
 esac
 start="$(date +%s)"
-"${command[@]}" >"$clone.log" 2>&1 || { tail -40 "$clone.log" >&2; exit 1; }
+"${command[@]}" >"$log" 2>&1 || { tail -40 "$log" >&2; exit 1; }
 seconds=$(( $(date +%s) - start ))
-crates="$(grep -c '^ *Compiling ' "$clone.log" || true)"
-rm -f "$clone.log"
+crates="$(grep -c '^ *Compiling ' "$log" || true)"
 printf '%s: `%s` on a fresh clone of %s, %d cores: %dm %02ds, %s crates compiled\n' \
     "$(date -u +%Y-%m-%d)" "${command[*]}" "$commit" "$(nproc)" \
     $((seconds / 60)) $((seconds % 60)) "$crates"

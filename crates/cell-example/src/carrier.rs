@@ -38,24 +38,9 @@ pub trait Exportable<W>: imrs_ipc::Export<W> {}
 #[cfg(not(feature = "zenoh"))]
 impl<W, P: imrs_ipc::Export<W>> Exportable<W> for P {}
 
-/// Imports `port` over iceoryx2, as [`Importable::import_ipc`].
-fn ipc_import<Req: Crossing, Rep: Crossing, U: Usage>(
-    remote: &imrs_ipc::Remote,
-    port: &str,
-    owner: &str,
-    module: &str,
-) -> Result<Imported<Req, Rep, U>, CarrierError>
-where
-    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
-{
-    let imported =
-        imrs_ipc::import::<imrs_ipc::Imported<Req, Rep, U>, _>(remote, port, owner, module)
-            .map_err(CarrierError::Ipc)?;
-    Ok(Arc::new(imported))
-}
-
-/// A usage whose ports of `Req` and `Rep` either carrier imports: how each does.
-pub trait Importable<Req: Crossing, Rep: Crossing>: Usage {
+/// A usage whose ports of `Req` and `Rep` either carrier imports: iceoryx2 here, zenoh by
+/// [`ZenohImport`].
+pub trait Importable<Req: Crossing, Rep: Crossing>: ZenohImport<Req, Rep> {
     /// Imports `port` from another process of `remote`'s cell.
     fn import_ipc(
         remote: &imrs_ipc::Remote,
@@ -63,9 +48,29 @@ pub trait Importable<Req: Crossing, Rep: Crossing>: Usage {
         owner: &str,
         module: &str,
     ) -> Result<Imported<Req, Rep, Self>, CarrierError>;
+}
 
+impl<Req: Crossing, Rep: Crossing, U: ZenohImport<Req, Rep>> Importable<Req, Rep> for U
+where
+    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
+{
+    fn import_ipc(
+        remote: &imrs_ipc::Remote,
+        port: &str,
+        owner: &str,
+        module: &str,
+    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
+        let imported =
+            imrs_ipc::import::<imrs_ipc::Imported<Req, Rep, U>, _>(remote, port, owner, module)
+                .map_err(CarrierError::Ipc)?;
+        Ok(Arc::new(imported))
+    }
+}
+
+/// How zenoh imports a usage's ports of `Req` and `Rep`.
+#[cfg(feature = "zenoh")]
+pub trait ZenohImport<Req: Crossing, Rep: Crossing>: Usage {
     /// Imports `port` from another host of `host`'s cell.
-    #[cfg(feature = "zenoh")]
     fn import_zenoh(
         host: &imrs_zenoh::Host,
         port: &str,
@@ -75,20 +80,10 @@ pub trait Importable<Req: Crossing, Rep: Crossing>: Usage {
 }
 
 #[cfg(feature = "zenoh")]
-impl<Req: Crossing, Rep: Crossing, U: Usage> Importable<Req, Rep> for U
+impl<Req: Crossing, Rep: Crossing, U: Usage> ZenohImport<Req, Rep> for U
 where
-    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
     imrs_zenoh::Imported<Req, Rep, U>: imrs_zenoh::Import,
 {
-    fn import_ipc(
-        remote: &imrs_ipc::Remote,
-        port: &str,
-        owner: &str,
-        module: &str,
-    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
-        ipc_import(remote, port, owner, module)
-    }
-
     async fn import_zenoh(
         host: &imrs_zenoh::Host,
         port: &str,
@@ -103,20 +98,12 @@ where
     }
 }
 
+/// In a build without the `zenoh` feature, nothing more than a usage.
 #[cfg(not(feature = "zenoh"))]
-impl<Req: Crossing, Rep: Crossing, U: Usage> Importable<Req, Rep> for U
-where
-    imrs_ipc::Imported<Req, Rep, U>: imrs_ipc::Import<(Req, Rep)>,
-{
-    fn import_ipc(
-        remote: &imrs_ipc::Remote,
-        port: &str,
-        owner: &str,
-        module: &str,
-    ) -> Result<Imported<Req, Rep, U>, CarrierError> {
-        ipc_import(remote, port, owner, module)
-    }
-}
+pub trait ZenohImport<Req: Crossing, Rep: Crossing>: Usage {}
+
+#[cfg(not(feature = "zenoh"))]
+impl<Req: Crossing, Rep: Crossing, U: Usage> ZenohImport<Req, Rep> for U {}
 
 /// A port imported from another process, by either carrier: its local stand-in.
 pub trait Bridged<Req: Send + 'static, Rep: Send + 'static, U: Usage>: Send + Sync {
