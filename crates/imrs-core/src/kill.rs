@@ -43,9 +43,6 @@ impl KillSwitch {
     /// skipping the registration (two compare-and-swaps at every poll) loses no kill.
     #[inline]
     pub(crate) fn poll_killed(&self, cx: &mut Context<'_>, registered: &mut Option<Waker>) -> bool {
-        if self.killed.load(Ordering::Acquire) {
-            return true;
-        }
         if !registered
             .as_ref()
             .is_some_and(|waker| waker.will_wake(cx.waker()))
@@ -53,6 +50,7 @@ impl KillSwitch {
             self.waker.register(cx.waker());
             *registered = Some(cx.waker().clone());
         }
+        // After the registration: a kill that this load misses wakes the waker registered.
         self.killed.load(Ordering::Acquire)
     }
 }

@@ -3,7 +3,9 @@
 //! from the cell, which calls it, and from a module's context, which it extends with
 //! `costart`: a module can start modules, and this is the one place that knows both.
 
+use std::pin::Pin;
 use std::sync::Arc;
+use std::task::{Context, Poll};
 
 use imrs_ports::transport::Presence;
 use imrs_ports::{Name, Wiring};
@@ -103,9 +105,13 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
                 parent.clone(),
                 Arc::clone(&kill),
                 children.clone(),
-                Arc::clone(&presence),
+                &presence,
             );
-            let exit = copy.await;
+            let exit = Present {
+                presence: &presence,
+                copy,
+            }
+            .await;
             // The kill that ended this copy is spent; one that comes later is for the next.
             // (Rearming before a copy starts would lose a kill made before its first poll.)
             kill.rearm();
@@ -165,6 +171,23 @@ pub(crate) fn supervisor<S: Send + Sync + 'static>(
         report.tell(outcome);
     };
     Ok((handle, supervisor))
+}
+
+/// A module's copy, polled within the module's presence, so that the ends its threads
+/// attach are known as the module's.
+struct Present<'a, F> {
+    presence: &'a Arc<Presence>,
+    copy: F,
+}
+
+impl<F: Future + Unpin> Future for Present<'_, F> {
+    type Output = F::Output;
+
+    #[inline(always)]
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<F::Output> {
+        let this = self.get_mut();
+        Presence::within(Some(this.presence), || Pin::new(&mut this.copy).poll(cx))
+    }
 }
 
 /// The ports in `uses` that module `name` would take past their number of users, with the

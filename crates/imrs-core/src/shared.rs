@@ -129,6 +129,7 @@ impl CellShared {
     }
 
     /// Whether the cell observes its primitives ([`Cell::observe`](crate::Cell::observe)).
+    #[inline]
     pub(crate) fn observing(&self) -> bool {
         self.observe.load(Ordering::Relaxed)
     }

@@ -50,6 +50,10 @@ pub(crate) struct WaitRecord {
 
 impl WaitRecord {
     /// Notes a wait on `port`, served by `peer` (or, `None`, by any of the port's users).
+    ///
+    /// Inlined into the port operation that waits: the usual wait takes the first place,
+    /// three stores, and a call would cost as much again.
+    #[inline]
     pub(crate) fn begin(&self, port: &Name, peer: Option<&Name>) -> WaitId {
         let wait = Wait {
             port: port.token(),
@@ -66,21 +70,33 @@ impl WaitRecord {
             self.port.store(wait.port, Ordering::Release);
             return WaitId::First;
         }
+        self.begin_more(wait)
+    }
+
+    /// A wait beside one in progress (a `join` of two sends): into the list.
+    #[cold]
+    #[inline(never)]
+    fn begin_more(&self, wait: Wait) -> WaitId {
         lock(self.more.get_or_init(Box::default)).push(wait);
         WaitId::More(wait.seq)
     }
 
     /// The wait `id` has ended.
+    #[inline]
     pub(crate) fn end(&self, id: WaitId) {
         match id {
             WaitId::First => self.port.store(0, Ordering::Release),
-            WaitId::More(seq) => {
-                if let Some(more) = self.more.get() {
-                    let mut more = lock(more);
-                    if let Some(at) = more.iter().position(|wait| wait.seq == seq) {
-                        more.remove(at);
-                    }
-                }
+            WaitId::More(seq) => self.end_more(seq),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn end_more(&self, seq: u32) {
+        if let Some(more) = self.more.get() {
+            let mut more = lock(more);
+            if let Some(at) = more.iter().position(|wait| wait.seq == seq) {
+                more.remove(at);
             }
         }
     }
@@ -125,6 +141,7 @@ thread_local! {
 }
 
 /// The next wait number of this OS thread.
+#[inline]
 fn next_seq() -> u32 {
     NEXT_SEQ.with(|next| {
         let seq = next.get().wrapping_add(1);

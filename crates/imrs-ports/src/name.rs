@@ -97,6 +97,7 @@ impl Name {
     /// one atomic store and read by another thread, such as the port a module's thread
     /// waits on. [`Name::from_token`] gives the name back. One text, one token, for the
     /// life of the process.
+    #[inline]
     pub fn token(&self) -> usize {
         // Each name is its own leaked allocation, so its address is its own; an empty
         // text's dangling address is still not 0.

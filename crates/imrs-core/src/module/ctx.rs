@@ -179,14 +179,11 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Sends,
     {
-        let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&message)));
-        let started = Started {
-            watch,
-            primitive: Primitive::Send,
-            show: ShowReply(shown.map(|shown| shown.reply)),
-            done: |port, observed| EventKind::Sent { port, observed },
-        };
-        PortOp::new(self, end.send(message), started)
+        let watch = self.watch(end, |shown| {
+            let text = (shown.request)(&message);
+            (Some(text), ShowReply(Some(shown.reply)))
+        });
+        PortOp::new(self, end.send(message), watch)
     }
 
     /// `RECEIVE`: as [`End::receive`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -200,14 +197,8 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Receives,
     {
-        let (watch, shown) = self.watch(end, |_| None);
-        let started = Started {
-            watch,
-            primitive: Primitive::Receive,
-            show: ShowRequest(shown.map(|shown| shown.request)),
-            done: |port, observed| EventKind::Received { port, observed },
-        };
-        PortOp::new(self, end.receive(), started)
+        let watch = self.watch(end, |shown| (None, ShowRequest(Some(shown.request))));
+        PortOp::new(self, end.receive(), watch)
     }
 
     /// `QUERY`: as [`End::query`], and a timeout raises `PORT.TIMEOUT` in this module.
@@ -222,14 +213,11 @@ impl<S: Send + Sync + 'static> Ctx<S> {
         Rep: Send + 'static,
         U: Queries,
     {
-        let (watch, shown) = self.watch(end, |shown| Some((shown.request)(&query)));
-        let started = Started {
-            watch,
-            primitive: Primitive::Query,
-            show: ShowReply(shown.map(|shown| shown.reply)),
-            done: |port, observed| EventKind::Queried { port, observed },
-        };
-        PortOp::new(self, end.query(query), started)
+        let watch = self.watch(end, |shown| {
+            let text = (shown.request)(&query);
+            (Some(text), ShowReply(Some(shown.reply)))
+        });
+        PortOp::new(self, end.query(query), watch)
     }
 
     /// Whether the cell observes its primitives closely ([`Cell::observe`]).
@@ -242,22 +230,25 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     /// port shows its values; with how the port shows them.
     #[allow(clippy::type_complexity)]
     #[inline]
-    fn watch<Req, Rep, U>(
+    fn watch<Req, Rep, U, D: Default>(
         &self,
         end: &End<Req, Rep, U>,
-        message: impl FnOnce(Shown<Req, Rep>) -> Option<String>,
-    ) -> (Option<Box<Watch>>, Option<Shown<Req, Rep>>)
+        shown: impl FnOnce(Shown<Req, Rep>) -> (Option<String>, D),
+    ) -> Option<Box<Watch<D>>>
     where
         Req: Send + 'static,
         Rep: Send + 'static,
         U: Usage,
     {
         if !self.observing() {
-            return (None, None);
+            return None;
         }
-        let shown = end.shown();
-        let text = shown.and_then(message);
-        (Some(Box::new(Watch { since: None, text })), shown)
+        let (text, show) = end.shown().map_or((None, D::default()), shown);
+        Some(Box::new(Watch {
+            since: None,
+            text,
+            show,
+        }))
     }
 
     /// `waitfor`: as [`WaitFor::waitfor`], under this task's name; a timeout raises
@@ -398,7 +389,9 @@ impl<S: Send + Sync + 'static> Ctx<S> {
     }
 
     /// Notes, in this thread's record, a wait on `port` served by `peer` (or by any of the
-    /// port's users): the deadlock diagnosis reads it only if the wait lasts.
+    /// port's users): the deadlock diagnosis reads it only if the wait lasts. Inlined into
+    /// [`begin_wait`], the one caller, which is itself out of the message's way.
+    #[inline(always)]
     fn wait_on(&self, port: &Name, peer: Option<&Name>) -> WaitGuard<'_> {
         let guard = WaitGuard {
             record: &self.thread.waits,
@@ -481,7 +474,9 @@ impl PortFailure for ReceiveError {
     }
 }
 
-/// The end's own future under a [`PortOp`]: the port it works on, and whom it waits on.
+/// The end's own future under a [`PortOp`]: the port it works on, whom it waits on, and
+/// which primitive it is. What depends only on the kind of operation is here, in the type,
+/// so that a port operation carries none of it.
 pub trait PortOperation {
     /// The port.
     fn port(&self) -> &Name;
@@ -491,9 +486,11 @@ pub trait PortOperation {
     /// Whether the deadlock diagnosis notes this operation's wait: a receive waits for
     /// whoever comes, which is no peer in a cycle.
     const NOTED: bool;
+    /// The primitive, as the event log names it.
+    const PRIMITIVE: Primitive;
 }
 
-impl<Req, Rep, O> PortOperation for Posting<'_, Req, Rep, O> {
+impl<Req, Rep> PortOperation for Posting<'_, Req, Rep, SendOutcome> {
     fn port(&self) -> &Name {
         Posting::port(self)
     }
@@ -501,6 +498,18 @@ impl<Req, Rep, O> PortOperation for Posting<'_, Req, Rep, O> {
         Posting::waits_on(self)
     }
     const NOTED: bool = true;
+    const PRIMITIVE: Primitive = Primitive::Send;
+}
+
+impl<Req, Rep> PortOperation for Posting<'_, Req, Rep, QueryOutcome> {
+    fn port(&self) -> &Name {
+        Posting::port(self)
+    }
+    fn waits_on(&self) -> Option<&Name> {
+        Posting::waits_on(self)
+    }
+    const NOTED: bool = true;
+    const PRIMITIVE: Primitive = Primitive::Query;
 }
 
 impl<Req, Rep> PortOperation for Receiving<'_, Req, Rep> {
@@ -511,6 +520,16 @@ impl<Req, Rep> PortOperation for Receiving<'_, Req, Rep> {
         None
     }
     const NOTED: bool = false;
+    const PRIMITIVE: Primitive = Primitive::Receive;
+}
+
+/// The event a port operation of `primitive` logs when it succeeds.
+fn done(primitive: Primitive, port: Name, observed: Option<Box<Observed>>) -> EventKind {
+    match primitive {
+        Primitive::Send => EventKind::Sent { port, observed },
+        Primitive::Query => EventKind::Queried { port, observed },
+        Primitive::Receive | Primitive::WaitFor => EventKind::Received { port, observed },
+    }
 }
 
 pin_project_lite::pin_project! {
@@ -527,11 +546,7 @@ pin_project_lite::pin_project! {
         ctx: &'a Ctx<S>,
         waiting: Option<WaitGuard<'a>>,
         // What an observing cell watches; `None` (and no clock read, no text) otherwise.
-        watch: Option<Box<Watch>>,
-        primitive: Primitive,
-        // How to show what comes back, where the port shows its values.
-        show: D,
-        done: fn(Name, Option<Box<Observed>>) -> EventKind,
+        watch: Option<Box<Watch<D>>>,
         #[pin]
         operation: F,
     }
@@ -539,34 +554,22 @@ pin_project_lite::pin_project! {
 
 /// What an observing cell's port operation keeps until it ends: when it first had to wait
 /// (`None` while it has not, so that one that completes at once reads the clock only for its
-/// event), and the text of the message it sent.
-struct Watch {
+/// event), the text of the message it sent, and how to show what comes back.
+struct Watch<D> {
     since: Option<Instant>,
     text: Option<String>,
-}
-
-/// What a port operation knows when it starts: what it watches (only
-/// while the cell observes), which primitive it is, how to show what comes back, and the
-/// event it logs when it ends.
-struct Started<D> {
-    watch: Option<Box<Watch>>,
-    primitive: Primitive,
     show: D,
-    done: fn(Name, Option<Box<Observed>>) -> EventKind,
 }
 
 impl<'a, S, F, D> PortOp<'a, S, F, D> {
     // Built in one go, and inlined into the task's future, so that the operation's future
     // is built where it stays rather than copied there.
     #[inline]
-    fn new(ctx: &'a Ctx<S>, operation: F, started: Started<D>) -> Self {
+    fn new(ctx: &'a Ctx<S>, operation: F, watch: Option<Box<Watch<D>>>) -> Self {
         Self {
             ctx,
             waiting: None,
-            watch: started.watch,
-            primitive: started.primitive,
-            show: started.show,
-            done: started.done,
+            watch,
             operation,
         }
     }
@@ -585,6 +588,19 @@ pub struct ShowReply<Rep>(Option<fn(&Rep) -> String>);
 /// Shows the message a receive got, if the port's values are shown.
 #[derive(Debug)]
 pub struct ShowRequest<Req>(Option<fn(&Req) -> String>);
+
+// By hand: a derive would ask the shown type to be `Default` too.
+impl<Rep> Default for ShowReply<Rep> {
+    fn default() -> Self {
+        Self(None)
+    }
+}
+
+impl<Req> Default for ShowRequest<Req> {
+    fn default() -> Self {
+        Self(None)
+    }
+}
 
 impl<Rep> ShowResult<Rep> for ShowReply<Rep> {
     fn show(&self, reply: &Rep) -> Option<String> {
@@ -627,35 +643,34 @@ where
                 let timed_out = error.is_timeout();
                 let port = port();
                 this.ctx
-                    .port_failed(port, *this.primitive, error.to_string(), None, timed_out);
+                    .port_failed(port, F::PRIMITIVE, error.to_string(), None, timed_out);
             }
             return Poll::Ready(result);
         };
+        let Watch { since, text, show } = *watch;
         let port = port();
         let now = this.ctx.module.cell.clock.now();
         let mut observed = Box::new(Observed {
-            waited: watch
-                .since
-                .map_or(Duration::ZERO, |since| now.saturating_duration_since(since)),
-            message: watch.text,
+            waited: since.map_or(Duration::ZERO, |since| now.saturating_duration_since(since)),
+            message: text,
             reply: None,
         });
         match &result {
             Ok(value) => {
                 // What came back: a send's or a query's reply, a receive's message.
-                let shown = this.show.show(value);
-                match *this.primitive {
+                let shown = show.show(value);
+                match F::PRIMITIVE {
                     Primitive::Receive => observed.message = shown,
                     _ => observed.reply = shown,
                 }
-                let kind = (this.done)(port, Some(observed));
+                let kind = done(F::PRIMITIVE, port, Some(observed));
                 this.ctx
                     .module
                     .event_at(now, Some(&this.ctx.thread.task), kind);
             }
             Err(error) => this.ctx.port_failed(
                 port,
-                *this.primitive,
+                F::PRIMITIVE,
                 error.to_string(),
                 Some(observed),
                 error.is_timeout(),
@@ -669,9 +684,9 @@ where
 /// notes whom it waits on, once. Out of line: an operation that completes at once, and an
 /// operation polled again while it waits, pass by it.
 #[inline(never)]
-fn begin_wait<'a, S: Send + Sync + 'static, F: PortOperation>(
+fn begin_wait<'a, S: Send + Sync + 'static, F: PortOperation, D>(
     ctx: &'a Ctx<S>,
-    watch: &mut Option<Box<Watch>>,
+    watch: &mut Option<Box<Watch<D>>>,
     waiting: &mut Option<WaitGuard<'a>>,
     operation: &F,
 ) {

@@ -48,6 +48,9 @@ pub(crate) enum ModuleExit {
     Killed,
 }
 
+// A one-byte tag: the scheduler looks at the stage at every poll, and a niche in the
+// reason's `String` would cost a decoding each time.
+#[repr(u8)]
 enum Stage {
     Running(BoxFuture<TaskResult>),
     Restarting(Pin<Box<Sleep>>),
@@ -87,9 +90,9 @@ pub(crate) struct ModuleRun<S> {
     kill: Arc<KillSwitch>,
     /// The waker last registered with `kill`.
     kill_waker: Option<Waker>,
-    /// The module's presence, entered around every poll so that the ends its threads attach
-    /// are known as the module's (taken out while it is entered).
-    presence: Option<Arc<Presence>>,
+    /// One task and no response handler: while no exception handler runs and nothing is
+    /// pending, a poll of the module is a poll of its task.
+    single: bool,
     /// The module's span, where a subscriber wanted it when the copy started: boxed, since
     /// most cells have none and every idle module would carry its room.
     span: Option<Box<tracing::Span>>,
@@ -102,7 +105,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         parent: Option<Name>,
         kill: Arc<KillSwitch>,
         children: Children,
-        presence: Arc<Presence>,
+        presence: &Arc<Presence>,
     ) -> Self {
         let order = Order::new(spec.name.clone(), spec.order);
         let background = order.background();
@@ -111,7 +114,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
             .into_iter()
             .map(|(name, mut end)| {
                 // Attached before the module ran: held by it all the same.
-                end.bind(&presence);
+                end.bind(presence);
                 ResponseRun {
                     rank: order.handler_rank(name.as_str()),
                     name,
@@ -149,7 +152,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
                 };
                 let ctx = Ctx::new(Arc::clone(&shared), Arc::clone(&run.thread));
                 // Within the presence: the ends the task's closure attaches are the module's.
-                let future = Presence::within(Some(&presence), || (run.factory)(ctx));
+                let future = Presence::within(Some(presence), || (run.factory)(ctx));
                 run.stage = Stage::Running(future);
                 shared.event(Some(&run.name), EventKind::TaskStarted);
                 run
@@ -160,13 +163,13 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         });
         Self {
             shared,
+            single: tasks.len() == 1 && responses.is_empty(),
             tasks,
             handlers: Vec::new(),
             responses,
             exception_handlers,
             kill,
             kill_waker: None,
-            presence: Some(presence),
             span,
         }
     }
@@ -526,15 +529,10 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
 
     #[inline(always)]
     fn poll_copy(&mut self, cx: &mut Context<'_>) -> Poll<ModuleExit> {
-        let this = self;
-        if this.kill.poll_killed(cx, &mut this.kill_waker) {
+        if self.kill.poll_killed(cx, &mut self.kill_waker) {
             return Poll::Ready(ModuleExit::Killed);
         }
-        // Moved out and back, so that the presence is lent while the module is borrowed.
-        let presence = this.presence.take();
-        let poll = Presence::within(presence.as_ref(), || this.poll_threads(cx));
-        this.presence = presence;
-        poll
+        self.poll_threads(cx)
     }
 }
 
@@ -545,11 +543,7 @@ impl<S: Send + Sync + 'static> ModuleRun<S> {
         // The usual module, between two messages: one task, no handler to start or run,
         // nothing raised. Its poll is its task's poll, and one load after it tells whether
         // the task raised something that the order must look at.
-        if self.tasks.len() == 1
-            && self.handlers.is_empty()
-            && self.responses.is_empty()
-            && !self.shared.has_pending()
-        {
+        if self.single && self.handlers.is_empty() && !self.shared.has_pending() {
             if !self.poll_task(0, cx) {
                 if !self.shared.has_pending() {
                     return Poll::Pending;
