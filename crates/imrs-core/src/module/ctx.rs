@@ -523,7 +523,8 @@ impl<Req, Rep> PortOperation for Receiving<'_, Req, Rep> {
     const PRIMITIVE: Primitive = Primitive::Receive;
 }
 
-/// The event a port operation of `primitive` logs when it succeeds.
+/// The event a port operation of `primitive` logs when it succeeds. A waitfor is no port
+/// operation (it logs its own events), so no `PortOp` asks for its arm.
 fn done(primitive: Primitive, port: Name, observed: Option<Box<Observed>>) -> EventKind {
     match primitive {
         Primitive::Send => EventKind::Sent { port, observed },
