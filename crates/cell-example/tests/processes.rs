@@ -322,6 +322,16 @@ fn line_process(world: u32, line: &str) -> Option<u32> {
     })
 }
 
+/// `line`'s process among `world`'s children once it is up, waited for within `limit`.
+fn line_up(world: u32, line: &str, limit: Duration) -> Option<u32> {
+    let mut found = None;
+    within(limit, || {
+        found = line_process(world, line);
+        found.is_some()
+    });
+    found
+}
+
 /// `report` shows line A's outage (its `what`: "process died", "host was cut off") and its
 /// next run back before the end; both lines completed cards, and no invariant failed.
 fn line_a_came_back(report: &str, what: &str) {
@@ -354,14 +364,8 @@ fn a_line_killed_mid_run_is_started_again_and_the_other_goes_on() {
     std::thread::sleep(Duration::from_secs(3));
     kill_9(line_a);
     // Line A's next run is started; line B's process is the same one all along.
-    let mut restarted = None;
-    assert!(
-        within(Duration::from_secs(10), || {
-            restarted = line_process(world.pid(), "A");
-            restarted.is_some()
-        }),
-        "line A was not started again"
-    );
+    let restarted = line_up(world.pid(), "A", Duration::from_secs(10));
+    assert!(restarted.is_some(), "line A was not started again");
     assert_ne!(restarted, Some(line_a));
     std::thread::sleep(Duration::from_secs(8));
     assert!(alive(line_b), "line B stopped");
@@ -428,15 +432,9 @@ fn over_zenoh_each_line_is_a_host_of_its_own_and_one_killed_is_started_again() {
     std::thread::sleep(Duration::from_secs(3));
     // Line A's process as the world runs it now: a run started again meanwhile (its host
     // seen gone under load) is found once it is up, and the report names that outage.
-    let mut line_a = None;
-    assert!(
-        within(Duration::from_secs(30), || {
-            line_a = line_process(world.pid(), "A");
-            line_a.is_some()
-        }),
-        "no process of line A among the world's children"
-    );
-    kill_9(line_a.expect("found above"));
+    let line_a = line_up(world.pid(), "A", Duration::from_secs(30))
+        .expect("no process of line A among the world's children");
+    kill_9(line_a);
     let report = world.report(Duration::from_secs(120));
     let apart = report.contains(
         "line A, line B over zenoh, each a host of its own (a network namespace, joined to \
